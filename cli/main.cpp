@@ -1,0 +1,88 @@
+// qsgi: the command-line host. Parses options, configures a RenderJob, reports progress and maps
+// errors to exit codes (0 ok, 2 bad input, 1 internal error). No algorithm lives here.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+
+#include "pipeline/render_job.h"
+#include "util/error.h"
+#include "util/progress.h"
+
+namespace {
+
+constexpr int kExitBadInput = 2;
+constexpr int kExitInternal = 1;
+
+struct CliOptions {
+    std::string config, animation, estimator, frames, out;
+    int64_t photons = -1, seed = -1, threads = -1;
+    bool quiet = false, verbose = false;
+};
+
+// Later sources override earlier ones: defaults, then --config, then explicit options.
+qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene) {
+    qsgi::RenderSettings s;
+    if (!o.config.empty()) qsgi::applyConfigFile(o.config, s);
+    if (!scene.empty()) s.scenePath = scene;
+    if (!o.animation.empty()) s.animationPath = o.animation;
+    if (!o.estimator.empty()) s.estimator = qsgi::parseEstimator(o.estimator, "command line");
+    if (!o.frames.empty()) s.frames = qsgi::parseFrameRange(o.frames, "command line");
+    if (!o.out.empty()) s.outDir = o.out;
+    if (o.photons == 0 || o.photons < -1) throw qsgi::InputError("command line", "--photons", "must be a positive integer");
+    if (o.photons > 0) s.photons = uint64_t(o.photons);
+    if (o.seed < -1) throw qsgi::InputError("command line", "--seed", "must be a non-negative integer");
+    if (o.seed >= 0) s.seed = uint64_t(o.seed);
+    if (o.threads < -1) throw qsgi::InputError("command line", "--threads", "must be a non-negative integer (0: all cores)");
+    if (o.threads >= 0) s.threads = int(o.threads);
+    s.quiet = o.quiet;
+    s.progress = !o.quiet && qsgi::stderrIsTerminal();
+    return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"qsgi — global illumination at mesh vertices for animations of quasi-static scenes"};
+    app.set_version_flag("--version", std::string("qsgi ") + QSGI_VERSION);
+    app.require_subcommand(1);
+
+    CliOptions o;
+    std::string scene;
+    CLI::App* render = app.add_subcommand("render", "render every frame of a scene's animation to vertex-radiosity PLYs");
+    render->add_option("SCENE", scene, "glTF 2.0 scene (.gltf or .glb); may come from --config instead");
+    render->add_option("--config", o.config, "JSON config with the same keys (configs/default.json); options override it");
+    render->add_option("--animation", o.animation, "qsgi-animation transform file (JSON)");
+    render->add_option("--estimator", o.estimator, "density estimator: impact-count");
+    render->add_option("--photons", o.photons, "photons traced per frame (default 1000000)");
+    render->add_option("--seed", o.seed, "random seed (default 1); same seed, same bytes");
+    render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");
+    render->add_option("--frames", o.frames, "frames A:B, inclusive at both ends (default: all)");
+    render->add_option("--out", o.out, "output folder (default out)");
+    render->add_flag("--quiet", o.quiet, "print nothing but errors");
+    render->add_flag("--verbose", o.verbose, "print per-frame timings");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);
+        return code == 0 ? 0 : kExitBadInput;
+    }
+
+    try {
+        qsgi::Warnings warnings;
+        qsgi::RenderJob job(settingsFrom(o, scene), warnings);
+        if (!o.quiet)
+            for (const auto& w : warnings.messages) std::fprintf(stderr, "qsgi: warning: %s\n", w.c_str());
+        job.run([&](const qsgi::FrameReport& r) {
+            if (o.verbose) std::fprintf(stderr, "qsgi: frame %d (%d/%d) %.3f s\n", r.frame, r.index + 1, r.count, r.seconds);
+        });
+        return 0;
+    } catch (const qsgi::InputError& e) {
+        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
+        return kExitBadInput;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "qsgi: internal error: %s\n", e.what());
+        return kExitInternal;
+    }
+}

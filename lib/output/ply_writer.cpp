@@ -1,0 +1,67 @@
+#include "output/ply_writer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "output/atomic_file.h"
+
+namespace qsgi {
+
+PreviewTonemap PreviewTonemap::fromPercentile(const std::vector<Vec3f>& radiosity) {
+    std::vector<float> peaks;
+    peaks.reserve(radiosity.size());
+    for (const Vec3f& b : radiosity) peaks.push_back(maxComponent(b));
+    PreviewTonemap t;
+    if (peaks.empty()) return t;
+    const size_t k = std::min(peaks.size() - 1, size_t(0.99 * double(peaks.size())));
+    std::nth_element(peaks.begin(), peaks.begin() + k, peaks.end());
+    t.scale = peaks[k] > 0 && std::isfinite(peaks[k]) ? 1.0f / peaks[k] : 1.0f;
+    return t;
+}
+
+uint8_t PreviewTonemap::encode(float value) const {
+    const float x = std::clamp(value * scale, 0.0f, 1.0f);
+    const float s = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1 / 2.4f) - 0.055f;
+    return uint8_t(std::lround(std::clamp(s, 0.0f, 1.0f) * 255));
+}
+
+namespace {
+template <typename T>
+void put(std::string& buf, T v) {
+    static_assert(sizeof(T) <= 8);
+    char bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));  // x86-64 and ARM64 are little-endian, as the format says
+    buf.append(bytes, sizeof(T));
+}
+}  // namespace
+
+void writeVertexRadiosityPly(const std::filesystem::path& path, const Scene& scene, const VertexRadiosity& result,
+                             const PreviewTonemap& tonemap) {
+    std::ostringstream header;
+    header << "ply\nformat binary_little_endian 1.0\ncomment qsgi " << QSGI_VERSION
+           << " vertex radiosity (W/m^2)\nelement vertex " << scene.vertexCount()
+           << "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+              "property float radiosity_r\nproperty float radiosity_g\nproperty float radiosity_b\n"
+              "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face "
+           << scene.triangleCount() << "\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string buf = header.str();
+    buf.reserve(buf.size() + scene.vertexCount() * 39 + scene.triangleCount() * 13);
+    for (size_t v = 0; v < scene.vertexCount(); ++v) {
+        const Vec3f p(Vec3d(scene.positions[v]) + scene.worldOrigin);
+        const Vec3f& n = scene.normals[v];
+        const Vec3f& b = result.radiosity[v];
+        for (float f : {p.x, p.y, p.z, n.x, n.y, n.z, b.x, b.y, b.z}) put(buf, f);
+        for (float f : {b.x, b.y, b.z}) put(buf, tonemap.encode(f));
+    }
+    for (const Triangle& t : scene.triangles) {
+        put(buf, uint8_t(3));
+        for (uint32_t v : t.v) put(buf, int32_t(v));
+    }
+    AtomicFile file(path);
+    file.stream().write(buf.data(), std::streamsize(buf.size()));
+    file.commit();
+}
+
+}  // namespace qsgi

@@ -1,0 +1,24 @@
+// frame_NNNN.ply (DESIGN §7): binary little-endian; vertex x y z nx ny nz, radiosity_r/g/b
+// (W/m^2) and a tonemapped red green blue preview; faces as vertex_indices.
+#pragma once
+
+#include <filesystem>
+
+#include "estimate/vertex_radiosity.h"
+#include "scene/scene.h"
+
+namespace qsgi {
+
+// Maps radiosity to the 8-bit preview colours: B * scale, clamped, sRGB-encoded. One scale for a
+// whole animation keeps the preview from flickering between frames.
+struct PreviewTonemap {
+    float scale = 1;
+    // Scale that puts the 99th percentile of the vertices' largest radiosity component at white.
+    static PreviewTonemap fromPercentile(const std::vector<Vec3f>& radiosity);
+    uint8_t encode(float value) const;
+};
+
+void writeVertexRadiosityPly(const std::filesystem::path& path, const Scene& scene, const VertexRadiosity& result,
+                             const PreviewTonemap& tonemap);
+
+}  // namespace qsgi

@@ -1,0 +1,55 @@
+#include "output/timing_log.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+
+#include "output/atomic_file.h"
+
+namespace qsgi {
+
+namespace {
+nlohmann::json summary(std::vector<double> v) {
+    if (v.empty()) return nullptr;
+    std::sort(v.begin(), v.end());
+    double sum = 0;
+    for (double x : v) sum += x;
+    const size_t n = v.size();
+    const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return {{"mean", sum / double(n)}, {"median", median}, {"max", v.back()}};
+}
+}  // namespace
+
+void TimingLog::write(const std::filesystem::path& path) const {
+    using nlohmann::json;
+    json j;
+    j["version"] = QSGI_VERSION;
+    j["config"] = {{"estimator", estimator}, {"photons", photons}, {"radius", nullptr}, {"k", nullptr},
+                   {"ray_cache", true}, {"sort_queries", true}, {"full_recompute", fullRecompute},
+                   {"seed", seed}, {"threads", threads}};
+    j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
+                  {"dynamic_vertices", dynamicVertices}, {"lights", lights},
+                  {"degenerate_triangles", degenerateTriangles}};
+    std::vector<double> updates, estimates;
+    for (size_t i = 1; i < frames.size(); ++i) {
+        updates.push_back(frames[i].photonSimulationSeconds);
+        estimates.push_back(frames[i].estimationSeconds);
+    }
+    j["photon_simulation"] = {{"initial_s", frames.empty() ? 0.0 : frames[0].photonSimulationSeconds},
+                              {"update_s", summary(updates)}};
+    j["density_estimation"] = {{"initial_s", frames.empty() ? 0.0 : frames[0].estimationSeconds},
+                               {"frame_s", summary(estimates)}};
+    json list = json::array();
+    for (const FrameTiming& f : frames)
+        list.push_back({{"frame", f.frame}, {"photon_update_s", f.photonSimulationSeconds},
+                        {"estimation_s", f.estimationSeconds}, {"write_s", f.writeSeconds},
+                        {"segments", f.segments}, {"paths_retraced", f.pathsRetraced},
+                        {"segments_removed", f.segmentsRemoved}, {"segments_added", f.segmentsAdded},
+                        {"vertices_updated", f.verticesUpdated}});
+    j["frames"] = list;
+    AtomicFile file(path);
+    file.stream() << j.dump(2) << "\n";
+    file.commit();
+}
+
+}  // namespace qsgi

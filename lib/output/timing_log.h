@@ -1,0 +1,39 @@
+// timing.json (DESIGN §7): the run's configuration, per-frame timings and work counts, and the
+// summaries that mirror the paper's table (initial frame vs. per-frame update).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace qsgi {
+
+struct FrameTiming {
+    int frame = 0;
+    double photonSimulationSeconds = 0;  // tracing (or retracing) photons
+    double estimationSeconds = 0;        // density estimation
+    double writeSeconds = 0;             // PLY (and later image) output
+    uint64_t segments = 0;               // segments in the ray cache after this frame
+    uint64_t pathsRetraced = 0;
+    uint64_t segmentsRemoved = 0, segmentsAdded = 0;
+    uint64_t verticesUpdated = 0;
+};
+
+struct TimingLog {
+    // config
+    std::string estimator;
+    uint64_t photons = 0, seed = 0;
+    int threads = 0;
+    bool fullRecompute = true;
+    // scene
+    std::string scene;
+    uint64_t vertices = 0, triangles = 0, dynamicVertices = 0, lights = 0;
+    uint64_t degenerateTriangles = 0;
+
+    std::vector<FrameTiming> frames;
+
+    void write(const std::filesystem::path& path) const;  // atomically
+};
+
+}  // namespace qsgi

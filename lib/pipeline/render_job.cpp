@@ -1,0 +1,124 @@
+#include "pipeline/render_job.h"
+
+#include <tbb/global_control.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+#include "estimate/impact_count.h"
+#include "output/ply_writer.h"
+#include "output/timing_log.h"
+#include "scene/gltf_loader.h"
+#include "trace/photon_tracer.h"
+#include "util/progress.h"
+#include "util/stopwatch.h"
+
+namespace qsgi {
+
+namespace fs = std::filesystem;
+
+std::string frameFileName(int frame, const char* extension) {
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%04d.%s", frame, extension);
+    return name;
+}
+
+RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
+    : settings_(std::move(settings)), scene_(), animation_() {
+    validateSettings(settings_);
+    scene_ = loadGltfScene(settings_.scenePath, warnings);
+    for (PunctualLight light : settings_.extraLights) {
+        light.position = Vec3f(Vec3d(light.position) - scene_.worldOrigin);
+        scene_.lights.push_back(light);
+    }
+    if (scene_.triangleCount() == 0) throw InputError(settings_.scenePath, "", "the scene has no triangles");
+    bool emissive = false;
+    for (uint32_t t = 0; t < scene_.triangleCount() && !emissive; ++t)
+        emissive = scene_.materials[scene_.triangleMaterial[t]].isEmissive() && scene_.triangleArea(t) > 0;
+    bool lit = emissive;
+    for (const PunctualLight& l : scene_.lights) lit = lit || luminance(l.intensity) > 0;
+    if (!lit)
+        throw InputError(settings_.scenePath, "",
+                         "the scene has no lights (no emissive material, no KHR_lights_punctual light); add one with "
+                         "\"lights\" in a --config file");
+
+    animation_ = settings_.animationPath.empty() ? Animation::still(scene_)
+                                                 : Animation::fromTransformFile(settings_.animationPath, scene_);
+    if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, settings_.animationPath);
+    scene_.markDynamic(animation_.movedNodes());
+
+    first_ = 0;
+    last_ = animation_.lastFrame();
+    if (settings_.frames) {
+        first_ = settings_.frames->first;
+        last_ = settings_.frames->last < 0 ? animation_.lastFrame() : settings_.frames->last;
+        if (last_ > animation_.lastFrame())
+            throw InputError("command line", "--frames",
+                             std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the animation's last frame " +
+                                 std::to_string(animation_.lastFrame()));
+    }
+}
+
+void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
+    std::optional<tbb::global_control> threadLimit;
+    if (settings_.threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(settings_.threads));
+
+    const fs::path outDir(settings_.outDir);
+    std::error_code ec;
+    fs::create_directories(outDir, ec);
+    if (ec || !fs::is_directory(outDir))
+        throw InputError(settings_.outDir, "--out", "cannot create the output folder" + (ec ? ": " + ec.message() : ""));
+
+    TimingLog log;
+    log.estimator = estimatorName(settings_.estimator);
+    log.photons = settings_.photons;
+    log.seed = settings_.seed;
+    log.threads = settings_.threads > 0 ? settings_.threads
+                                        : int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    log.scene = settings_.scenePath;
+    log.vertices = scene_.vertexCount();
+    log.triangles = scene_.triangleCount();
+    for (uint8_t d : scene_.vertexDynamic) log.dynamicVertices += d;
+    log.lights = scene_.lights.size();
+
+    EmbreeDevice device;
+    std::optional<PreviewTonemap> tonemap;
+    const int count = last_ - first_ + 1;
+    for (int frame = first_; frame <= last_; ++frame) {
+        Stopwatch frameClock;
+        FrameTiming timing;
+        timing.frame = frame;
+        scene_.applyPose(animation_.localsAt(frame));
+
+        // Every frame from scratch for now; the incremental update (DESIGN §6) slots in here.
+        Stopwatch clock;
+        const SceneBvh bvh(device, scene_);
+        const PhotonTracer tracer(scene_, bvh, TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces});
+        ProgressBar bar("frame " + std::to_string(frame) + " photons", settings_.photons, settings_.progress);
+        const RayCache cache = tracer.traceAll([&](uint64_t done, uint64_t) { bar.update(done); });
+        bar.finish();
+        timing.photonSimulationSeconds = clock.seconds();
+        timing.segments = cache.segments.size();
+        timing.pathsRetraced = cache.pathCount();
+        timing.segmentsAdded = cache.segments.size();
+
+        clock.restart();
+        ImpactCount estimator(scene_);
+        estimator.accumulate(cache);
+        const VertexRadiosity result = estimator.estimate(scene_, PowerQuantizer(cache.maxPhotonPower));
+        timing.estimationSeconds = clock.seconds();
+        timing.verticesUpdated = scene_.vertexCount();
+        log.degenerateTriangles = estimator.degenerateTriangles();
+
+        clock.restart();
+        if (!tonemap) tonemap = PreviewTonemap::fromPercentile(result.radiosity);
+        writeVertexRadiosityPly(outDir / frameFileName(frame, "ply"), scene_, result, *tonemap);
+        timing.writeSeconds = clock.seconds();
+        log.frames.push_back(timing);
+        if (onFrame) onFrame(FrameReport{frame, frame - first_, count, frameClock.seconds()});
+    }
+    log.write(outDir / "timing.json");
+}
+
+}  // namespace qsgi

@@ -1,0 +1,141 @@
+#include "pipeline/render_settings.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "util/error.h"
+
+namespace qsgi {
+
+using nlohmann::json;
+
+EstimatorKind parseEstimator(const std::string& name, const std::string& source) {
+    if (name == "impact-count") return EstimatorKind::ImpactCount;
+    throw InputError(source, "estimator", "unknown estimator '" + name + "' (available: impact-count)");
+}
+
+const char* estimatorName(EstimatorKind kind) {
+    switch (kind) {
+        case EstimatorKind::ImpactCount: return "impact-count";
+    }
+    return "?";
+}
+
+FrameRange parseFrameRange(const std::string& text, const std::string& source) {
+    auto parseInt = [&](const std::string& s) {
+        if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos)
+            throw InputError(source, "frames", "'" + text + "' is not A:B with non-negative integers A <= B");
+        return std::stoi(s);
+    };
+    FrameRange r;
+    const auto colon = text.find(':');
+    if (colon == std::string::npos) {
+        r.first = r.last = parseInt(text);
+    } else {
+        r.first = parseInt(text.substr(0, colon));
+        r.last = parseInt(text.substr(colon + 1));
+    }
+    if (r.first > r.last) throw InputError(source, "frames", "'" + text + "': the first frame is after the last");
+    return r;
+}
+
+namespace {
+
+Vec3f vec3(const json& j, const std::string& file, const std::string& place) {
+    if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
+        throw InputError(file, place, "must be an array of 3 numbers");
+    Vec3f v(j[0].get<float>(), j[1].get<float>(), j[2].get<float>());
+    if (!isFinite(v)) throw InputError(file, place, "holds a non-finite number");
+    return v;
+}
+
+PunctualLight parseLight(const json& j, const std::string& file, const std::string& place) {
+    if (!j.is_object() || !j.contains("type") || !j["type"].is_string())
+        throw InputError(file, place, "must be an object with a \"type\" (point or directional)");
+    PunctualLight l;
+    const std::string type = j["type"];
+    l.name = place;
+    auto nonNegative = [&](const Vec3f& v, const std::string& field) {
+        if (v.x < 0 || v.y < 0 || v.z < 0) throw InputError(file, place + "." + field, "must be non-negative");
+        return v;
+    };
+    if (type == "point") {
+        l.type = LightType::Point;
+        if (!j.contains("position") || !j.contains("intensity"))
+            throw InputError(file, place, "a point light needs \"position\" and \"intensity\" (W/sr)");
+        l.position = vec3(j["position"], file, place + ".position");
+        l.intensity = nonNegative(vec3(j["intensity"], file, place + ".intensity"), "intensity");
+    } else if (type == "directional") {
+        l.type = LightType::Directional;
+        if (!j.contains("direction") || !j.contains("irradiance"))
+            throw InputError(file, place, "a directional light needs \"direction\" and \"irradiance\" (W/m^2)");
+        l.direction = normalize(vec3(j["direction"], file, place + ".direction"));
+        if (dot(l.direction, l.direction) == 0) throw InputError(file, place + ".direction", "must not be zero");
+        l.intensity = nonNegative(vec3(j["irradiance"], file, place + ".irradiance"), "irradiance");
+    } else {
+        throw InputError(file, place + ".type", "unknown light type '" + type + "' (point or directional)");
+    }
+    return l;
+}
+
+uint64_t positiveInteger(const json& j, const std::string& file, const std::string& key) {
+    if (!j.is_number_integer() || j.get<int64_t>() <= 0)
+        throw InputError(file, key, "must be a positive integer");
+    return j.get<uint64_t>();
+}
+
+}  // namespace
+
+void applyConfigFile(const std::string& path, RenderSettings& s) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, "", "cannot be opened for reading");
+    json doc;
+    try {
+        doc = json::parse(in);
+    } catch (const json::parse_error& e) {
+        throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
+    }
+    if (!doc.is_object()) throw InputError(path, "", "must be a JSON object");
+    const std::filesystem::path base = std::filesystem::path(path).parent_path();
+    auto resolve = [&](const std::string& p) { return std::filesystem::path(p).is_absolute() ? p : (base / p).string(); };
+    for (auto it = doc.begin(); it != doc.end(); ++it) {
+        const std::string& key = it.key();
+        const json& v = it.value();
+        auto str = [&]() {
+            if (!v.is_string()) throw InputError(path, key, "must be a string");
+            return v.get<std::string>();
+        };
+        if (key == "scene") s.scenePath = resolve(str());
+        else if (key == "animation") s.animationPath = resolve(str());
+        else if (key == "out") s.outDir = str();
+        else if (key == "estimator") s.estimator = parseEstimator(str(), path);
+        else if (key == "photons") s.photons = positiveInteger(v, path, key);
+        else if (key == "seed") {
+            if (!v.is_number_integer() || v.get<int64_t>() < 0) throw InputError(path, key, "must be a non-negative integer");
+            s.seed = v.get<uint64_t>();
+        } else if (key == "max_bounces") s.maxBounces = uint32_t(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 16));
+        else if (key == "threads") {
+            if (!v.is_number_integer() || v.get<int64_t>() < 0) throw InputError(path, key, "must be a non-negative integer");
+            s.threads = int(std::min<int64_t>(v.get<int64_t>(), 1024));
+        } else if (key == "frames") s.frames = parseFrameRange(str(), path);
+        else if (key == "lights") {
+            if (!v.is_array()) throw InputError(path, key, "must be an array of lights");
+            for (size_t i = 0; i < v.size(); ++i) s.extraLights.push_back(parseLight(v[i], path, "lights[" + std::to_string(i) + "]"));
+        } else if (key.rfind("_", 0) == 0 || key == "comment") {
+            // "_…" and "comment" keys are notes for people
+        } else {
+            throw InputError(path, key, "unknown key");
+        }
+    }
+}
+
+void validateSettings(const RenderSettings& s) {
+    if (s.scenePath.empty()) throw InputError("command line", "SCENE", "no scene given");
+    if (s.photons == 0) throw InputError("command line", "--photons", "must be a positive integer");
+    if (s.photons > (uint64_t(1) << 32)) throw InputError("command line", "--photons", "at most 2^32 photons are supported");
+    if (s.maxBounces == 0) throw InputError("command line", "max_bounces", "must be positive");
+}
+
+}  // namespace qsgi

@@ -1,0 +1,48 @@
+// Everything a render run needs to know, from a JSON config (configs/*.json) overridden by the
+// command line (DESIGN §8). Parsing lives here; the CLI only maps options onto the fields.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace qsgi {
+
+enum class EstimatorKind { ImpactCount };
+
+struct FrameRange {
+    int first = 0;
+    int last = -1;  // -1: through the animation's last frame
+};
+
+struct RenderSettings {
+    std::string scenePath;
+    std::string animationPath;  // empty: no animation (one frame, 0)
+    std::string outDir = "out";
+    EstimatorKind estimator = EstimatorKind::ImpactCount;
+    uint64_t photons = 1000000;
+    uint64_t seed = 1;
+    uint32_t maxBounces = 32;
+    int threads = 0;  // 0: all cores
+    std::optional<FrameRange> frames;
+    std::vector<PunctualLight> extraLights;  // world space, from the config
+    bool progress = false;
+    bool quiet = false;
+};
+
+// Reads a config file into `settings` (only the keys present change). Relative scene and
+// animation paths are resolved against the config's folder. Throws InputError.
+void applyConfigFile(const std::string& path, RenderSettings& settings);
+
+// Parses "A:B" (inclusive, as in Blender) or "A". Throws InputError naming `source`.
+FrameRange parseFrameRange(const std::string& text, const std::string& source);
+EstimatorKind parseEstimator(const std::string& name, const std::string& source);
+const char* estimatorName(EstimatorKind kind);
+
+// Checks values that no parser can (photons > 0, …). Throws InputError naming the option.
+void validateSettings(const RenderSettings& settings);
+
+}  // namespace qsgi

@@ -1,0 +1,169 @@
+#include "scene/animation.h"
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <set>
+
+#include "util/error.h"
+
+namespace qsgi {
+
+using nlohmann::json;
+
+Animation Animation::still(const Scene& scene) {
+    Animation a;
+    a.rest_ = scene.restLocals();
+    return a;
+}
+
+namespace {
+
+int findNode(const Scene& scene, const std::string& name) {
+    if (!name.empty() && name[0] == '#') {
+        const std::string digits = name.substr(1);
+        if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos && digits.size() < 10) {
+            const long i = std::stol(digits);
+            if (i < long(scene.nodes.size())) return int(i);
+        }
+        return -1;
+    }
+    for (size_t i = 0; i < scene.nodes.size(); ++i)
+        if (scene.nodes[i].name == name) return int(i);
+    return -1;
+}
+
+std::vector<double> numbers(const json& j, size_t count, const std::string& file, const std::string& place) {
+    if (!j.is_array() || j.size() != count)
+        throw InputError(file, place, "must be an array of " + std::to_string(count) + " numbers");
+    std::vector<double> out;
+    for (const json& v : j) {
+        if (!v.is_number()) throw InputError(file, place, "must hold only numbers");
+        const double d = v.get<double>();
+        if (!std::isfinite(d)) throw InputError(file, place, "holds a non-finite number");
+        out.push_back(d);
+    }
+    return out;
+}
+
+Transform parseNodeTransform(const json& j, const std::string& file, const std::string& place) {
+    if (!j.is_object()) throw InputError(file, place, "must be an object with matrix or translation/rotation/scale");
+    for (auto it = j.begin(); it != j.end(); ++it)
+        if (it.key() != "matrix" && it.key() != "translation" && it.key() != "rotation" && it.key() != "scale")
+            throw InputError(file, place + "." + it.key(), "unknown field (expected matrix, translation, rotation, scale)");
+    Transform t;
+    if (j.contains("matrix")) {
+        if (j.size() != 1) throw InputError(file, place, "matrix cannot be combined with translation/rotation/scale");
+        const std::vector<double> m = numbers(j["matrix"], 16, file, place + ".matrix");
+        t = Transform::fromColumnMajor(m.data());
+    } else {
+        Vec3d tr(0.0), sc(1.0);
+        std::array<double, 4> rot{0, 0, 0, 1};
+        if (j.contains("translation")) {
+            auto v = numbers(j["translation"], 3, file, place + ".translation");
+            tr = {v[0], v[1], v[2]};
+        }
+        if (j.contains("rotation")) {
+            auto v = numbers(j["rotation"], 4, file, place + ".rotation");
+            if (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3] < 1e-12)
+                throw InputError(file, place + ".rotation", "is a zero quaternion");
+            rot = {v[0], v[1], v[2], v[3]};
+        }
+        if (j.contains("scale")) {
+            auto v = numbers(j["scale"], 3, file, place + ".scale");
+            sc = {v[0], v[1], v[2]};
+        }
+        t = Transform::fromTRS(tr, rot, sc);
+    }
+    const double det = t.determinant3x3();
+    if (!(std::fabs(det) > 1e-12) || !t.isFinite()) throw InputError(file, place, "transform is not invertible");
+    return t;
+}
+
+}  // namespace
+
+Animation Animation::fromTransformFile(const std::string& path, const Scene& scene) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, "", "cannot be opened for reading");
+    json doc;
+    try {
+        doc = json::parse(in);
+    } catch (const json::parse_error& e) {
+        throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
+    }
+    if (!doc.is_object()) throw InputError(path, "", "must be a JSON object");
+    if (doc.value("format", "") != "qsgi-animation")
+        throw InputError(path, "format", "must be \"qsgi-animation\"");
+    if (!doc.contains("version") || !doc["version"].is_number_integer() || doc["version"].get<int>() != 1)
+        throw InputError(path, "version", "must be 1");
+    Animation a = still(scene);
+    if (doc.contains("fps")) {
+        if (!doc["fps"].is_number() || !(doc["fps"].get<double>() > 0) || !std::isfinite(doc["fps"].get<double>()))
+            throw InputError(path, "fps", "must be a positive number");
+        a.fps_ = doc["fps"].get<double>();
+    }
+    if (!doc.contains("frames") || !doc["frames"].is_array() || doc["frames"].empty())
+        throw InputError(path, "frames", "must be a non-empty array");
+
+    std::set<int> moved;
+    int previousFrame = -1;
+    for (size_t i = 0; i < doc["frames"].size(); ++i) {
+        const json& f = doc["frames"][i];
+        std::string place = "frames[" + std::to_string(i) + "]";
+        if (!f.is_object() || !f.contains("frame") || !f["frame"].is_number_integer())
+            throw InputError(path, place, "must be an object with an integer \"frame\"");
+        const int64_t frame = f["frame"].get<int64_t>();
+        if (frame < 0 || frame > 10000000) throw InputError(path, place + ".frame", "must lie in [0, 10^7]");
+        if (frame <= previousFrame)
+            throw InputError(path, place, "frame " + std::to_string(frame) + (frame == previousFrame ? " is duplicated" : " is out of order") +
+                                              " (frames must increase)");
+        previousFrame = int(frame);
+        place = "frame " + std::to_string(frame);
+        Key key{int(frame), {}};
+        if (f.contains("nodes")) {
+            if (!f["nodes"].is_object()) throw InputError(path, place + ".nodes", "must be an object keyed by node name");
+            for (auto it = f["nodes"].begin(); it != f["nodes"].end(); ++it) {
+                const int node = findNode(scene, it.key());
+                if (node < 0) throw InputError(path, place + ", node '" + it.key() + "'", "no such node in " + scene.sourcePath);
+                const Transform t = parseNodeTransform(it.value(), path, place + ", node '" + it.key() + "'");
+                key.nodes.emplace_back(node, t);
+                if (!(t == a.rest_[node])) moved.insert(node);
+            }
+        }
+        a.keys_.push_back(std::move(key));
+    }
+    a.lastFrame_ = previousFrame;
+    a.moved_.assign(moved.begin(), moved.end());
+    return a;
+}
+
+std::vector<Transform> Animation::localsAt(int frame) const {
+    std::vector<Transform> locals = rest_;
+    for (const Key& k : keys_) {
+        if (k.frame > frame) break;
+        for (const auto& [node, t] : k.nodes) locals[node] = t;
+    }
+    return locals;
+}
+
+void checkLightsAreStatic(const Scene& scene, const Animation& animation, const std::string& animationFile) {
+    std::vector<uint8_t> dynamicNode(scene.nodes.size(), 0);
+    std::vector<int> stack(animation.movedNodes());
+    while (!stack.empty()) {
+        const int n = stack.back();
+        stack.pop_back();
+        if (dynamicNode[n]) continue;
+        dynamicNode[n] = 1;
+        for (int c : scene.nodes[n].children) stack.push_back(c);
+    }
+    for (const PunctualLight& l : scene.lights)
+        if (l.node >= 0 && dynamicNode[l.node])
+            throw InputError(animationFile, "node '" + scene.nodes[l.node].name + "'",
+                             "moves light '" + l.name + "', but lights must be static");
+    for (const MeshInstance& inst : scene.instances)
+        if (dynamicNode[inst.node] && scene.materials[scene.vertexMaterial[inst.firstVertex]].isEmissive())
+            throw InputError(animationFile, "node '" + scene.nodes[inst.node].name + "'",
+                             "moves an emissive mesh, but lights must be static");
+}
+
+}  // namespace qsgi

@@ -1,0 +1,42 @@
+// Per-frame node transforms (DESIGN §3) from a qsgi-animation transform file. A node's entry
+// replaces its local transform; nodes not listed keep their last transform.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace qsgi {
+
+class Animation {
+public:
+    // No animation: one frame, 0, in the rest pose.
+    static Animation still(const Scene& scene);
+    // Throws InputError naming the file, frame and node for anything unusable.
+    static Animation fromTransformFile(const std::string& path, const Scene& scene);
+
+    int lastFrame() const { return lastFrame_; }
+    double fps() const { return fps_; }
+    // Local transform of every node at the frame (frames past the last keep the last pose).
+    std::vector<Transform> localsAt(int frame) const;
+    // Nodes whose local transform differs from the rest pose in some frame.
+    const std::vector<int>& movedNodes() const { return moved_; }
+
+private:
+    struct Key {
+        int frame;
+        std::vector<std::pair<int, Transform>> nodes;
+    };
+    std::vector<Transform> rest_;
+    std::vector<Key> keys_;  // increasing frame
+    std::vector<int> moved_;
+    int lastFrame_ = 0;
+    double fps_ = 24;
+};
+
+// Lights are static (DESIGN §2): throws InputError if a punctual light or an emissive mesh hangs
+// under a node the animation moves.
+void checkLightsAreStatic(const Scene& scene, const Animation& animation, const std::string& animationFile);
+
+}  // namespace qsgi

@@ -1,0 +1,535 @@
+#include "scene/gltf_loader.h"
+
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+namespace qsgi {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Extensions whose meaning qsgi implements, or which cannot change the radiosity it computes.
+const std::set<std::string> kSupportedExtensions = {
+    "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization",
+    "KHR_texture_transform"};
+
+std::string at(const std::string& what, int index) { return what + "[" + std::to_string(index) + "]"; }
+
+// Accessor Decoding
+// An accessor's elements as doubles, `components` per element, normalised integers mapped to
+// [0,1] or [-1,1] as the glTF spec says. Every offset is bounds-checked against its buffer.
+struct AccessorData {
+    size_t count = 0;
+    int components = 0;
+    std::vector<double> values;
+    double operator()(size_t element, int component) const { return values[element * components + component]; }
+};
+
+class AccessorReader {
+public:
+    AccessorReader(const tinygltf::Model& model, const std::string& file) : model_(model), file_(file) {}
+
+    AccessorData read(int accessorIndex, const std::string& usedBy) const {
+        const std::string place = usedBy + " -> " + at("accessors", accessorIndex);
+        if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
+            throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) +
+                                                ", which does not exist");
+        const tinygltf::Accessor& acc = model_.accessors[accessorIndex];
+        AccessorData out;
+        out.count = acc.count;
+        out.components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+        const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
+        if (out.components <= 0 || componentSize <= 0)
+            throw InputError(file_, place, "unknown accessor type or componentType");
+        if (acc.count > (size_t(1) << 31))
+            throw InputError(file_, place, "count " + std::to_string(acc.count) + " is implausibly large");
+        out.values.assign(acc.count * size_t(out.components), 0.0);
+        if (acc.bufferView >= 0)
+            decode(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, acc.normalized,
+                   out.components, place, out.values.data(), nullptr);
+        if (acc.sparse.isSparse) applySparse(acc, out, place);
+        for (double v : out.values)
+            if (!std::isfinite(v)) throw InputError(file_, place, "holds a non-finite number (NaN or Inf)");
+        return out;
+    }
+
+private:
+    // Decodes `count` elements from a buffer view into `doubles` (or, for sparse indices, into
+    // `indices`), checking that every byte read lies inside the view and the buffer.
+    void decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized,
+                int components, const std::string& place, double* doubles, std::vector<size_t>* indices) const {
+        if (viewIndex < 0 || viewIndex >= int(model_.bufferViews.size()))
+            throw InputError(file_, place, "refers to bufferView " + std::to_string(viewIndex) + ", which does not exist");
+        const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
+        if (view.buffer < 0 || view.buffer >= int(model_.buffers.size()))
+            throw InputError(file_, at("bufferViews", viewIndex), "refers to a buffer that does not exist");
+        const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
+        if (view.byteOffset + view.byteLength > buffer.data.size())
+            throw InputError(file_, at("bufferViews", viewIndex),
+                             "reaches byte " + std::to_string(view.byteOffset + view.byteLength) + " of buffer " +
+                                 std::to_string(view.buffer) + ", which holds only " + std::to_string(buffer.data.size()));
+        const size_t componentSize = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
+        const size_t elementSize = componentSize * size_t(components);
+        const size_t stride = view.byteStride ? view.byteStride : elementSize;
+        if (count > 0 && byteOffset + stride * (count - 1) + elementSize > view.byteLength)
+            throw InputError(file_, place, "reads past the end of bufferView " + std::to_string(viewIndex));
+        const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
+        for (size_t e = 0; e < count; ++e) {
+            const unsigned char* element = base + e * stride;
+            for (int c = 0; c < components; ++c) {
+                const double v = component(element + c * componentSize, componentType, normalized);
+                if (indices) (*indices)[e] = size_t(v);
+                else doubles[e * components + c] = v;
+            }
+        }
+    }
+
+    static double component(const unsigned char* p, int type, bool normalized) {
+        switch (type) {
+            case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0, -1.0) : v; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { uint8_t v; std::memcpy(&v, p, 1); return normalized ? v / 255.0 : v; }
+            case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? v / 4294967295.0 : v; }
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
+            default: return 0;
+        }
+    }
+
+    void applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const {
+        const size_t n = size_t(std::max(acc.sparse.count, 0));
+        std::vector<size_t> targets(n);
+        decode(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n,
+               acc.sparse.indices.componentType, false, 1, place + ".sparse.indices", nullptr, &targets);
+        std::vector<double> values(n * size_t(out.components));
+        decode(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
+               acc.normalized, out.components, place + ".sparse.values", values.data(), nullptr);
+        for (size_t i = 0; i < n; ++i) {
+            if (targets[i] >= out.count)
+                throw InputError(file_, place + ".sparse.indices", "index " + std::to_string(targets[i]) +
+                                                                       " is beyond the accessor's count");
+            for (int c = 0; c < out.components; ++c) out.values[targets[i] * out.components + c] = values[i * out.components + c];
+        }
+    }
+
+    const tinygltf::Model& model_;
+    const std::string& file_;
+};
+
+// Textures and Materials
+double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+
+// Mean linear colour of a decoded image, or nullopt if it was not loaded (e.g. file missing).
+std::optional<Vec3f> meanImageColour(const tinygltf::Image& image) {
+    const int channels = image.component;
+    const int bytesPerChannel = image.bits == 16 ? 2 : 1;
+    const size_t pixels = size_t(std::max(image.width, 0)) * size_t(std::max(image.height, 0));
+    if (pixels == 0 || channels <= 0 || image.image.size() < pixels * channels * bytesPerChannel) return std::nullopt;
+    const double maxValue = bytesPerChannel == 2 ? 65535.0 : 255.0;
+    double sum[3] = {0, 0, 0};
+    for (size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c) {
+            const int channel = channels >= 3 ? c : 0;
+            const size_t offset = (p * channels + channel) * bytesPerChannel;
+            uint32_t v = image.image[offset];
+            if (bytesPerChannel == 2) v |= uint32_t(image.image[offset + 1]) << 8;
+            sum[c] += srgbToLinear(v / maxValue);
+        }
+    return Vec3f(float(sum[0] / pixels), float(sum[1] / pixels), float(sum[2] / pixels));
+}
+
+std::optional<Vec3f> textureMean(const tinygltf::Model& model, int textureIndex) {
+    if (textureIndex < 0 || textureIndex >= int(model.textures.size())) return std::nullopt;
+    const int source = model.textures[textureIndex].source;
+    if (source < 0 || source >= int(model.images.size())) return std::nullopt;
+    return meanImageColour(model.images[source]);
+}
+
+Vec3f vec3FromFactor(const std::vector<double>& f, Vec3f fallback) {
+    return f.size() >= 3 ? Vec3f(float(f[0]), float(f[1]), float(f[2])) : fallback;
+}
+
+Material convertMaterial(const tinygltf::Model& model, int index, const std::string& file, Warnings& warnings) {
+    const tinygltf::Material& m = model.materials[index];
+    const std::string place = at("materials", index);
+    Material out;
+    out.name = m.name;
+    const auto& pbr = m.pbrMetallicRoughness;
+    out.albedo = vec3FromFactor(pbr.baseColorFactor, Vec3f(1.0f));
+    if (pbr.baseColorTexture.index >= 0) {
+        if (auto mean = textureMean(model, pbr.baseColorTexture.index)) out.albedo = out.albedo * *mean;
+        else warnings.add(file + ": " + place + ": base colour texture could not be read; using baseColorFactor alone");
+    }
+    if (!isFinite(out.albedo) || out.albedo.x < 0 || out.albedo.y < 0 || out.albedo.z < 0 || maxComponent(out.albedo) > 1) {
+        warnings.add(file + ": " + place + ": albedo outside [0,1] clamped (energy must not grow)");
+        out.albedo = min(max(out.albedo, Vec3f(0.0f)), Vec3f(1.0f));
+        if (!isFinite(out.albedo)) out.albedo = Vec3f(0.0f);
+    }
+    if (pbr.metallicRoughnessTexture.index >= 0 || m.normalTexture.index >= 0 || m.occlusionTexture.index >= 0)
+        warnings.add(file + ": metallic/roughness, normal and occlusion maps are ignored (surfaces are Lambertian)");
+
+    Vec3f emissive = vec3FromFactor(m.emissiveFactor, Vec3f(0.0f));
+    if (m.emissiveTexture.index >= 0 && maxComponent(emissive) > 0) {
+        if (auto mean = textureMean(model, m.emissiveTexture.index)) emissive = emissive * *mean;
+    }
+    auto strength = m.extensions.find("KHR_materials_emissive_strength");
+    if (strength != m.extensions.end() && strength->second.Has("emissiveStrength")) {
+        const auto& v = strength->second.Get("emissiveStrength");
+        if (!v.IsNumber() || !(v.GetNumberAsDouble() >= 0) || !std::isfinite(v.GetNumberAsDouble()))
+            throw InputError(file, place + ".extensions.KHR_materials_emissive_strength.emissiveStrength",
+                             "must be a finite non-negative number");
+        emissive = emissive * float(v.GetNumberAsDouble());
+    }
+    if (!isFinite(emissive) || emissive.x < 0 || emissive.y < 0 || emissive.z < 0)
+        throw InputError(file, place + ".emissiveFactor", "must be finite and non-negative");
+    out.emission = emissive;
+    return out;
+}
+
+// Node Hierarchy
+Transform nodeLocalTransform(const tinygltf::Node& n, const std::string& file, int index) {
+    const std::string place = at("nodes", index);
+    Transform t;
+    if (n.matrix.size() == 16) {
+        t = Transform::fromColumnMajor(n.matrix.data());
+    } else {
+        Vec3d tr(0.0), sc(1.0);
+        std::array<double, 4> rot{0, 0, 0, 1};
+        if (n.translation.size() == 3) tr = {n.translation[0], n.translation[1], n.translation[2]};
+        if (n.scale.size() == 3) sc = {n.scale[0], n.scale[1], n.scale[2]};
+        if (n.rotation.size() == 4) rot = {n.rotation[0], n.rotation[1], n.rotation[2], n.rotation[3]};
+        t = Transform::fromTRS(tr, rot, sc);
+    }
+    if (!t.isFinite()) throw InputError(file, place, "transform holds a non-finite number");
+    return t;
+}
+
+std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::string& file) {
+    std::vector<SceneNode> nodes(model.nodes.size());
+    for (size_t i = 0; i < model.nodes.size(); ++i) {
+        nodes[i].name = model.nodes[i].name;
+        nodes[i].local = nodeLocalTransform(model.nodes[i], file, int(i));
+        for (int c : model.nodes[i].children) {
+            if (c < 0 || c >= int(nodes.size()))
+                throw InputError(file, at("nodes", int(i)) + ".children", "refers to node " + std::to_string(c) + ", which does not exist");
+            if (c == int(i)) throw InputError(file, at("nodes", int(i)), "is its own child (the hierarchy has a cycle)");
+            if (nodes[c].parent >= 0 && nodes[c].parent != int(i))
+                throw InputError(file, at("nodes", c), "has two parents (nodes " + std::to_string(nodes[c].parent) +
+                                                           " and " + std::to_string(i) + "); glTF nodes form a tree");
+            nodes[c].parent = int(i);
+            nodes[i].children.push_back(c);
+        }
+    }
+    // A cycle without a root: following parents from any node must end.
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        int p = nodes[i].parent;
+        size_t steps = 0;
+        while (p >= 0) {
+            if (++steps > nodes.size())
+                throw InputError(file, at("nodes", int(i)), "is its own descendant (the hierarchy has a cycle)");
+            p = nodes[p].parent;
+        }
+    }
+    return nodes;
+}
+
+// Mesh Flattening
+std::vector<uint32_t> triangleIndices(int mode, const std::vector<uint32_t>& idx) {
+    std::vector<uint32_t> tri;
+    const size_t n = idx.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        tri.assign(idx.begin(), idx.begin() + (n / 3) * 3);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        for (size_t i = 0; i + 2 < n; ++i) {
+            // Alternate the winding so every triangle keeps the strip's orientation.
+            if (i % 2 == 0) tri.insert(tri.end(), {idx[i], idx[i + 1], idx[i + 2]});
+            else tri.insert(tri.end(), {idx[i + 1], idx[i], idx[i + 2]});
+        }
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+        for (size_t i = 1; i + 1 < n; ++i) tri.insert(tri.end(), {idx[0], idx[i], idx[i + 1]});
+    }
+    return tri;
+}
+
+class SceneBuilder {
+public:
+    SceneBuilder(const tinygltf::Model& model, const std::string& file, Warnings& warnings)
+        : model_(model), file_(file), warnings_(warnings), reader_(model, file) {}
+
+    Scene build() {
+        Scene scene;
+        scene.sourcePath = file_;
+        scene.nodes = buildHierarchy(model_, file_);
+        for (size_t i = 0; i < model_.materials.size(); ++i)
+            scene.materials.push_back(convertMaterial(model_, int(i), file_, warnings_));
+        defaultMaterial_ = uint32_t(scene.materials.size());
+        scene.materials.push_back(Material{"(default)", Vec3f(1.0f), Vec3f(0.0f)});
+
+        if (model_.scenes.empty()) throw InputError(file_, "scenes", "the file has no scene to render");
+        const int sceneIndex = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+        if (sceneIndex >= int(model_.scenes.size()))
+            throw InputError(file_, "scene", "names scene " + std::to_string(sceneIndex) + ", which does not exist");
+        const auto& roots = model_.scenes[sceneIndex].nodes;
+        if (roots.empty()) throw InputError(file_, at("scenes", sceneIndex), "has no nodes: nothing to render");
+
+        const std::vector<Transform> world = scene.worldTransforms(scene.restLocals());
+        std::vector<uint8_t> visited(scene.nodes.size(), 0);
+        std::vector<int> stack;
+        for (int r : roots) {
+            if (r < 0 || r >= int(scene.nodes.size()))
+                throw InputError(file_, at("scenes", sceneIndex) + ".nodes", "refers to node " + std::to_string(r) + ", which does not exist");
+            if (scene.nodes[r].parent >= 0)
+                throw InputError(file_, at("scenes", sceneIndex) + ".nodes", "lists node " + std::to_string(r) + ", which is not a root");
+            stack.push_back(r);
+        }
+        // Depth-first in file order, so vertex numbering is stable across runs.
+        std::reverse(stack.begin(), stack.end());
+        while (!stack.empty()) {
+            const int n = stack.back();
+            stack.pop_back();
+            if (visited[n]) continue;
+            visited[n] = 1;
+            visitNode(scene, n, world[n]);
+            const auto& children = scene.nodes[n].children;
+            for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
+        }
+        scene.worldOrigin = centreOfInstances(scene, world);
+        for (PunctualLight& l : scene.lights) l.position = Vec3f(Vec3d(l.position) - scene.worldOrigin);
+        if (scene.camera) scene.camera->position = Vec3f(Vec3d(scene.camera->position) - scene.worldOrigin);
+        scene.placedWith.assign(scene.instances.size(), Transform());
+        for (size_t i = 0; i < scene.instances.size(); ++i) scene.placeInstance(i, world[scene.instances[i].node]);
+        scene.markDynamic({});
+        return scene;
+    }
+
+private:
+    // Centre of the rest-pose world bounds, in double precision.
+    static Vec3d centreOfInstances(const Scene& scene, const std::vector<Transform>& world) {
+        Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+        for (const MeshInstance& inst : scene.instances)
+            for (const Vec3f& p : inst.objectPositions) {
+                const Vec3d w = world[inst.node].applyPoint(Vec3d(p));
+                lo = min(lo, w);
+                hi = max(hi, w);
+            }
+        return lo.x <= hi.x ? (lo + hi) * 0.5 : Vec3d(0.0);
+    }
+
+    void visitNode(Scene& scene, int n, const Transform& world) {
+        const tinygltf::Node& node = model_.nodes[n];
+        if (node.mesh >= 0) {
+            if (node.mesh >= int(model_.meshes.size()))
+                throw InputError(file_, at("nodes", n) + ".mesh", "refers to mesh " + std::to_string(node.mesh) + ", which does not exist");
+            if (node.skin >= 0) warnings_.add(file_ + ": skins are not applied; the base mesh is used");
+            const tinygltf::Mesh& mesh = model_.meshes[node.mesh];
+            for (size_t p = 0; p < mesh.primitives.size(); ++p)
+                addPrimitive(scene, n, world, mesh.primitives[p], at("meshes", node.mesh) + "." + at("primitives", int(p)));
+        }
+        if (node.camera >= 0 && !scene.camera) addCamera(scene, n, world);
+        auto light = node.extensions.find("KHR_lights_punctual");
+        if (light != node.extensions.end() && light->second.Has("light")) addLight(scene, n, world, light->second.Get("light"));
+    }
+
+    void addPrimitive(Scene& scene, int nodeIndex, const Transform& world, const tinygltf::Primitive& prim,
+                      const std::string& place) {
+        if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+            prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+            warnings_.add(file_ + ": point and line primitives are skipped");
+            return;
+        }
+        if (!prim.targets.empty()) warnings_.add(file_ + ": morph targets are not applied; the base mesh is used");
+        auto pos = prim.attributes.find("POSITION");
+        if (pos == prim.attributes.end()) throw InputError(file_, place, "has no POSITION attribute");
+        const AccessorData positions = reader_.read(pos->second, place + ".attributes.POSITION");
+        if (positions.components != 3) throw InputError(file_, place + ".attributes.POSITION", "must be VEC3");
+        const size_t vertexCount = positions.count;
+
+        std::optional<AccessorData> normals;
+        auto nrm = prim.attributes.find("NORMAL");
+        if (nrm != prim.attributes.end()) {
+            normals = reader_.read(nrm->second, place + ".attributes.NORMAL");
+            if (normals->components != 3) throw InputError(file_, place + ".attributes.NORMAL", "must be VEC3");
+            if (normals->count != vertexCount)
+                throw InputError(file_, place + ".attributes.NORMAL",
+                                 "has " + std::to_string(normals->count) + " elements but POSITION has " +
+                                     std::to_string(vertexCount) + " (attribute arrays must have equal lengths)");
+        }
+        for (const auto& [name, accessor] : prim.attributes) {
+            if (accessor >= 0 && accessor < int(model_.accessors.size()) && model_.accessors[accessor].count != vertexCount)
+                throw InputError(file_, place + ".attributes." + name,
+                                 "has " + std::to_string(model_.accessors[accessor].count) + " elements but POSITION has " +
+                                     std::to_string(vertexCount) + " (attribute arrays must have equal lengths)");
+        }
+
+        std::vector<uint32_t> indices;
+        if (prim.indices >= 0) {
+            const AccessorData idx = reader_.read(prim.indices, place + ".indices");
+            if (idx.components != 1) throw InputError(file_, place + ".indices", "must be SCALAR");
+            indices.resize(idx.count);
+            for (size_t i = 0; i < idx.count; ++i) {
+                const double v = idx.values[i];
+                if (v < 0 || v >= double(vertexCount))
+                    throw InputError(file_, place + ".indices", "index " + std::to_string(uint64_t(v)) + " at position " +
+                                                                    std::to_string(i) + " is beyond the " +
+                                                                    std::to_string(vertexCount) + " vertices");
+                indices[i] = uint32_t(v);
+            }
+        } else {
+            indices.resize(vertexCount);
+            for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
+        }
+        std::vector<uint32_t> tri = triangleIndices(prim.mode, indices);
+        if (scene.positions.size() + vertexCount > (size_t(1) << 31))
+            throw InputError(file_, place, "the scene exceeds 2^31 vertices");
+
+        uint32_t material = defaultMaterial_;
+        if (prim.material >= 0) {
+            if (prim.material >= int(model_.materials.size()))
+                throw InputError(file_, place + ".material", "refers to material " + std::to_string(prim.material) + ", which does not exist");
+            material = uint32_t(prim.material);
+        }
+
+        MeshInstance inst;
+        inst.node = nodeIndex;
+        inst.firstVertex = uint32_t(scene.positions.size());
+        inst.vertexCount = uint32_t(vertexCount);
+        inst.firstTriangle = uint32_t(scene.triangles.size());
+        inst.triangleCount = uint32_t(tri.size() / 3);
+        inst.mirrored = world.determinant3x3() < 0;
+        inst.objectPositions.resize(vertexCount);
+        for (size_t i = 0; i < vertexCount; ++i)
+            inst.objectPositions[i] = Vec3f(float(positions(i, 0)), float(positions(i, 1)), float(positions(i, 2)));
+        if (normals) {
+            inst.objectNormals.resize(vertexCount);
+            for (size_t i = 0; i < vertexCount; ++i)
+                inst.objectNormals[i] = Vec3f(float((*normals)(i, 0)), float((*normals)(i, 1)), float((*normals)(i, 2)));
+        }
+        scene.positions.resize(scene.positions.size() + vertexCount);
+        scene.normals.resize(scene.normals.size() + vertexCount);
+        scene.vertexMaterial.resize(scene.vertexMaterial.size() + vertexCount, material);
+        for (size_t t = 0; t + 2 < tri.size(); t += 3) {
+            // A mirroring transform reverses the winding; swapping keeps the front side CCW in world space.
+            Triangle out{{inst.firstVertex + tri[t], inst.firstVertex + tri[t + 1], inst.firstVertex + tri[t + 2]}};
+            if (inst.mirrored) std::swap(out.v[1], out.v[2]);
+            scene.triangles.push_back(out);
+            scene.triangleMaterial.push_back(material);
+        }
+        scene.instances.push_back(std::move(inst));
+    }
+
+    void addCamera(Scene& scene, int n, const Transform& world) {
+        const tinygltf::Node& node = model_.nodes[n];
+        if (node.camera >= int(model_.cameras.size()))
+            throw InputError(file_, at("nodes", n) + ".camera", "refers to a camera that does not exist");
+        const tinygltf::Camera& cam = model_.cameras[node.camera];
+        if (cam.type != "perspective") {
+            warnings_.add(file_ + ": " + at("cameras", node.camera) + ": only perspective cameras are used; skipped");
+            return;
+        }
+        PerspectiveCamera c;
+        c.position = Vec3f(world.applyPoint(Vec3d(0.0)));
+        c.forward = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
+        c.up = Vec3f(normalize(world.applyVector(Vec3d(0, 1, 0))));
+        c.yfov = float(cam.perspective.yfov);
+        c.aspect = float(cam.perspective.aspectRatio);
+        c.znear = float(cam.perspective.znear);
+        if (!(c.yfov > 0 && c.yfov < 3.14159f) || !isFinite(c.position) || !isFinite(c.forward))
+            throw InputError(file_, at("cameras", node.camera), "yfov must lie in (0, pi) and the camera node's transform must be finite");
+        scene.camera = c;
+    }
+
+    void addLight(Scene& scene, int n, const Transform& world, const tinygltf::Value& ref) {
+        const std::string place = at("nodes", n) + ".extensions.KHR_lights_punctual.light";
+        if (!ref.IsNumber()) throw InputError(file_, place, "must be a light index");
+        const int index = ref.GetNumberAsInt();
+        if (index < 0 || index >= int(model_.lights.size()))
+            throw InputError(file_, place, "refers to light " + std::to_string(index) + ", which does not exist");
+        const tinygltf::Light& l = model_.lights[index];
+        PunctualLight out;
+        out.name = l.name.empty() ? "light " + std::to_string(index) : l.name;
+        out.node = n;
+        const Vec3f colour = vec3FromFactor(l.color, Vec3f(1.0f));
+        out.intensity = colour * float(l.intensity);
+        out.position = Vec3f(world.applyPoint(Vec3d(0.0)));  // re-centred in build()
+        out.direction = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
+        if (l.type == "point") out.type = LightType::Point;
+        else if (l.type == "spot") {
+            out.type = LightType::Spot;
+            const double outer = l.spot.outerConeAngle;
+            if (!(outer > 0 && outer <= M_PI / 2 + 1e-9))
+                throw InputError(file_, at("KHR_lights_punctual.lights", index) + ".spot.outerConeAngle", "must lie in (0, pi/2]");
+            out.cosOuterCone = float(std::cos(outer));
+        } else if (l.type == "directional") out.type = LightType::Directional;
+        else throw InputError(file_, at("KHR_lights_punctual.lights", index) + ".type", "unknown light type '" + l.type + "'");
+        if (!isFinite(out.intensity) || out.intensity.x < 0 || out.intensity.y < 0 || out.intensity.z < 0 ||
+            !isFinite(out.position) || dot(out.direction, out.direction) == 0)
+            throw InputError(file_, at("KHR_lights_punctual.lights", index), "colour and intensity must be finite and non-negative");
+        scene.lights.push_back(out);
+    }
+
+    const tinygltf::Model& model_;
+    const std::string& file_;
+    Warnings& warnings_;
+    AccessorReader reader_;
+    uint32_t defaultMaterial_ = 0;
+};
+
+bool isBinaryGltf(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char magic[4] = {};
+    in.read(magic, 4);
+    return in.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
+}
+
+std::string firstLine(const std::string& s) {
+    std::string out = s.substr(0, s.find('\n'));
+    return out.empty() ? s : out;
+}
+
+}  // namespace
+
+Scene loadGltfScene(const std::string& path, Warnings& warnings) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw InputError(path, "", "no such file");
+    if (fs::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a glTF file");
+    {
+        std::ifstream probe(path, std::ios::binary);
+        if (!probe) throw InputError(path, "", "cannot be opened for reading");
+    }
+
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    bool ok = false;
+    try {
+        ok = isBinaryGltf(path) ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                                : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    } catch (const std::exception& e) {
+        throw InputError(path, "", std::string("not a readable glTF file: ") + e.what());
+    }
+    if (!ok) throw InputError(path, "", "not a valid glTF file: " + firstLine(err.empty() ? warn : err));
+    if (!warn.empty()) {
+        size_t start = 0;
+        while (start < warn.size()) {
+            size_t end = warn.find('\n', start);
+            if (end == std::string::npos) end = warn.size();
+            if (end > start) warnings.add(path + ": " + warn.substr(start, end - start));
+            start = end + 1;
+        }
+    }
+    for (const auto& ext : model.extensionsRequired)
+        if (!kSupportedExtensions.count(ext))
+            throw InputError(path, "extensionsRequired", "requires extension " + ext + ", which qsgi does not implement");
+    for (const auto& ext : model.extensionsUsed)
+        if (!kSupportedExtensions.count(ext)) warnings.add(path + ": extension " + ext + " is ignored");
+
+    Scene scene = SceneBuilder(model, path, warnings).build();
+    return scene;
+}
+
+}  // namespace qsgi

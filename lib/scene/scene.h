@@ -1,0 +1,114 @@
+// The render-ready scene: world-space triangles with materials, lights, the node hierarchy that
+// animation moves, and which vertices are dynamic (DESIGN §2). Built by the glTF loader; the
+// tracer and estimators read it and never see file syntax.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "util/vecmath.h"
+
+namespace qsgi {
+
+// Lambertian material. emission is the radiance L_e (W m^-2 sr^-1) of the front side.
+struct Material {
+    std::string name;
+    Vec3f albedo{0.8f};
+    Vec3f emission{0.0f};
+    bool isEmissive() const { return maxComponent(emission) > 0; }
+};
+
+struct Triangle {
+    uint32_t v[3];
+};
+
+enum class LightType { Point, Spot, Directional };
+
+// A punctual light, static by definition (DESIGN §2). intensity is W/sr for point and spot
+// lights; for directional lights it is the irradiance (W/m^2) on a plane facing the light.
+struct PunctualLight {
+    std::string name;
+    LightType type = LightType::Point;
+    Vec3f position{0.0f};
+    Vec3f direction{0, -1, 0};  // unit; the direction light travels (spot axis, directional)
+    Vec3f intensity{1.0f};
+    float cosOuterCone = 0;     // spot lights only
+    int node = -1;              // glTF node it hangs from (-1: added by the config)
+};
+
+struct SceneNode {
+    std::string name;
+    int parent = -1;
+    std::vector<int> children;
+    Transform local;  // rest pose, from the glTF file
+};
+
+// One mesh primitive placed by one node: a contiguous block of scene vertices and triangles.
+// Object-space data is kept so that a new node transform re-places the block exactly.
+struct MeshInstance {
+    int node = -1;
+    uint32_t firstVertex = 0, vertexCount = 0;
+    uint32_t firstTriangle = 0, triangleCount = 0;
+    std::vector<Vec3f> objectPositions;
+    std::vector<Vec3f> objectNormals;  // empty: area-weighted normals from world triangles
+    bool mirrored = false;             // rest transform has a negative determinant
+};
+
+struct PerspectiveCamera {
+    Vec3f position{0.0f};
+    Vec3f forward{0, 0, -1}, up{0, 1, 0};
+    float yfov = 0.8f;  // radians
+    float aspect = 0;   // 0: from the image size
+    float znear = 0.01f;
+};
+
+struct Scene {
+    std::string sourcePath;
+
+    std::vector<SceneNode> nodes;
+    std::vector<MeshInstance> instances;
+    std::vector<Material> materials;
+    std::vector<PunctualLight> lights;
+    std::optional<PerspectiveCamera> camera;
+
+    // World space, current pose, relative to worldOrigin: re-centring keeps float positions
+    // precise for scenes far from the origin (DESIGN §4), so a scene translated by 1e5 m traces
+    // exactly as at the origin. Add worldOrigin back when writing positions out.
+    Vec3d worldOrigin{0.0};
+    std::vector<Vec3f> positions;
+    std::vector<Vec3f> normals;
+    std::vector<uint32_t> vertexMaterial;
+    std::vector<Triangle> triangles;
+    std::vector<uint32_t> triangleMaterial;
+
+    // Dynamic = under a node the animation moves (DESIGN §2). Filled by markDynamic.
+    std::vector<uint8_t> vertexDynamic;
+    std::vector<uint8_t> triangleDynamic;
+
+    size_t vertexCount() const { return positions.size(); }
+    size_t triangleCount() const { return triangles.size(); }
+
+    Bounds3f bounds() const;
+    Vec3f geometricNormal(uint32_t tri) const;  // unit, from the CCW winding (front side)
+    float triangleArea(uint32_t tri) const;
+
+    // World transform of every node for the given local transforms (one per node).
+    std::vector<Transform> worldTransforms(const std::vector<Transform>& locals) const;
+    std::vector<Transform> restLocals() const;
+
+    // Re-places the instances whose world transform differs from the one they were placed with.
+    // Returns true if any vertex moved.
+    bool applyPose(const std::vector<Transform>& locals);
+
+    // Marks the vertices/triangles of every instance at or below one of the given nodes.
+    void markDynamic(const std::vector<int>& movedNodes);
+    bool hasDynamicGeometry() const;
+
+    // Internal: the world transform each instance was last placed with.
+    std::vector<Transform> placedWith;
+    void placeInstance(size_t instanceIndex, const Transform& world);
+};
+
+}  // namespace qsgi

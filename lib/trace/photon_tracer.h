@@ -1,0 +1,48 @@
+// Photon tracing (DESIGN §4): emits photons from the lights, follows them through diffuse
+// bounces with Russian roulette and stores every segment in the ray cache.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "scene/scene.h"
+#include "trace/light_sampler.h"
+#include "trace/ray_cache.h"
+#include "trace/scene_bvh.h"
+
+namespace qsgi {
+
+struct TraceSettings {
+    uint64_t photons = 100000;
+    uint64_t seed = 1;
+    uint32_t maxBounces = 32;
+};
+
+class PhotonTracer {
+public:
+    PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings);
+
+    // Traces every photon from scratch. progress(done, total), if given, is called about five
+    // times a second from a reporter thread, and once at the end.
+    RayCache traceAll(const std::function<void(uint64_t, uint64_t)>& progress = {}) const;
+
+    // Appends the segments of `path` from segment index `fromBounce` on, continuing from the
+    // state the path had there (origin, direction, power) with the same random numbers.
+    void tracePath(uint64_t path, std::vector<Segment>& out) const;
+    void continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power, float tnear,
+                      std::vector<Segment>& out) const;
+
+    const LightSampler& lights() const { return lights_; }
+
+private:
+    // Length of the ray inside the scene's bounds (for escaping photons).
+    float exitDistance(const Vec3f& origin, const Vec3f& direction) const;
+
+    const Scene& scene_;
+    const SceneBvh& bvh_;
+    TraceSettings settings_;
+    LightSampler lights_;
+    Bounds3f bounds_;
+};
+
+}  // namespace qsgi

@@ -1,0 +1,48 @@
+// The scene's triangles in Embree: static triangles in one geometry built once, dynamic triangles
+// in another that is refitted when the animation moves them (DESIGN §6.1).
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "scene/scene.h"
+#include "trace/embree_device.h"
+
+namespace qsgi {
+
+struct SurfaceHit {
+    float t = 0;
+    uint32_t triangle = 0;  // scene triangle index
+};
+
+class SceneBvh {
+public:
+    SceneBvh(const EmbreeDevice& device, const Scene& scene);
+
+    // Re-reads the dynamic vertices from the scene and refits the dynamic geometry.
+    void updateDynamic(const Scene& scene);
+
+    std::optional<SurfaceHit> intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // True if the dynamic geometry alone blocks the ray within (tnear, tfar).
+    bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+
+    // Offset that lifts spawned rays off surfaces: scaled with the scene, never with metres.
+    float rayEpsilon() const { return rayEpsilon_; }
+
+private:
+    struct Part {
+        std::vector<uint32_t> triangles;  // Embree primID -> scene triangle
+        std::vector<uint32_t> vertices;   // Embree vertex -> scene vertex
+        unsigned geomId = RTC_INVALID_GEOMETRY_ID;
+    };
+    Part addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality);
+    void fillVertices(RTCGeometry geom, const Part& part, const Scene& scene);
+
+    const EmbreeDevice& device_;
+    EmbreeScene all_;
+    EmbreeScene dynamicOnly_;
+    Part static_, dynamic_, dynamicAlone_;
+    float rayEpsilon_ = 1e-5f;
+};
+
+}  // namespace qsgi
