@@ -1,8 +1,173 @@
 #include "test_support.h"
-#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <map>
+
+namespace fs = std::filesystem;
+using namespace qsgi;
+
+fs::path sourceDir() { return fs::path(QSGI_SOURCE_DIR); }
+fs::path sharedDir() { return sourceDir().parent_path() / "shared"; }
+
 std::string testScratchDir(const std::string& name) {
-    auto p = std::filesystem::temp_directory_path() / ("qsgi_test_" + name);
-    std::filesystem::remove_all(p);
-    std::filesystem::create_directories(p);
+    auto p = fs::temp_directory_path() / ("qsgi_test_" + name);
+    fs::remove_all(p);
+    fs::create_directories(p);
     return p.string();
 }
+
+CommandResult runQsgi(const std::string& arguments) {
+    const std::string command = std::string(QSGI_CLI) + " " + arguments + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    CommandResult r{-1, ""};
+    if (!pipe) return r;
+    std::array<char, 4096> buf;
+    size_t n;
+    while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+    const int status = pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+namespace testscenes {
+
+namespace {
+uint32_t addMaterial(Scene& s, Vec3f albedo, Vec3f emission = Vec3f(0.0f)) {
+    s.materials.push_back(Material{"m" + std::to_string(s.materials.size()), albedo, emission});
+    return uint32_t(s.materials.size() - 1);
+}
+
+// Quad grid from corner spanning u, v; front (CCW) side faces cross(u, v).
+void addGrid(Scene& s, int node, Vec3f corner, Vec3f u, Vec3f v, int cells, uint32_t material) {
+    std::vector<Vec3f> p, n;
+    std::vector<uint32_t> idx;
+    const Vec3f normal = normalize(cross(u, v));
+    for (int j = 0; j <= cells; ++j)
+        for (int i = 0; i <= cells; ++i) {
+            p.push_back(corner + u * (float(i) / cells) + v * (float(j) / cells));
+            n.push_back(normal);
+        }
+    const uint32_t row = uint32_t(cells + 1);
+    for (int j = 0; j < cells; ++j)
+        for (int i = 0; i < cells; ++i) {
+            const uint32_t a = uint32_t(j) * row + uint32_t(i);
+            idx.insert(idx.end(), {a, a + 1, a + row + 1, a, a + row + 1, a + row});
+        }
+    s.addInstance(node, std::move(p), std::move(n), idx, material);
+}
+}  // namespace
+
+Scene closedSphere(float radius, int subdivisions, Vec3f albedo, bool inwardNormals) {
+    // Icosphere: near-uniform triangles, so impact-count noise is alike everywhere.
+    const float t = (1 + std::sqrt(5.0f)) / 2;
+    std::vector<Vec3f> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                            {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    std::vector<uint32_t> idx = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2,
+                                 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5,
+                                 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+    for (auto& q : p) q = normalize(q);
+    for (int level = 0; level < subdivisions; ++level) {
+        std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+        auto midpoint = [&](uint32_t a, uint32_t b) {
+            auto key = std::minmax(a, b);
+            auto it = mid.find(key);
+            if (it != mid.end()) return it->second;
+            p.push_back(normalize(p[a] + p[b]));
+            return mid[key] = uint32_t(p.size() - 1);
+        };
+        std::vector<uint32_t> next;
+        for (size_t i = 0; i < idx.size(); i += 3) {
+            const uint32_t a = idx[i], b = idx[i + 1], c = idx[i + 2];
+            const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+            next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+        }
+        idx.swap(next);
+    }
+    std::vector<Vec3f> n(p.size());
+    for (size_t i = 0; i < p.size(); ++i) {
+        n[i] = inwardNormals ? -p[i] : p[i];
+        p[i] = p[i] * radius;
+    }
+    if (inwardNormals)
+        for (size_t i = 0; i < idx.size(); i += 3) std::swap(idx[i + 1], idx[i + 2]);
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    s.addInstance(s.addNode("Sphere", Transform()), std::move(p), std::move(n), idx, m);
+    s.finalize();
+    return s;
+}
+
+Scene plane(float halfSize, int cells, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    // y = 0, facing +y.
+    addGrid(s, s.addNode("Plane", Transform()), {-halfSize, 0, halfSize}, {2 * halfSize, 0, 0}, {0, 0, -2 * halfSize}, cells, m);
+    s.finalize();
+    return s;
+}
+
+Scene closedBox(int cells) {
+    Scene s;
+    const int node = s.addNode("Box", Transform());
+    const uint32_t white = addMaterial(s, {0.725f, 0.71f, 0.68f}), red = addMaterial(s, {0.63f, 0.065f, 0.05f}),
+                   green = addMaterial(s, {0.14f, 0.45f, 0.091f});
+    addGrid(s, node, {-1, -1, 1}, {2, 0, 0}, {0, 0, -2}, cells, white);   // floor, +y
+    addGrid(s, node, {-1, 1, -1}, {2, 0, 0}, {0, 0, 2}, cells, white);    // ceiling, -y
+    addGrid(s, node, {-1, -1, -1}, {2, 0, 0}, {0, 2, 0}, cells, white);   // back, +z
+    addGrid(s, node, {1, -1, 1}, {-2, 0, 0}, {0, 2, 0}, cells, white);    // front, -z
+    addGrid(s, node, {-1, -1, 1}, {0, 0, -2}, {0, 2, 0}, cells, red);     // left, +x
+    addGrid(s, node, {1, -1, -1}, {0, 0, 2}, {0, 2, 0}, cells, green);    // right, -x
+    s.finalize();
+    return s;
+}
+
+void addPointLight(Scene& s, Vec3f position, Vec3f intensity) {
+    PunctualLight l;
+    l.name = "test point light";
+    l.type = LightType::Point;
+    l.position = Vec3f(Vec3d(position) - s.worldOrigin);
+    l.intensity = intensity;
+    s.lights.push_back(l);
+}
+
+void writeQuadGltf(const std::string& path, bool lit) {
+    // Two triangles of a 1 m quad facing +y, positions then indices in one base64 buffer.
+    const float pos[12] = {-0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 0.5f, 0, -0.5f, -0.5f, 0, -0.5f};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    std::string bytes(reinterpret_cast<const char*>(pos), sizeof pos);
+    bytes.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    static const char* b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string enc;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
+        if (i + 1 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
+        if (i + 2 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 2]));
+        enc += b64[(v >> 18) & 63];
+        enc += b64[(v >> 12) & 63];
+        enc += i + 1 < bytes.size() ? b64[(v >> 6) & 63] : '=';
+        enc += i + 2 < bytes.size() ? b64[v & 63] : '=';
+    }
+    nlohmann::json m = {
+        {"asset", {{"version", "2.0"}}},
+        {"scene", 0},
+        {"scenes", {{{"nodes", {0}}}}},
+        {"nodes", {{{"name", "Quad"}, {"mesh", 0}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}, {"material", 0}}}}}}},
+        {"materials", {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}},
+                        {"emissiveFactor", lit ? nlohmann::json({1, 1, 1}) : nlohmann::json({0, 0, 0})}}}},
+        {"buffers", {{{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + enc}}}},
+        {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
+                         {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 12}}}},
+        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"},
+                        {"min", {-0.5, 0, -0.5}}, {"max", {0.5, 0, 0.5}}},
+                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}}},
+    };
+    std::ofstream(path) << m.dump(1);
+}
+
+}  // namespace testscenes

@@ -1,3 +1,28 @@
+// Helpers shared by the tests: paths, scratch folders, scenes built in code, and running the CLI.
 #pragma once
+
+#include <filesystem>
 #include <string>
+
+#include "scene/scene.h"
+
+std::filesystem::path sourceDir();  // the repository root
+std::filesystem::path sharedDir();  // ../shared beside the repository (may be absent)
 std::string testScratchDir(const std::string& name);
+
+struct CommandResult {
+    int exitCode;
+    std::string output;  // stdout and stderr together
+};
+CommandResult runQsgi(const std::string& arguments);
+
+// Scenes built in code, with one instance per mesh (see scene_builders.cpp).
+namespace testscenes {
+qsgi::Scene closedSphere(float radius, int subdivisions, qsgi::Vec3f albedo, bool inwardNormals = true);
+qsgi::Scene plane(float halfSize, int cells, qsgi::Vec3f albedo);
+// A closed box [-1,1]^3 with coloured walls facing inward.
+qsgi::Scene closedBox(int cells);
+void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
+// Writes a small glTF (a quad; emissive if lit) with an embedded buffer.
+void writeQuadGltf(const std::string& path, bool lit);
+}  // namespace testscenes

@@ -298,28 +298,11 @@ public:
             const auto& children = scene.nodes[n].children;
             for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
         }
-        scene.worldOrigin = centreOfInstances(scene, world);
-        for (PunctualLight& l : scene.lights) l.position = Vec3f(Vec3d(l.position) - scene.worldOrigin);
-        if (scene.camera) scene.camera->position = Vec3f(Vec3d(scene.camera->position) - scene.worldOrigin);
-        scene.placedWith.assign(scene.instances.size(), Transform());
-        for (size_t i = 0; i < scene.instances.size(); ++i) scene.placeInstance(i, world[scene.instances[i].node]);
-        scene.markDynamic({});
+        scene.finalize();
         return scene;
     }
 
 private:
-    // Centre of the rest-pose world bounds, in double precision.
-    static Vec3d centreOfInstances(const Scene& scene, const std::vector<Transform>& world) {
-        Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-        for (const MeshInstance& inst : scene.instances)
-            for (const Vec3f& p : inst.objectPositions) {
-                const Vec3d w = world[inst.node].applyPoint(Vec3d(p));
-                lo = min(lo, w);
-                hi = max(hi, w);
-            }
-        return lo.x <= hi.x ? (lo + hi) * 0.5 : Vec3d(0.0);
-    }
-
     void visitNode(Scene& scene, int n, const Transform& world) {
         const tinygltf::Node& node = model_.nodes[n];
         if (node.mesh >= 0) {
@@ -328,14 +311,14 @@ private:
             if (node.skin >= 0) warnings_.add(file_ + ": skins are not applied; the base mesh is used");
             const tinygltf::Mesh& mesh = model_.meshes[node.mesh];
             for (size_t p = 0; p < mesh.primitives.size(); ++p)
-                addPrimitive(scene, n, world, mesh.primitives[p], at("meshes", node.mesh) + "." + at("primitives", int(p)));
+                addPrimitive(scene, n, mesh.primitives[p], at("meshes", node.mesh) + "." + at("primitives", int(p)));
         }
         if (node.camera >= 0 && !scene.camera) addCamera(scene, n, world);
         auto light = node.extensions.find("KHR_lights_punctual");
         if (light != node.extensions.end() && light->second.Has("light")) addLight(scene, n, world, light->second.Get("light"));
     }
 
-    void addPrimitive(Scene& scene, int nodeIndex, const Transform& world, const tinygltf::Primitive& prim,
+    void addPrimitive(Scene& scene, int nodeIndex, const tinygltf::Primitive& prim,
                       const std::string& place) {
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
@@ -394,32 +377,16 @@ private:
             material = uint32_t(prim.material);
         }
 
-        MeshInstance inst;
-        inst.node = nodeIndex;
-        inst.firstVertex = uint32_t(scene.positions.size());
-        inst.vertexCount = uint32_t(vertexCount);
-        inst.firstTriangle = uint32_t(scene.triangles.size());
-        inst.triangleCount = uint32_t(tri.size() / 3);
-        inst.mirrored = world.determinant3x3() < 0;
-        inst.objectPositions.resize(vertexCount);
+        std::vector<Vec3f> objectPositions(vertexCount);
         for (size_t i = 0; i < vertexCount; ++i)
-            inst.objectPositions[i] = Vec3f(float(positions(i, 0)), float(positions(i, 1)), float(positions(i, 2)));
+            objectPositions[i] = Vec3f(float(positions(i, 0)), float(positions(i, 1)), float(positions(i, 2)));
+        std::vector<Vec3f> objectNormals;
         if (normals) {
-            inst.objectNormals.resize(vertexCount);
+            objectNormals.resize(vertexCount);
             for (size_t i = 0; i < vertexCount; ++i)
-                inst.objectNormals[i] = Vec3f(float((*normals)(i, 0)), float((*normals)(i, 1)), float((*normals)(i, 2)));
+                objectNormals[i] = Vec3f(float((*normals)(i, 0)), float((*normals)(i, 1)), float((*normals)(i, 2)));
         }
-        scene.positions.resize(scene.positions.size() + vertexCount);
-        scene.normals.resize(scene.normals.size() + vertexCount);
-        scene.vertexMaterial.resize(scene.vertexMaterial.size() + vertexCount, material);
-        for (size_t t = 0; t + 2 < tri.size(); t += 3) {
-            // A mirroring transform reverses the winding; swapping keeps the front side CCW in world space.
-            Triangle out{{inst.firstVertex + tri[t], inst.firstVertex + tri[t + 1], inst.firstVertex + tri[t + 2]}};
-            if (inst.mirrored) std::swap(out.v[1], out.v[2]);
-            scene.triangles.push_back(out);
-            scene.triangleMaterial.push_back(material);
-        }
-        scene.instances.push_back(std::move(inst));
+        scene.addInstance(nodeIndex, std::move(objectPositions), std::move(objectNormals), tri, material);
     }
 
     void addCamera(Scene& scene, int n, const Transform& world) {
@@ -455,7 +422,7 @@ private:
         out.node = n;
         const Vec3f colour = vec3FromFactor(l.color, Vec3f(1.0f));
         out.intensity = colour * float(l.intensity);
-        out.position = Vec3f(world.applyPoint(Vec3d(0.0)));  // re-centred in build()
+        out.position = Vec3f(world.applyPoint(Vec3d(0.0)));  // world space; Scene::finalize re-centres it
         out.direction = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
         if (l.type == "point") out.type = LightType::Point;
         else if (l.type == "spot") {

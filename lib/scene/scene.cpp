@@ -1,6 +1,7 @@
 #include "scene/scene.h"
 
 #include <functional>
+#include <limits>
 
 namespace qsgi {
 
@@ -98,6 +99,60 @@ void Scene::markDynamic(const std::vector<int>& movedNodes) {
         std::fill_n(vertexDynamic.begin() + inst.firstVertex, inst.vertexCount, 1);
         std::fill_n(triangleDynamic.begin() + inst.firstTriangle, inst.triangleCount, 1);
     }
+}
+
+int Scene::addNode(std::string name, const Transform& local, int parent) {
+    SceneNode n;
+    n.name = std::move(name);
+    n.local = local;
+    n.parent = parent;
+    nodes.push_back(std::move(n));
+    const int index = int(nodes.size() - 1);
+    if (parent >= 0) nodes[parent].children.push_back(index);
+    return index;
+}
+
+void Scene::addInstance(int node, std::vector<Vec3f> objectPositions, std::vector<Vec3f> objectNormals,
+                        const std::vector<uint32_t>& indices, uint32_t material) {
+    const Transform world = worldTransforms(restLocals())[node];
+    MeshInstance inst;
+    inst.node = node;
+    inst.firstVertex = uint32_t(positions.size());
+    inst.vertexCount = uint32_t(objectPositions.size());
+    inst.firstTriangle = uint32_t(triangles.size());
+    inst.triangleCount = uint32_t(indices.size() / 3);
+    inst.mirrored = world.determinant3x3() < 0;
+    inst.objectPositions = std::move(objectPositions);
+    inst.objectNormals = std::move(objectNormals);
+    positions.resize(positions.size() + inst.vertexCount);
+    normals.resize(normals.size() + inst.vertexCount);
+    vertexMaterial.resize(vertexMaterial.size() + inst.vertexCount, material);
+    for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+        // A mirroring transform reverses the winding; swapping keeps the front side CCW in world space.
+        Triangle out{{inst.firstVertex + indices[t], inst.firstVertex + indices[t + 1], inst.firstVertex + indices[t + 2]}};
+        if (inst.mirrored) std::swap(out.v[1], out.v[2]);
+        triangles.push_back(out);
+        triangleMaterial.push_back(material);
+    }
+    instances.push_back(std::move(inst));
+}
+
+void Scene::finalize() {
+    const std::vector<Transform> world = worldTransforms(restLocals());
+    // Centre of the rest-pose world bounds, in double precision.
+    Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const MeshInstance& inst : instances)
+        for (const Vec3f& p : inst.objectPositions) {
+            const Vec3d w = world[inst.node].applyPoint(Vec3d(p));
+            lo = min(lo, w);
+            hi = max(hi, w);
+        }
+    worldOrigin = lo.x <= hi.x ? (lo + hi) * 0.5 : Vec3d(0.0);
+    for (PunctualLight& l : lights) l.position = Vec3f(Vec3d(l.position) - worldOrigin);
+    if (camera) camera->position = Vec3f(Vec3d(camera->position) - worldOrigin);
+    placedWith.assign(instances.size(), Transform());
+    for (size_t i = 0; i < instances.size(); ++i) placeInstance(i, world[instances[i].node]);
+    markDynamic({});
 }
 
 bool Scene::hasDynamicGeometry() const {

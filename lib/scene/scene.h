@@ -106,6 +106,17 @@ struct Scene {
     void markDynamic(const std::vector<int>& movedNodes);
     bool hasDynamicGeometry() const;
 
+    // Assembly (the glTF loader and procedural scenes use these).
+    // Appends a node; returns its index.
+    int addNode(std::string name, const Transform& local, int parent = -1);
+    // Appends one mesh placed by `node`. indices: CCW triangles in object space; objectNormals
+    // may be empty (area-weighted normals are used). World positions are set by finalize().
+    void addInstance(int node, std::vector<Vec3f> objectPositions, std::vector<Vec3f> objectNormals,
+                     const std::vector<uint32_t>& indices, uint32_t material);
+    // Chooses worldOrigin, places every instance in the rest pose, re-centres lights and camera
+    // given in world space, and marks everything static.
+    void finalize();
+
     // Internal: the world transform each instance was last placed with.
     std::vector<Transform> placedWith;
     void placeInstance(size_t instanceIndex, const Transform& world);
