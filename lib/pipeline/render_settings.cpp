@@ -3,9 +3,9 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
-#include <fstream>
 
 #include "util/error.h"
+#include "util/json_file.h"
 
 namespace qsgi {
 
@@ -86,17 +86,19 @@ uint64_t positiveInteger(const json& j, const std::string& file, const std::stri
     return j.get<uint64_t>();
 }
 
+void applyConfig(const std::string& path, const json& doc, RenderSettings& s);
 }  // namespace
 
 void applyConfigFile(const std::string& path, RenderSettings& s) {
-    std::ifstream in(path);
-    if (!in) throw InputError(path, "", "cannot be opened for reading");
-    json doc;
     try {
-        doc = json::parse(in);
-    } catch (const json::parse_error& e) {
-        throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
+        applyConfig(path, readJsonFile(path), s);
+    } catch (const json::exception& e) {
+        throw InputError(path, "", std::string("a field has the wrong JSON type (") + e.what() + ")");
     }
+}
+
+namespace {
+void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
     if (!doc.is_object()) throw InputError(path, "", "must be a JSON object");
     const std::filesystem::path base = std::filesystem::path(path).parent_path();
     auto resolve = [&](const std::string& p) { return std::filesystem::path(p).is_absolute() ? p : (base / p).string(); };
@@ -130,6 +132,8 @@ void applyConfigFile(const std::string& path, RenderSettings& s) {
         }
     }
 }
+
+}  // namespace
 
 void validateSettings(const RenderSettings& s) {
     if (s.scenePath.empty()) throw InputError("command line", "SCENE", "no scene given");

@@ -2,10 +2,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include <fstream>
 #include <set>
 
 #include "util/error.h"
+#include "util/json_file.h"
 
 namespace qsgi {
 
@@ -83,14 +83,14 @@ Transform parseNodeTransform(const json& j, const std::string& file, const std::
 }  // namespace
 
 Animation Animation::fromTransformFile(const std::string& path, const Scene& scene) {
-    std::ifstream in(path);
-    if (!in) throw InputError(path, "", "cannot be opened for reading");
-    json doc;
     try {
-        doc = json::parse(in);
-    } catch (const json::parse_error& e) {
-        throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
+        return parseTransformFile(path, readJsonFile(path), scene);
+    } catch (const json::exception& e) {
+        throw InputError(path, "", std::string("a field has the wrong JSON type (") + e.what() + ")");
     }
+}
+
+Animation Animation::parseTransformFile(const std::string& path, const nlohmann::json& doc, const Scene& scene) {
     if (!doc.is_object()) throw InputError(path, "", "must be a JSON object");
     if (doc.value("format", "") != "qsgi-animation")
         throw InputError(path, "format", "must be \"qsgi-animation\"");

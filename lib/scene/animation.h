@@ -2,6 +2,8 @@
 // replaces its local transform; nodes not listed keep their last transform.
 #pragma once
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <string>
 #include <vector>
 
@@ -24,6 +26,8 @@ public:
     const std::vector<int>& movedNodes() const { return moved_; }
 
 private:
+    static Animation parseTransformFile(const std::string& path, const nlohmann::json& doc, const Scene& scene);
+
     struct Key {
         int frame;
         std::vector<std::pair<int, Transform>> nodes;

@@ -1,0 +1,134 @@
+// The qsgi executable end to end: determinism of the bytes it writes, and bad input giving one
+// clear message, exit code 2 and nothing written (DESIGN §8).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string readAll(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::string cornell() { return (sourceDir() / "data/cornell/cornell.gltf").string(); }
+std::string cornellAnimation() { return (sourceDir() / "data/cornell/animation.json").string(); }
+
+void writeText(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+// Runs a command that must fail on bad input: exit 2, the message names `mention`, no output folder.
+void expectBadInput(const std::string& args, const std::string& mention, const fs::path& out) {
+    const CommandResult r = runQsgi(args + " --out " + out.string());
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find(mention), std::string::npos) << "message should name '" << mention << "':\n" << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line expected:\n" << r.output;
+    EXPECT_FALSE(fs::exists(out)) << "bad input must write nothing: " << args;
+}
+
+}  // namespace
+
+TEST(Cli, PlyBytesAreIdenticalForOneAndTwoThreadsAndRepeatedRuns) {
+    const fs::path dir = testScratchDir("determinism");
+    const std::string common = cornell() + " --animation " + cornellAnimation() + " --frames 0:2 --photons 60000 --seed 3";
+    for (const char* run : {"t1", "t2", "t2again"}) {
+        const std::string threads = std::string(run) == "t1" ? "1" : "2";
+        const CommandResult r = runQsgi("render " + common + " --threads " + threads + " --out " + (fs::path(dir) / run).string());
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+    }
+    for (int f = 0; f <= 2; ++f) {
+        const std::string name = "frame_000" + std::to_string(f) + ".ply";
+        const std::string a = readAll(fs::path(dir) / "t1" / name);
+        ASSERT_GT(a.size(), 1000u);
+        EXPECT_EQ(a, readAll(fs::path(dir) / "t2" / name)) << name << " differs between 1 and 2 threads";
+        EXPECT_EQ(a, readAll(fs::path(dir) / "t2again" / name)) << name << " differs between runs";
+    }
+    // The block moves, so frames differ.
+    EXPECT_NE(readAll(fs::path(dir) / "t1/frame_0000.ply"), readAll(fs::path(dir) / "t1/frame_0002.ply"));
+    EXPECT_TRUE(fs::exists(fs::path(dir) / "t1/timing.json"));
+}
+
+TEST(Cli, RenderWritesOnePlyPerFrameAndATimingLog) {
+    const fs::path dir = testScratchDir("frames");
+    const CommandResult r = runQsgi("render " + cornell() + " --animation " + cornellAnimation() +
+                                    " --frames 5:7 --photons 20000 --quiet --out " + dir.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(r.output.empty()) << r.output;
+    for (int f : {5, 6, 7}) EXPECT_TRUE(fs::exists(dir / ("frame_000" + std::to_string(f) + ".ply")));
+    EXPECT_FALSE(fs::exists(dir / "frame_0004.ply"));
+    EXPECT_FALSE(fs::exists(dir / "frame_0008.ply"));
+    const std::string timing = readAll(dir / "timing.json");
+    EXPECT_NE(timing.find("\"photon_simulation\""), std::string::npos);
+    EXPECT_NE(timing.find("\"segments\""), std::string::npos);
+    for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos);
+}
+
+TEST(Cli, HelpAndVersion) {
+    EXPECT_EQ(runQsgi("--help").exitCode, 0);
+    const CommandResult v = runQsgi("--version");
+    EXPECT_EQ(v.exitCode, 0);
+    EXPECT_NE(v.output.find("qsgi"), std::string::npos);
+}
+
+TEST(Cli, BadInputGivesOneClearMessageExitCodeTwoAndWritesNothing) {
+    const fs::path dir = testScratchDir("badinput");
+    const fs::path out = dir / "out";
+
+    expectBadInput("render " + (dir / "missing.gltf").string(), "missing.gltf", out);
+
+    writeText(dir / "malformed.gltf", "{ \"asset\": { \"version\": \"2.0\" }, \"scenes\": [ ");
+    expectBadInput("render " + (dir / "malformed.gltf").string(), "malformed.gltf", out);
+
+    // A .gltf whose buffer file is missing.
+    writeText(dir / "nobin.gltf",
+              R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+                  "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+                  "buffers":[{"uri":"absent.bin","byteLength":36}],
+                  "bufferViews":[{"buffer":0,"byteLength":36}],
+                  "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})");
+    expectBadInput("render " + (dir / "nobin.gltf").string(), "nobin.gltf", out);
+
+    testscenes::writeQuadGltf((dir / "dark.gltf").string(), false);
+    expectBadInput("render " + (dir / "dark.gltf").string(), "no lights", out);
+
+    testscenes::writeQuadGltf((dir / "lit.gltf").string(), true);
+    const std::string lit = (dir / "lit.gltf").string();
+    ASSERT_EQ(runQsgi("render " + lit + " --photons 100 --out " + (dir / "ok").string()).exitCode, 0);
+
+    writeText(dir / "unknown.json",
+              R"({"format":"qsgi-animation","version":1,"frames":[{"frame":0,"nodes":{"Nope":{"translation":[0,0,0]}}}]})");
+    expectBadInput("render " + lit + " --animation " + (dir / "unknown.json").string(), "Nope", out);
+
+    writeText(dir / "inf.json",
+              R"({"format":"qsgi-animation","version":1,"frames":[{"frame":0,"nodes":{"Quad":{"translation":[0,1e999,0]}}}]})");
+    expectBadInput("render " + lit + " --animation " + (dir / "inf.json").string(), "inf.json", out);
+
+    writeText(dir / "nan.json",
+              R"({"format":"qsgi-animation","version":1,"frames":[{"frame":0,"nodes":{"Quad":{"translation":[0,NaN,0]}}}]})");
+    expectBadInput("render " + lit + " --animation " + (dir / "nan.json").string(), "nan.json", out);
+
+    writeText(dir / "order.json",
+              R"({"format":"qsgi-animation","version":1,"frames":[{"frame":1},{"frame":1}]})");
+    expectBadInput("render " + lit + " --animation " + (dir / "order.json").string(), "duplicated", out);
+
+    writeText(dir / "singular.json",
+              R"({"format":"qsgi-animation","version":1,"frames":[{"frame":0,"nodes":{"#0":{"scale":[1,0,1]}}}]})");
+    expectBadInput("render " + lit + " --animation " + (dir / "singular.json").string(), "not invertible", out);
+
+    expectBadInput("render " + lit + " --photons 0", "--photons", out);
+    expectBadInput("render " + lit + " --photons -5", "--photons", out);
+    expectBadInput("render " + lit + " --frames 3:1", "frames", out);
+
+    // An output folder that cannot be created: its parent is a regular file.
+    writeText(dir / "file", "x");
+    const CommandResult r = runQsgi("render " + lit + " --photons 100 --out " + (dir / "file" / "sub").string());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("file/sub"), std::string::npos) << r.output;
+}
