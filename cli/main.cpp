@@ -2,6 +2,7 @@
 // errors to exit codes (0 ok, 2 bad input, 1 internal error). No algorithm lives here.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -17,7 +18,9 @@ constexpr int kExitInternal = 1;
 struct CliOptions {
     std::string config, animation, estimator, frames, out;
     int64_t photons = -1, seed = -1, threads = -1;
-    bool quiet = false, verbose = false;
+    int64_t width = -1, height = -1, spp = -1, camera = -1;
+    double exposure = -1;
+    bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false;
 };
 
 // Later sources override earlier ones: defaults, then --config, then explicit options.
@@ -35,6 +38,15 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.seed >= 0) s.seed = uint64_t(o.seed);
     if (o.threads < -1) throw qsgi::InputError("command line", "--threads", "must be a non-negative integer (0: all cores)");
     if (o.threads >= 0) s.threads = int(o.threads);
+    if (o.width >= 0) s.width = int(std::min<int64_t>(o.width, 1 << 20));
+    if (o.height >= 0) s.height = int(std::min<int64_t>(o.height, 1 << 20));
+    if (o.width < -1 || o.height < -1) throw qsgi::InputError("command line", "--width/--height", "must be positive");
+    if (o.spp != -1) s.samplesPerPixel = int(std::clamp<int64_t>(o.spp, -1, 1 << 20));
+    if (o.camera != -1) s.cameraIndex = int(std::clamp<int64_t>(o.camera, -2, 1 << 20));
+    if (o.exposure != -1) s.exposure = float(o.exposure);
+    if (o.png) s.writePng = true;
+    if (o.noExr) s.writeExr = false;
+    if (o.exrHalf) s.exrHalf = true;
     s.quiet = o.quiet;
     s.progress = !o.quiet && qsgi::stderrIsTerminal();
     return s;
@@ -59,6 +71,14 @@ int main(int argc, char** argv) {
     render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");
     render->add_option("--frames", o.frames, "frames A:B, inclusive at both ends (default: all)");
     render->add_option("--out", o.out, "output folder (default out)");
+    render->add_option("--width", o.width, "image width in pixels (default 640)");
+    render->add_option("--height", o.height, "image height in pixels (default 480)");
+    render->add_option("--spp", o.spp, "jittered primary rays per pixel (default 1: the pixel centre)");
+    render->add_option("--camera", o.camera, "use the glTF camera with this index (default: the first camera node)");
+    render->add_flag("--no-exr", o.noExr, "do not write frame_NNNN.exr");
+    render->add_flag("--exr-half", o.exrHalf, "write EXRs as half floats instead of float");
+    render->add_flag("--png", o.png, "also write an 8-bit sRGB preview frame_NNNN.png");
+    render->add_option("--exposure", o.exposure, "PNG exposure multiplier (default: automatic, fixed at the first frame)");
     render->add_flag("--quiet", o.quiet, "print nothing but errors");
     render->add_flag("--verbose", o.verbose, "print per-frame timings");
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "output/atomic_file.h"
+#include "output/srgb.h"
 
 namespace qsgi {
 
@@ -22,9 +23,7 @@ PreviewTonemap PreviewTonemap::fromPercentile(const std::vector<Vec3f>& radiosit
 }
 
 uint8_t PreviewTonemap::encode(float value) const {
-    const float x = std::clamp(value * scale, 0.0f, 1.0f);
-    const float s = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1 / 2.4f) - 0.055f;
-    return uint8_t(std::lround(std::clamp(s, 0.0f, 1.0f) * 255));
+    return encodeSrgb8(value * scale);
 }
 
 namespace {

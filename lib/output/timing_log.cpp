@@ -42,7 +42,8 @@ void TimingLog::write(const std::filesystem::path& path) const {
     json list = json::array();
     for (const FrameTiming& f : frames)
         list.push_back({{"frame", f.frame}, {"photon_update_s", f.photonSimulationSeconds},
-                        {"estimation_s", f.estimationSeconds}, {"write_s", f.writeSeconds},
+                        {"estimation_s", f.estimationSeconds}, {"render_s", f.renderSeconds},
+                        {"write_s", f.writeSeconds},
                         {"segments", f.segments}, {"paths_retraced", f.pathsRetraced},
                         {"segments_removed", f.segmentsRemoved}, {"segments_added", f.segmentsAdded},
                         {"vertices_updated", f.verticesUpdated}});

@@ -13,7 +13,8 @@ struct FrameTiming {
     int frame = 0;
     double photonSimulationSeconds = 0;  // tracing (or retracing) photons
     double estimationSeconds = 0;        // density estimation
-    double writeSeconds = 0;             // PLY (and later image) output
+    double renderSeconds = 0;            // the camera view (EXR/PNG), excluding file writing
+    double writeSeconds = 0;             // PLY, EXR and PNG output
     uint64_t segments = 0;               // segments in the ray cache after this frame
     uint64_t pathsRetraced = 0;
     uint64_t segmentsRemoved = 0, segmentsAdded = 0;

@@ -4,10 +4,14 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <climits>
 #include <optional>
+#include <stdexcept>
 
 #include "estimate/impact_count.h"
+#include "output/image_files.h"
 #include "output/ply_writer.h"
+#include "output/radiosity_image.h"
 #include "output/timing_log.h"
 #include "scene/gltf_loader.h"
 #include "trace/photon_tracer.h"
@@ -23,6 +27,36 @@ std::string frameFileName(int frame, const char* extension) {
     std::snprintf(name, sizeof name, "frame_%04d.%s", frame, extension);
     return name;
 }
+
+namespace {
+
+// The config's look-at camera, else --camera N, else the scene's first camera, else one that
+// frames the scene (with a warning).
+PerspectiveCamera resolveCamera(const RenderSettings& s, const Scene& scene, Warnings& warnings) {
+    if (s.camera) {
+        try {
+            return lookAtCamera(Vec3f(Vec3d(s.camera->position) - scene.worldOrigin),
+                                Vec3f(Vec3d(s.camera->target) - scene.worldOrigin), s.camera->up, s.camera->yfov);
+        } catch (const std::invalid_argument& e) {
+            throw InputError(s.configPath.empty() ? "config" : s.configPath, "camera", e.what());
+        }
+    }
+    if (s.cameraIndex) {
+        const int i = *s.cameraIndex;
+        if (i < 0 || i >= int(scene.cameras.size()))
+            throw InputError(s.scenePath, "--camera " + std::to_string(i),
+                             "no such camera (the file has " + std::to_string(scene.cameras.size()) + ")");
+        if (!scene.cameras[i])
+            throw InputError(s.scenePath, "--camera " + std::to_string(i), "the camera is not perspective or no node in the scene uses it");
+        return *scene.cameras[i];
+    }
+    if (scene.camera) return *scene.camera;
+    if (s.writeExr || s.writePng)
+        warnings.add(s.scenePath + ": no camera in the scene or config; using one that frames the scene's bounds");
+    return framingCamera(scene.bounds(), float(s.width) / float(s.height));
+}
+
+}  // namespace
 
 RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     : settings_(std::move(settings)), scene_(), animation_() {
@@ -47,6 +81,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                                                  : Animation::fromTransformFile(settings_.animationPath, scene_);
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, settings_.animationPath);
     scene_.markDynamic(animation_.movedNodes());
+
+    camera_ = resolveCamera(settings_, scene_, warnings);
 
     first_ = 0;
     last_ = animation_.lastFrame();
@@ -84,6 +120,17 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
 
     EmbreeDevice device;
     std::optional<PreviewTonemap> tonemap;
+    std::optional<float> exposure;  // fixed at the first frame so previews do not flicker
+    auto imageMetadata = [&](int frame) {
+        ImageMetadata m;
+        m.strings = {{"qsgi:estimator", estimatorName(settings_.estimator)}, {"qsgi:version", QSGI_VERSION},
+                     {"qsgi:scene", settings_.scenePath},
+                     {"qsgi:seed", std::to_string(settings_.seed)}, {"Software", std::string("qsgi ") + QSGI_VERSION}};
+        m.ints = {{"qsgi:frame", frame}, {"qsgi:photons", int(std::min<uint64_t>(settings_.photons, INT32_MAX))},
+                  {"qsgi:spp", settings_.samplesPerPixel}};
+        m.floats = {{"qsgi:radius", 0.0f}};  // 0: the estimator has no radius (impact count)
+        return m;
+    };
     const int count = last_ - first_ + 1;
     for (int frame = first_; frame <= last_; ++frame) {
         Stopwatch frameClock;
@@ -111,9 +158,22 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         timing.verticesUpdated = scene_.vertexCount();
         log.degenerateTriangles = estimator.degenerateTriangles();
 
+        std::optional<RgbImage> image;
+        if (settings_.writeExr || settings_.writePng) {
+            clock.restart();
+            image = renderRadiosityImage(scene_, bvh, result, camera_,
+                                         ImageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.seed});
+            timing.renderSeconds = clock.seconds();
+        }
+
         clock.restart();
         if (!tonemap) tonemap = PreviewTonemap::fromPercentile(result.radiosity);
         writeVertexRadiosityPly(outDir / frameFileName(frame, "ply"), scene_, result, *tonemap);
+        if (settings_.writeExr) writeExr(outDir / frameFileName(frame, "exr"), *image, imageMetadata(frame), settings_.exrHalf);
+        if (settings_.writePng) {
+            if (!exposure) exposure = settings_.exposure ? *settings_.exposure : automaticExposure(*image);
+            writePngPreview(outDir / frameFileName(frame, "png"), *image, *exposure);
+        }
         timing.writeSeconds = clock.seconds();
         log.frames.push_back(timing);
         if (onFrame) onFrame(FrameReport{frame, frame - first_, count, frameClock.seconds()});

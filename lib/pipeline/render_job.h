@@ -35,6 +35,7 @@ public:
 private:
     RenderSettings settings_;
     Scene scene_;
+    PerspectiveCamera camera_;
     Animation animation_;
     int first_ = 0, last_ = 0;
 };

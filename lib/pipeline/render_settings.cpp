@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "util/error.h"
@@ -90,6 +92,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s);
 }  // namespace
 
 void applyConfigFile(const std::string& path, RenderSettings& s) {
+    s.configPath = path;
     try {
         applyConfig(path, readJsonFile(path), s);
     } catch (const json::exception& e) {
@@ -125,6 +128,38 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
         else if (key == "lights") {
             if (!v.is_array()) throw InputError(path, key, "must be an array of lights");
             for (size_t i = 0; i < v.size(); ++i) s.extraLights.push_back(parseLight(v[i], path, "lights[" + std::to_string(i) + "]"));
+        } else if (key == "width") s.width = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 20));
+        else if (key == "height") s.height = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 20));
+        else if (key == "spp") s.samplesPerPixel = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 16));
+        else if (key == "exr") {
+            if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
+            s.writeExr = v.get<bool>();
+        } else if (key == "exr_half") {
+            if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
+            s.exrHalf = v.get<bool>();
+        } else if (key == "png") {
+            if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
+            s.writePng = v.get<bool>();
+        } else if (key == "exposure") {
+            if (!v.is_number() || !(v.get<double>() > 0) || !std::isfinite(v.get<double>()))
+                throw InputError(path, key, "must be a positive number");
+            s.exposure = v.get<float>();
+        } else if (key == "camera") {
+            if (v.is_number_integer()) {
+                s.cameraIndex = int(std::clamp<int64_t>(v.get<int64_t>(), -1, 1 << 20));
+                continue;
+            }
+            if (!v.is_object() || !v.contains("position") || !v.contains("target"))
+                throw InputError(path, key, "must be a glTF camera index or {position, target, up, yfov}");
+            RenderSettings::LookAt c;
+            c.position = vec3(v["position"], path, "camera.position");
+            c.target = vec3(v["target"], path, "camera.target");
+            if (v.contains("up")) c.up = vec3(v["up"], path, "camera.up");
+            if (v.contains("yfov")) {
+                if (!v["yfov"].is_number()) throw InputError(path, "camera.yfov", "must be a number (radians)");
+                c.yfov = v["yfov"].get<float>();
+            }
+            s.camera = c;
         } else if (key.rfind("_", 0) == 0 || key == "comment") {
             // "_…" and "comment" keys are notes for people
         } else {
@@ -140,6 +175,13 @@ void validateSettings(const RenderSettings& s) {
     if (s.photons == 0) throw InputError("command line", "--photons", "must be a positive integer");
     if (s.photons > (uint64_t(1) << 32)) throw InputError("command line", "--photons", "at most 2^32 photons are supported");
     if (s.maxBounces == 0) throw InputError("command line", "max_bounces", "must be positive");
+    constexpr int kMaxImageSide = 16384;
+    if (s.width <= 0 || s.height <= 0 || s.width > kMaxImageSide || s.height > kMaxImageSide)
+        throw InputError("command line", "--width/--height",
+                         std::to_string(s.width) + "x" + std::to_string(s.height) + " is outside 1..16384 per side");
+    if (s.samplesPerPixel <= 0 || s.samplesPerPixel > 4096) throw InputError("command line", "--spp", "must lie in 1..4096");
+    if (s.exposure && !(*s.exposure > 0 && std::isfinite(*s.exposure)))
+        throw InputError("command line", "--exposure", "must be a positive number");
 }
 
 }  // namespace qsgi

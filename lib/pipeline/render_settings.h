@@ -19,6 +19,7 @@ struct FrameRange {
 };
 
 struct RenderSettings {
+    std::string configPath;     // the config file read, if any (for messages)
     std::string scenePath;
     std::string animationPath;  // empty: no animation (one frame, 0)
     std::string outDir = "out";
@@ -29,6 +30,15 @@ struct RenderSettings {
     int threads = 0;  // 0: all cores
     std::optional<FrameRange> frames;
     std::vector<PunctualLight> extraLights;  // world space, from the config
+
+    // Images (DESIGN §7)
+    int width = 640, height = 480;
+    int samplesPerPixel = 1;
+    bool writeExr = true, exrHalf = false, writePng = false;
+    std::optional<float> exposure;        // PNG preview; unset: automatic from frame 0
+    std::optional<int> cameraIndex;       // a glTF camera by index
+    struct LookAt { Vec3f position, target, up{0, 1, 0}; float yfov = 0.8f; };
+    std::optional<LookAt> camera;         // world space, from the config
     bool progress = false;
     bool quiet = false;
 };

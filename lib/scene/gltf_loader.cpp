@@ -298,6 +298,7 @@ public:
             const auto& children = scene.nodes[n].children;
             for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
         }
+        scene.cameras.resize(model_.cameras.size());
         scene.finalize();
         return scene;
     }
@@ -313,7 +314,7 @@ private:
             for (size_t p = 0; p < mesh.primitives.size(); ++p)
                 addPrimitive(scene, n, mesh.primitives[p], at("meshes", node.mesh) + "." + at("primitives", int(p)));
         }
-        if (node.camera >= 0 && !scene.camera) addCamera(scene, n, world);
+        if (node.camera >= 0) addCamera(scene, n, world);
         auto light = node.extensions.find("KHR_lights_punctual");
         if (light != node.extensions.end() && light->second.Has("light")) addLight(scene, n, world, light->second.Get("light"));
     }
@@ -394,6 +395,8 @@ private:
         if (node.camera >= int(model_.cameras.size()))
             throw InputError(file_, at("nodes", n) + ".camera", "refers to a camera that does not exist");
         const tinygltf::Camera& cam = model_.cameras[node.camera];
+        scene.cameras.resize(model_.cameras.size());
+        if (scene.cameras[node.camera]) return;  // the first node using a camera places it
         if (cam.type != "perspective") {
             warnings_.add(file_ + ": " + at("cameras", node.camera) + ": only perspective cameras are used; skipped");
             return;
@@ -407,7 +410,8 @@ private:
         c.znear = float(cam.perspective.znear);
         if (!(c.yfov > 0 && c.yfov < 3.14159f) || !isFinite(c.position) || !isFinite(c.forward))
             throw InputError(file_, at("cameras", node.camera), "yfov must lie in (0, pi) and the camera node's transform must be finite");
-        scene.camera = c;
+        scene.cameras[node.camera] = c;
+        if (!scene.camera) scene.camera = c;
     }
 
     void addLight(Scene& scene, int n, const Transform& world, const tinygltf::Value& ref) {

@@ -150,6 +150,8 @@ void Scene::finalize() {
     worldOrigin = lo.x <= hi.x ? (lo + hi) * 0.5 : Vec3d(0.0);
     for (PunctualLight& l : lights) l.position = Vec3f(Vec3d(l.position) - worldOrigin);
     if (camera) camera->position = Vec3f(Vec3d(camera->position) - worldOrigin);
+    for (auto& c : cameras)
+        if (c) c->position = Vec3f(Vec3d(c->position) - worldOrigin);
     placedWith.assign(instances.size(), Transform());
     for (size_t i = 0; i < instances.size(); ++i) placeInstance(i, world[instances[i].node]);
     markDynamic({});

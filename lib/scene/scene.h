@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/camera.h"
 #include "util/vecmath.h"
 
 namespace qsgi {
@@ -56,14 +57,6 @@ struct MeshInstance {
     bool mirrored = false;             // rest transform has a negative determinant
 };
 
-struct PerspectiveCamera {
-    Vec3f position{0.0f};
-    Vec3f forward{0, 0, -1}, up{0, 1, 0};
-    float yfov = 0.8f;  // radians
-    float aspect = 0;   // 0: from the image size
-    float znear = 0.01f;
-};
-
 struct Scene {
     std::string sourcePath;
 
@@ -71,7 +64,8 @@ struct Scene {
     std::vector<MeshInstance> instances;
     std::vector<Material> materials;
     std::vector<PunctualLight> lights;
-    std::optional<PerspectiveCamera> camera;
+    std::optional<PerspectiveCamera> camera;          // the first camera node's
+    std::vector<std::optional<PerspectiveCamera>> cameras;  // by glTF camera index (first node using it)
 
     // World space, current pose, relative to worldOrigin: re-centring keeps float positions
     // precise for scenes far from the origin (DESIGN §4), so a scene translated by 1e5 m traces

@@ -92,7 +92,7 @@ std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& 
     rtcIntersect1(all_.get(), &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     const Part& part = rh.hit.geomID == static_.geomId ? static_ : dynamic_;
-    return SurfaceHit{rh.ray.tfar, part.triangles[rh.hit.primID]};
+    return SurfaceHit{rh.ray.tfar, part.triangles[rh.hit.primID], rh.hit.u, rh.hit.v};
 }
 
 bool SceneBvh::dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {

@@ -13,6 +13,7 @@ namespace qsgi {
 struct SurfaceHit {
     float t = 0;
     uint32_t triangle = 0;  // scene triangle index
+    float u = 0, v = 0;     // barycentrics of vertices 1 and 2 of that triangle
 };
 
 class SceneBvh {

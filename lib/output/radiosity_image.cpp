@@ -1,0 +1,50 @@
+#include "output/radiosity_image.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <limits>
+
+#include "trace/counter_rng.h"
+#include "trace/sampling.h"
+
+namespace qsgi {
+
+RgbImage renderRadiosityImage(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& solution,
+                              const PerspectiveCamera& camera, const ImageSettings& settings) {
+    RgbImage image;
+    image.width = settings.width;
+    image.height = settings.height;
+    image.pixels.assign(size_t(settings.width) * size_t(settings.height) * 3, 0.0f);
+    const int spp = std::max(1, settings.samplesPerPixel);
+    const float tnear = std::max(camera.znear, 0.0f);
+    // Each pixel depends only on its own rays, so tiles can run in any order.
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, settings.height, 16, 0, settings.width, 16),
+                      [&](const tbb::blocked_range2d<int>& tile) {
+        for (int y = tile.rows().begin(); y != tile.rows().end(); ++y)
+            for (int x = tile.cols().begin(); x != tile.cols().end(); ++x) {
+                const uint64_t pixel = uint64_t(y) * uint64_t(settings.width) + uint64_t(x);
+                const PhotonRandom jitter(settings.seed ^ 0x5EED1AA6Eull, pixel);
+                Vec3d sum(0.0);
+                for (int s = 0; s < spp; ++s) {
+                    const float jx = spp == 1 ? 0.5f : jitter.uniform(uint32_t(s), 0);
+                    const float jy = spp == 1 ? 0.5f : jitter.uniform(uint32_t(s), 1);
+                    const Vec3f d = cameraRayDirection(camera, float(x) + jx, float(y) + jy, settings.width, settings.height);
+                    const auto hit = bvh.intersect(camera.position, d, tnear, std::numeric_limits<float>::infinity());
+                    if (!hit) continue;
+                    const Triangle& t = scene.triangles[hit->triangle];
+                    const Vec3f b = solution.radiosity[t.v[0]] * (1 - hit->u - hit->v) +
+                                    solution.radiosity[t.v[1]] * hit->u + solution.radiosity[t.v[2]] * hit->v;
+                    sum += Vec3d(b);
+                }
+                const Vec3f radiance = Vec3f(sum / (double(spp) * M_PI));
+                float* out = &image.pixels[pixel * 3];
+                out[0] = radiance.x;
+                out[1] = radiance.y;
+                out[2] = radiance.z;
+            }
+    });
+    return image;
+}
+
+}  // namespace qsgi
