@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <iostream>
 
 #include "pipeline/render_job.h"
@@ -17,9 +18,9 @@ constexpr int kExitInternal = 1;
 
 struct CliOptions {
     std::string config, animation, estimator, frames, out;
-    int64_t photons = -1, seed = -1, threads = -1;
-    int64_t width = -1, height = -1, spp = -1, camera = -1;
-    double exposure = -1;
+    // Unset options leave the config's (or the default) value alone.
+    std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
+    std::optional<double> exposure;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false;
 };
 
@@ -32,18 +33,25 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (!o.estimator.empty()) s.estimator = qsgi::parseEstimator(o.estimator, "command line");
     if (!o.frames.empty()) s.frames = qsgi::parseFrameRange(o.frames, "command line");
     if (!o.out.empty()) s.outDir = o.out;
-    if (o.photons == 0 || o.photons < -1) throw qsgi::InputError("command line", "--photons", "must be a positive integer");
-    if (o.photons > 0) s.photons = uint64_t(o.photons);
-    if (o.seed < -1) throw qsgi::InputError("command line", "--seed", "must be a non-negative integer");
-    if (o.seed >= 0) s.seed = uint64_t(o.seed);
-    if (o.threads < -1) throw qsgi::InputError("command line", "--threads", "must be a non-negative integer (0: all cores)");
-    if (o.threads >= 0) s.threads = int(o.threads);
-    if (o.width >= 0) s.width = int(std::min<int64_t>(o.width, 1 << 20));
-    if (o.height >= 0) s.height = int(std::min<int64_t>(o.height, 1 << 20));
-    if (o.width < -1 || o.height < -1) throw qsgi::InputError("command line", "--width/--height", "must be positive");
-    if (o.spp != -1) s.samplesPerPixel = int(std::clamp<int64_t>(o.spp, -1, 1 << 20));
-    if (o.camera != -1) s.cameraIndex = int(std::clamp<int64_t>(o.camera, -2, 1 << 20));
-    if (o.exposure != -1) s.exposure = float(o.exposure);
+    if (o.photons) {
+        if (*o.photons <= 0) throw qsgi::InputError("command line", "--photons", "must be a positive integer");
+        s.photons = uint64_t(*o.photons);
+    }
+    if (o.seed) {
+        if (*o.seed < 0) throw qsgi::InputError("command line", "--seed", "must be a non-negative integer");
+        s.seed = uint64_t(*o.seed);
+    }
+    if (o.threads) {
+        if (*o.threads < 0) throw qsgi::InputError("command line", "--threads", "must be a non-negative integer (0: all cores)");
+        s.threads = int(std::min<int64_t>(*o.threads, 1024));
+    }
+    // Out-of-range sizes are clamped into int range here and rejected by validateSettings.
+    auto clampToInt = [](int64_t v) { return int(std::clamp<int64_t>(v, -1, 1 << 24)); };
+    if (o.width) s.width = clampToInt(*o.width);
+    if (o.height) s.height = clampToInt(*o.height);
+    if (o.spp) s.samplesPerPixel = clampToInt(*o.spp);
+    if (o.camera) s.cameraIndex = clampToInt(*o.camera);
+    if (o.exposure) s.exposure = float(*o.exposure);
     if (o.png) s.writePng = true;
     if (o.noExr) s.writeExr = false;
     if (o.exrHalf) s.exrHalf = true;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "output/image_compare.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -35,18 +36,20 @@ void expectBadInput(const std::string& args, const std::string& mention, const f
 
 }  // namespace
 
-TEST(Cli, PlyBytesAreIdenticalForOneAndTwoThreadsAndRepeatedRuns) {
+TEST(Cli, OutputBytesAreIdenticalForOneAndTwoThreadsAndRepeatedRuns) {
     const fs::path dir = testScratchDir("determinism");
-    const std::string common = cornell() + " --animation " + cornellAnimation() + " --frames 0:2 --photons 60000 --seed 3";
+    const std::string common = cornell() + " --animation " + cornellAnimation() +
+                               " --frames 0:2 --photons 60000 --seed 3 --width 160 --height 120 --spp 2 --png";
     for (const char* run : {"t1", "t2", "t2again"}) {
         const std::string threads = std::string(run) == "t1" ? "1" : "2";
         const CommandResult r = runQsgi("render " + common + " --threads " + threads + " --out " + (fs::path(dir) / run).string());
         ASSERT_EQ(r.exitCode, 0) << r.output;
     }
-    for (int f = 0; f <= 2; ++f) {
-        const std::string name = "frame_000" + std::to_string(f) + ".ply";
+    for (int f = 0; f <= 2; ++f)
+      for (const char* ext : {".ply", ".exr", ".png"}) {
+        const std::string name = "frame_000" + std::to_string(f) + ext;
         const std::string a = readAll(fs::path(dir) / "t1" / name);
-        ASSERT_GT(a.size(), 1000u);
+        ASSERT_GT(a.size(), 1000u) << name;
         EXPECT_EQ(a, readAll(fs::path(dir) / "t2" / name)) << name << " differs between 1 and 2 threads";
         EXPECT_EQ(a, readAll(fs::path(dir) / "t2again" / name)) << name << " differs between runs";
     }
@@ -131,4 +134,34 @@ TEST(Cli, BadInputGivesOneClearMessageExitCodeTwoAndWritesNothing) {
     const CommandResult r = runQsgi("render " + lit + " --photons 100 --out " + (dir / "file" / "sub").string());
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("file/sub"), std::string::npos) << r.output;
+}
+
+TEST(Cli, ImageOptionsAreCheckedBeforeAnythingIsWritten) {
+    const fs::path dir = testScratchDir("badimage");
+    const fs::path out = dir / "out";
+    expectBadInput("render " + cornell() + " --camera 5", "--camera 5", out);
+    expectBadInput("render " + cornell() + " --camera -3", "--camera", out);
+    expectBadInput("render " + cornell() + " --width 0", "--width", out);
+    expectBadInput("render " + cornell() + " --height 20000", "16384", out);
+    expectBadInput("render " + cornell() + " --spp 0", "--spp", out);
+    expectBadInput("render " + cornell() + " --exposure -1", "--exposure", out);
+}
+
+// A run killed mid-frame leaves only complete files under the final names: every frame_NNNN.exr
+// that exists opens and holds the whole image (the writer renames a finished temporary file).
+TEST(Cli, AnInterruptedRunNeverLeavesATruncatedExr) {
+    const fs::path out = testScratchDir("interrupted");
+    const std::string command = std::string(QSGI_CLI) + " render " + cornell() + " --animation " + cornellAnimation() +
+                                " --photons 20000 --width 640 --height 480 --quiet --out " + out.string() +
+                                " & pid=$!; sleep 1.0; kill -9 $pid; wait $pid 2>/dev/null; true";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    int complete = 0;
+    for (const auto& e : fs::directory_iterator(out)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("frame_", 0) != 0 || e.path().extension() != ".exr" || name.find(".tmp") != std::string::npos) continue;
+        const auto self = qsgi::compareImages(e.path(), e.path(), qsgi::ImageTolerance{});
+        EXPECT_TRUE(self.readable) << name << ": " << self.problem;
+        ++complete;
+    }
+    EXPECT_GT(complete, 0) << "the run should have finished some frames within a second";
 }

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <climits>
 #include <optional>
 #include <stdexcept>
@@ -105,6 +106,15 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     fs::create_directories(outDir, ec);
     if (ec || !fs::is_directory(outDir))
         throw InputError(settings_.outDir, "--out", "cannot create the output folder" + (ec ? ": " + ec.message() : ""));
+    {
+        // Find out now, not after the first frame's work, whether files can be written here.
+        const fs::path probe = outDir / ".qsgi-write-test";
+        std::ofstream test(probe);
+        const bool writable = bool(test << "ok");
+        test.close();
+        fs::remove(probe, ec);
+        if (!writable) throw InputError(settings_.outDir, "--out", "the output folder is not writable");
+    }
 
     TimingLog log;
     log.estimator = estimatorName(settings_.estimator);

@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""Generates the analytic test scenes in tests/scenes/ (standard library only):
+
+- sphere_point_light.gltf: a closed sphere of radius 1 m (icosphere, inward normals, albedo 0.5)
+  with a 1 W/sr KHR_lights_punctual point light at its centre: E = 2 W/m^2 everywhere.
+- plane_point_light.gltf: a 3.2 m square plane (albedo 0.5) under a 1 W/sr point light 1 m
+  above its centre: E = I h / d^3.
+Each has a camera. Run: python3 scripts/make_test_scenes.py [OUT_DIR]
+"""
+import base64
+import json
+import math
+import os
+import struct
+import sys
+
+
+def icosphere(subdivisions):
+    t = (1 + math.sqrt(5)) / 2
+    p = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+         (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    p = [normalize(v) for v in p]
+    f = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+         (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5),
+         (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(subdivisions):
+        cache = {}
+
+        def mid(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in cache:
+                p.append(normalize([(p[a][k] + p[b][k]) / 2 for k in range(3)]))
+                cache[key] = len(p) - 1
+            return cache[key]
+        nf = []
+        for a, b, c in f:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            nf += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        f = nf
+    return p, f
+
+
+def normalize(v):
+    n = math.sqrt(sum(c * c for c in v))
+    return [c / n for c in v]
+
+
+def gltf(positions, normals, faces, albedo, light_pos, camera_node, name):
+    pos = b"".join(struct.pack("<3f", *v) for v in positions)
+    nrm = b"".join(struct.pack("<3f", *v) for v in normals)
+    idx = b"".join(struct.pack("<3I", *f) for f in faces)
+    data = pos + nrm + idx
+    lo = [min(v[k] for v in positions) for k in range(3)]
+    hi = [max(v[k] for v in positions) for k in range(3)]
+    return {
+        "asset": {"version": "2.0", "generator": "qsgi scripts/make_test_scenes.py"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1, 1, 1], "intensity": 1.0}]}},
+        "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [{"name": name, "mesh": 0},
+                  {"name": "Light", "translation": light_pos, "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                  dict(camera_node, camera=0, name="Camera")],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "aspectRatio": 4 / 3, "znear": 0.01}}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": albedo + [1], "metallicFactor": 0}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}]}],
+        "buffers": [{"byteLength": len(data),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(pos)},
+                        {"buffer": 0, "byteOffset": len(pos), "byteLength": len(nrm)},
+                        {"buffer": 0, "byteOffset": len(pos) + len(nrm), "byteLength": len(idx)}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(positions), "type": "VEC3", "min": lo, "max": hi},
+                      {"bufferView": 1, "componentType": 5126, "count": len(normals), "type": "VEC3"},
+                      {"bufferView": 2, "componentType": 5125, "count": 3 * len(faces), "type": "SCALAR"}],
+    }
+
+
+def main():
+    folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "tests", "scenes")
+    os.makedirs(folder, exist_ok=True)
+    p, f = icosphere(5)
+    inward = [(a, c, b) for a, b, c in f]  # reversed winding: the front side faces the centre
+    sphere = gltf(p, [[-c for c in v] for v in p], inward, [0.5, 0.5, 0.5], [0, 0, 0],
+                  {"translation": [0, 0, 0.3]}, "Sphere")
+    cells, half = 96, 1.6
+    pos, faces = [], []
+    for j in range(cells + 1):
+        for i in range(cells + 1):
+            pos.append([-half + 2 * half * i / cells, 0, half - 2 * half * j / cells])
+    row = cells + 1
+    for j in range(cells):
+        for i in range(cells):
+            a = j * row + i
+            faces += [(a, a + 1, a + row + 1), (a, a + row + 1, a + row)]
+    # Camera 3 m out and 2 m up, pitched down to look at the plane's centre.
+    pitch = -math.atan2(2.0, 3.0)
+    plane = gltf(pos, [[0, 1, 0]] * len(pos), faces, [0.5, 0.5, 0.5], [0, 1, 0],
+                 {"translation": [0, 2, 3], "rotation": [math.sin(pitch / 2), 0, 0, math.cos(pitch / 2)]}, "Plane")
+    for name, doc in (("sphere_point_light", sphere), ("plane_point_light", plane)):
+        with open(os.path.join(folder, name + ".gltf"), "w") as out:
+            json.dump(doc, out)
+            out.write("\n")
+
+
+if __name__ == "__main__":
+    main()
