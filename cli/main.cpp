@@ -17,10 +17,12 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 1;
 
 struct CliOptions {
-    std::string config, animation, estimator, frames, out;
+    std::string config, animation, estimator, detpIndex, frames, out;
     // Unset options leave the config's (or the default) value alone.
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
-    std::optional<double> exposure;
+    std::optional<double> exposure, radius;
+    std::optional<int64_t> k;
+    bool noRayCache = false, noSortQueries = false;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false;
 };
 
@@ -30,7 +32,15 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (!o.config.empty()) qsgi::applyConfigFile(o.config, s);
     if (!scene.empty()) s.scenePath = scene;
     if (!o.animation.empty()) s.animationPath = o.animation;
-    if (!o.estimator.empty()) s.estimator = qsgi::parseEstimator(o.estimator, "command line");
+    if (!o.estimator.empty()) s.estimator.kind = qsgi::parseEstimator(o.estimator, "command line");
+    if (!o.detpIndex.empty()) s.estimator.detpIndex = qsgi::parseDetpIndex(o.detpIndex, "command line");
+    if (o.radius) {
+        s.estimator.radius = float(*o.radius);
+        s.radiusGiven = true;
+    }
+    if (o.k) s.estimator.k = int(std::clamp<int64_t>(*o.k, -1, 1 << 24));
+    if (o.noRayCache) s.estimator.useIndex = false;
+    if (o.noSortQueries) s.estimator.sortQueries = false;
     if (!o.frames.empty()) s.frames = qsgi::parseFrameRange(o.frames, "command line");
     if (!o.out.empty()) s.outDir = o.out;
     if (o.photons) {
@@ -73,7 +83,12 @@ int main(int argc, char** argv) {
     render->add_option("SCENE", scene, "glTF 2.0 scene (.gltf or .glb); may come from --config instead");
     render->add_option("--config", o.config, "JSON config with the same keys (configs/default.json); options override it");
     render->add_option("--animation", o.animation, "qsgi-animation transform file (JSON)");
-    render->add_option("--estimator", o.estimator, "density estimator: impact-count");
+    render->add_option("--estimator", o.estimator, "density estimator: detp, photon-map or impact-count (default)");
+    render->add_option("--radius", o.radius, "DETP disc / photon-map search radius, scene units (default 1.5 % of the scene diagonal)");
+    render->add_option("--k", o.k, "photon map: nearest impacts per vertex (default 50)");
+    render->add_option("--detp-index", o.detpIndex, "DETP index: embree (exact, default) or flann (approximate candidates)");
+    render->add_flag("--no-ray-cache", o.noRayCache, "density estimation without any spatial index (brute force)");
+    render->add_flag("--no-sort-queries", o.noSortQueries, "queries in input order instead of Morton order");
     render->add_option("--photons", o.photons, "photons traced per frame (default 1000000)");
     render->add_option("--seed", o.seed, "random seed (default 1); same seed, same bytes");
     render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");

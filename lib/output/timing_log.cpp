@@ -24,8 +24,12 @@ void TimingLog::write(const std::filesystem::path& path) const {
     using nlohmann::json;
     json j;
     j["version"] = QSGI_VERSION;
-    j["config"] = {{"estimator", estimator}, {"photons", photons}, {"radius", nullptr}, {"k", nullptr},
-                   {"ray_cache", true}, {"sort_queries", true}, {"full_recompute", fullRecompute},
+    const bool hasRadius = estimator != "impact-count";
+    j["config"] = {{"estimator", estimator}, {"photons", photons},
+                   {"radius", hasRadius ? nlohmann::json(radius) : nlohmann::json(nullptr)},
+                   {"k", estimator == "photon-map" ? nlohmann::json(k) : nlohmann::json(nullptr)},
+                   {"detp_index", estimator == "detp" ? nlohmann::json(detpIndex) : nlohmann::json(nullptr)},
+                   {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute},
                    {"seed", seed}, {"threads", threads}};
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},

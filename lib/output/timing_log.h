@@ -24,6 +24,10 @@ struct FrameTiming {
 struct TimingLog {
     // config
     std::string estimator;
+    float radius = 0;
+    int k = 0;
+    bool rayCache = true, sortQueries = true;
+    std::string detpIndex;
     uint64_t photons = 0, seed = 0;
     int threads = 0;
     bool fullRecompute = true;

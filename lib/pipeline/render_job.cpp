@@ -9,6 +9,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "estimate/estimator.h"
 #include "estimate/impact_count.h"
 #include "output/image_files.h"
 #include "output/ply_writer.h"
@@ -84,6 +85,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     scene_.markDynamic(animation_.movedNodes());
 
     camera_ = resolveCamera(settings_, scene_, warnings);
+    if (!settings_.radiusGiven) settings_.estimator.radius = defaultRadius(scene_);
 
     first_ = 0;
     last_ = animation_.lastFrame();
@@ -117,7 +119,13 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     }
 
     TimingLog log;
-    log.estimator = estimatorName(settings_.estimator);
+    log.estimator = estimatorName(settings_.estimator.kind);
+    log.radius = settings_.estimator.radius;
+    log.k = settings_.estimator.k;
+    log.rayCache = settings_.estimator.useIndex;
+    log.sortQueries = settings_.estimator.sortQueries;
+    log.detpIndex = settings_.estimator.detpIndex == DetpIndex::Flann ? "flann" : "embree";
+    log.degenerateTriangles = ImpactCount(scene_).degenerateTriangles();
     log.photons = settings_.photons;
     log.seed = settings_.seed;
     log.threads = settings_.threads > 0 ? settings_.threads
@@ -133,12 +141,14 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     std::optional<float> exposure;  // fixed at the first frame so previews do not flicker
     auto imageMetadata = [&](int frame) {
         ImageMetadata m;
-        m.strings = {{"qsgi:estimator", estimatorName(settings_.estimator)}, {"qsgi:version", QSGI_VERSION},
+        m.strings = {{"qsgi:estimator", estimatorName(settings_.estimator.kind)}, {"qsgi:version", QSGI_VERSION},
                      {"qsgi:scene", settings_.scenePath},
                      {"qsgi:seed", std::to_string(settings_.seed)}, {"Software", std::string("qsgi ") + QSGI_VERSION}};
         m.ints = {{"qsgi:frame", frame}, {"qsgi:photons", int(std::min<uint64_t>(settings_.photons, INT32_MAX))},
                   {"qsgi:spp", settings_.samplesPerPixel}};
-        m.floats = {{"qsgi:radius", 0.0f}};  // 0: the estimator has no radius (impact count)
+        // 0: the estimator has no radius (impact count)
+        m.floats = {{"qsgi:radius", settings_.estimator.kind == EstimatorKind::ImpactCount ? 0.0f : settings_.estimator.radius}};
+        m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.k : 0);
         return m;
     };
     const int count = last_ - first_ + 1;
@@ -161,12 +171,9 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         timing.segmentsAdded = cache.segments.size();
 
         clock.restart();
-        ImpactCount estimator(scene_);
-        estimator.accumulate(cache);
-        const VertexRadiosity result = estimator.estimate(scene_, PowerQuantizer(cache.maxPhotonPower));
+        const VertexRadiosity result = estimateVertexRadiosity(scene_, cache, settings_.estimator, device);
         timing.estimationSeconds = clock.seconds();
         timing.verticesUpdated = scene_.vertexCount();
-        log.degenerateTriangles = estimator.degenerateTriangles();
 
         std::optional<RgbImage> image;
         if (settings_.writeExr || settings_.writePng) {

@@ -15,15 +15,18 @@ using nlohmann::json;
 
 EstimatorKind parseEstimator(const std::string& name, const std::string& source) {
     if (name == "impact-count") return EstimatorKind::ImpactCount;
-    throw InputError(source, "estimator", "unknown estimator '" + name + "' (available: impact-count)");
+    if (name == "photon-map") return EstimatorKind::PhotonMap;
+    if (name == "detp") return EstimatorKind::Detp;
+    throw InputError(source, "estimator", "unknown estimator '" + name + "' (available: detp, photon-map, impact-count)");
 }
 
-const char* estimatorName(EstimatorKind kind) {
-    switch (kind) {
-        case EstimatorKind::ImpactCount: return "impact-count";
-    }
-    return "?";
+DetpIndex parseDetpIndex(const std::string& name, const std::string& source) {
+    if (name == "embree") return DetpIndex::Embree;
+    if (name == "flann") return DetpIndex::Flann;
+    throw InputError(source, "detp_index", "unknown DETP index '" + name + "' (embree: exact, flann: approximate)");
 }
+
+float defaultRadius(const Scene& scene) { return 0.015f * std::max(scene.bounds().extent(), 1e-6f); }
 
 FrameRange parseFrameRange(const std::string& text, const std::string& source) {
     auto parseInt = [&](const std::string& s) {
@@ -115,7 +118,17 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
         if (key == "scene") s.scenePath = resolve(str());
         else if (key == "animation") s.animationPath = resolve(str());
         else if (key == "out") s.outDir = str();
-        else if (key == "estimator") s.estimator = parseEstimator(str(), path);
+        else if (key == "estimator") s.estimator.kind = parseEstimator(str(), path);
+        else if (key == "radius") {
+            if (!v.is_number() || !(v.get<double>() > 0) || !std::isfinite(v.get<double>()))
+                throw InputError(path, key, "must be a positive number (scene units)");
+            s.estimator.radius = v.get<float>();
+            s.radiusGiven = true;
+        } else if (key == "k") s.estimator.k = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 24));
+        else if (key == "ray_cache" || key == "sort_queries") {
+            if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
+            (key == "ray_cache" ? s.estimator.useIndex : s.estimator.sortQueries) = v.get<bool>();
+        } else if (key == "detp_index") s.estimator.detpIndex = parseDetpIndex(str(), path);
         else if (key == "photons") s.photons = positiveInteger(v, path, key);
         else if (key == "seed") {
             if (!v.is_number_integer() || v.get<int64_t>() < 0) throw InputError(path, key, "must be a non-negative integer");
@@ -175,6 +188,9 @@ void validateSettings(const RenderSettings& s) {
     if (s.photons == 0) throw InputError("command line", "--photons", "must be a positive integer");
     if (s.photons > (uint64_t(1) << 32)) throw InputError("command line", "--photons", "at most 2^32 photons are supported");
     if (s.maxBounces == 0) throw InputError("command line", "max_bounces", "must be positive");
+    if (s.radiusGiven && !(s.estimator.radius > 0 && std::isfinite(s.estimator.radius)))
+        throw InputError("command line", "--radius", "must be a positive number (scene units)");
+    if (s.estimator.k <= 0) throw InputError("command line", "--k", "must be a positive integer");
     constexpr int kMaxImageSide = 16384;
     if (s.width <= 0 || s.height <= 0 || s.width > kMaxImageSide || s.height > kMaxImageSide)
         throw InputError("command line", "--width/--height",

@@ -7,11 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "estimate/estimator.h"
 #include "scene/scene.h"
 
 namespace qsgi {
-
-enum class EstimatorKind { ImpactCount };
 
 struct FrameRange {
     int first = 0;
@@ -23,7 +22,8 @@ struct RenderSettings {
     std::string scenePath;
     std::string animationPath;  // empty: no animation (one frame, 0)
     std::string outDir = "out";
-    EstimatorKind estimator = EstimatorKind::ImpactCount;
+    EstimatorSettings estimator;     // radius 0 here: chosen from the scene (defaultRadius)
+    bool radiusGiven = false;
     uint64_t photons = 1000000;
     uint64_t seed = 1;
     uint32_t maxBounces = 32;
@@ -50,7 +50,10 @@ void applyConfigFile(const std::string& path, RenderSettings& settings);
 // Parses "A:B" (inclusive, as in Blender) or "A". Throws InputError naming `source`.
 FrameRange parseFrameRange(const std::string& text, const std::string& source);
 EstimatorKind parseEstimator(const std::string& name, const std::string& source);
-const char* estimatorName(EstimatorKind kind);
+DetpIndex parseDetpIndex(const std::string& name, const std::string& source);
+
+// 1.5 % of the scene's bounding-box diagonal: a radius that means the same in any unit.
+float defaultRadius(const Scene& scene);
 
 // Checks values that no parser can (photons > 0, …). Throws InputError naming the option.
 void validateSettings(const RenderSettings& settings);

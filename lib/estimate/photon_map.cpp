@@ -1,0 +1,77 @@
+#include "estimate/photon_map.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace qsgi {
+
+PhotonMap::PhotonMap(const RayCache& cache) : cache_(cache), index_(cache), quantizer_(cache.maxPhotonPower) {}
+
+Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, float radius, int k) const {
+    const size_t used = std::min(sortedFront.size(), size_t(k));
+    if (used == 0) return Vec3f(0.0f);
+    PowerSum sum;
+    for (size_t i = 0; i < used; ++i) sum.add(segmentOf(sortedFront[i].impact).power, quantizer_);
+    const double rk = used == size_t(k) ? std::sqrt(double(sortedFront[used - 1].distanceSquared)) : double(radius);
+    // k coincident impacts at the vertex would give r_k = 0; take the search radius instead of
+    // an infinite density.
+    const double r = rk > 0 ? rk : double(radius);
+    return Vec3f(sum.watts(quantizer_) / (M_PI * r * r));
+}
+
+std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, float radius, int k, const std::vector<uint32_t>& order) const {
+    std::vector<Vec3f> out(scene.vertexCount(), Vec3f(0.0f));
+    if (index_.size() == 0 || k <= 0) return out;
+    const float radiusSquared = radius * radius;
+    const size_t n = index_.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<size_t> indices;
+        std::vector<float> d2;
+        std::vector<Neighbour> front;
+        for (size_t q = r.begin(); q != r.end(); ++q) {
+            const uint32_t v = order[q];
+            const Vec3f& normal = scene.normals[v];
+            // Back-facing impacts do not count, so ask the tree for more neighbours until k
+            // front-facing ones are found or the candidates run past the radius.
+            size_t want = std::min(n, size_t(2 * k));
+            while (true) {
+                index_.nearest(scene.positions[v], want, indices, d2);
+                front.clear();
+                for (size_t i = 0; i < want; ++i)
+                    if (d2[i] <= radiusSquared && dot(segmentOf(uint32_t(indices[i])).direction, normal) < 0)
+                        front.push_back({d2[i], uint32_t(indices[i])});
+                if (front.size() >= size_t(k) || want == n || d2[want - 1] > radiusSquared) break;
+                want = std::min(n, want * 4);
+            }
+            std::sort(front.begin(), front.end());
+            out[v] = estimate(front, radius, k);
+        }
+    });
+    return out;
+}
+
+std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, float radius, int k) const {
+    std::vector<Vec3f> out(scene.vertexCount(), Vec3f(0.0f));
+    if (k <= 0) return out;
+    const float radiusSquared = radius * radius;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, scene.vertexCount(), 16), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<Neighbour> front;
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            front.clear();
+            for (size_t i = 0; i < index_.size(); ++i) {
+                const float d2 = ImpactIndex::distanceSquared(scene.positions[v], index_.point(i));
+                if (d2 <= radiusSquared && dot(segmentOf(uint32_t(i)).direction, scene.normals[v]) < 0)
+                    front.push_back({d2, uint32_t(i)});
+            }
+            const size_t keep = std::min(front.size(), size_t(k));
+            std::partial_sort(front.begin(), front.begin() + keep, front.end());
+            front.resize(keep);
+            out[v] = estimate(front, radius, k);
+        }
+    });
+    return out;
+}
+
+}  // namespace qsgi
