@@ -126,6 +126,32 @@ Scene closedBox(int cells) {
     return s;
 }
 
+Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    const int floor = s.addNode("Floor", Transform());
+    addGrid(s, floor, {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, floorCells, m);
+    const int cube = s.addNode("Cube", Transform());
+    const float h = 0.3f;
+    addGrid(s, cube, {-h, 0, h}, {2 * h, 0, 0}, {0, 2 * h, 0}, cubeCells, m);        // +z
+    addGrid(s, cube, {h, 0, -h}, {-2 * h, 0, 0}, {0, 2 * h, 0}, cubeCells, m);       // -z
+    addGrid(s, cube, {h, 0, h}, {0, 0, -2 * h}, {0, 2 * h, 0}, cubeCells, m);        // +x
+    addGrid(s, cube, {-h, 0, -h}, {0, 0, 2 * h}, {0, 2 * h, 0}, cubeCells, m);       // -x
+    addGrid(s, cube, {-h, 2 * h, h}, {2 * h, 0, 0}, {0, 0, -2 * h}, cubeCells, m);   // top
+    s.finalize();
+    return s;
+}
+
+Scene corner(int cells, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    const int node = s.addNode("Corner", Transform());
+    addGrid(s, node, {-1, 0, 2}, {2, 0, 0}, {0, 0, -2}, cells, m);  // floor, +y
+    addGrid(s, node, {-1, 0, 0}, {2, 0, 0}, {0, 2, 0}, cells, m);   // wall, +z
+    s.finalize();
+    return s;
+}
+
 void addPointLight(Scene& s, Vec3f position, Vec3f intensity) {
     PunctualLight l;
     l.name = "test point light";

@@ -22,6 +22,10 @@ qsgi::Scene closedSphere(float radius, int subdivisions, qsgi::Vec3f albedo, boo
 qsgi::Scene plane(float halfSize, int cells, qsgi::Vec3f albedo);
 // A closed box [-1,1]^3 with coloured walls facing inward.
 qsgi::Scene closedBox(int cells);
+// A 4x4 m floor (y = 0) with a 0.6 m cube on it: the cube's convex edges make silhouettes.
+qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo);
+// An inside corner: floor y = 0 (x in [-1,1], z in [0,2]) and wall z = 0 (x in [-1,1], y in [0,2]).
+qsgi::Scene corner(int cells, qsgi::Vec3f albedo);
 void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
 // Writes a small glTF (a quad; emissive if lit) with an embedded buffer.
 void writeQuadGltf(const std::string& path, bool lit);

@@ -10,14 +10,18 @@ namespace qsgi {
 PhotonMap::PhotonMap(const RayCache& cache) : cache_(cache), index_(cache), quantizer_(cache.maxPhotonPower) {}
 
 Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, float radius, int k) const {
-    const size_t used = std::min(sortedFront.size(), size_t(k));
-    if (used == 0) return Vec3f(0.0f);
+    const size_t found = std::min(sortedFront.size(), size_t(k));
+    if (found == 0) return Vec3f(0.0f);
+    // With k neighbours, the k-th only marks the radius r_k: it lies on the disc's rim, and
+    // counting it biases the estimate by k/(k−1) for a uniform density (E[(k−1)/(π r_k²)] = λ).
+    // So the k−1 inside are summed. With fewer than k inside `radius`, the disc is the search
+    // disc itself, and every impact in it counts.
+    const bool full = found == size_t(k) && k > 1;
+    const size_t summed = full ? found - 1 : found;
     PowerSum sum;
-    for (size_t i = 0; i < used; ++i) sum.add(segmentOf(sortedFront[i].impact).power, quantizer_);
-    const double rk = used == size_t(k) ? std::sqrt(double(sortedFront[used - 1].distanceSquared)) : double(radius);
-    // k coincident impacts at the vertex would give r_k = 0; take the search radius instead of
-    // an infinite density.
-    const double r = rk > 0 ? rk : double(radius);
+    for (size_t i = 0; i < summed; ++i) sum.add(segmentOf(sortedFront[i].impact).power, quantizer_);
+    double r = full ? std::sqrt(double(sortedFront[found - 1].distanceSquared)) : double(radius);
+    if (!(r > 0)) r = double(radius);  // k coincident impacts: no finite density to report
     return Vec3f(sum.watts(quantizer_) / (M_PI * r * r));
 }
 

@@ -1,6 +1,7 @@
-// Photon map (DESIGN §5): E_v = Σ Φ_s / (π r_k²) over the k nearest impacts h_s to vertex v that
-// arrive from the front (d_s · n_v < 0), searched within `radius`; r_k is the distance to the
-// k-th, or `radius` if fewer were found. The ImpactIndex kd-tree answers the queries;
+// Photon map (DESIGN §5): the k nearest impacts h_s to vertex v that arrive from the front
+// (d_s · n_v < 0), searched within `radius`; r_k is the distance to the k-th. E_v = Σ Φ_s / (π r_k²)
+// over the k−1 impacts strictly inside r_k (DESIGN sums all k, which overestimates by k/(k−1);
+// see estimate()), or over all impacts within `radius` / (π radius²) if fewer than k were found. The ImpactIndex kd-tree answers the queries;
 // bruteForce() is the index-free reference that must give the same answers.
 #pragma once
 
