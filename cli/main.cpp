@@ -7,6 +7,12 @@
 #include <optional>
 #include <iostream>
 
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
+#include "estimate/accuracy.h"
+#include "output/ply_reader.h"
 #include "pipeline/render_job.h"
 #include "util/error.h"
 #include "util/progress.h"
@@ -70,6 +76,36 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     return s;
 }
 
+// `qsgi compare`: reads both PLYs and prints the accuracy report.
+int runCompare(const std::string& a, const std::string& b, double borderDistance, bool json) {
+    const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(a);
+    const qsgi::VertexRadiosityPly reference = qsgi::readVertexRadiosityPly(b);
+    if (solution.positions.size() != reference.positions.size())
+        throw qsgi::InputError(a, "", "has " + std::to_string(solution.positions.size()) + " vertices but " + b + " has " +
+                                          std::to_string(reference.positions.size()) + ": not the same scene");
+    if (!(borderDistance >= 0) || !std::isfinite(borderDistance))
+        throw qsgi::InputError("command line", "--border", "must be a non-negative distance");
+    const qsgi::AccuracyReport r = qsgi::compareSolutions(reference.positions, reference.normals, solution.radiosity,
+                                                          reference.radiosity, float(borderDistance));
+    if (json) {
+        auto stats = [](const qsgi::ErrorStats& s) {
+            return nlohmann::json{{"vertices", s.vertices}, {"relative_rms", s.relativeRms}, {"relative_bias", s.relativeBias}};
+        };
+        nlohmann::json j{{"solution", a}, {"reference", b}, {"all", stats(r.all)}};
+        if (borderDistance > 0) j["border"] = stats(r.border), j["border_distance"] = borderDistance;
+        std::printf("%s\n", j.dump(2).c_str());
+        return 0;
+    }
+    std::printf("%-28s %10s %14s %14s\n", "vertices", "count", "relative RMS", "relative bias");
+    std::printf("%-28s %10zu %14.5f %+14.5f\n", "all", r.all.vertices, r.all.relativeRms, r.all.relativeBias);
+    if (borderDistance > 0) {
+        char label[64];
+        std::snprintf(label, sizeof label, "within %g of a crease", borderDistance);
+        std::printf("%-28s %10zu %14.5f %+14.5f\n", label, r.border.vertices, r.border.relativeRms, r.border.relativeBias);
+    }
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -105,11 +141,29 @@ int main(int argc, char** argv) {
     render->add_flag("--quiet", o.quiet, "print nothing but errors");
     render->add_flag("--verbose", o.verbose, "print per-frame timings");
 
+    std::string compareA, compareB;
+    double borderDistance = 0;
+    bool compareJson = false;
+    CLI::App* compare = app.add_subcommand("compare", "accuracy of one frame_NNNN.ply against a reference PLY of the same scene");
+    compare->add_option("PLY", compareA, "the solution to judge")->required();
+    compare->add_option("REFERENCE", compareB, "the reference (e.g. the same estimator at many more photons)")->required();
+    compare->add_option("--border", borderDistance, "also report vertices within this distance of a crease (scene units)");
+    compare->add_flag("--json", compareJson, "print JSON instead of a table");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         const int code = app.exit(e);
         return code == 0 ? 0 : kExitBadInput;
+    }
+
+    if (compare->parsed()) {
+        try {
+            return runCompare(compareA, compareB, borderDistance, compareJson);
+        } catch (const qsgi::InputError& e) {
+            std::fprintf(stderr, "qsgi: error: %s\n", e.what());
+            return kExitBadInput;
+        }
     }
 
     try {

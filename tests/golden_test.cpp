@@ -30,6 +30,9 @@ struct GoldenCase {
     int frame;
 };
 
+// Test names show the case's name, not its bytes.
+void PrintTo(const GoldenCase& c, std::ostream* os) { *os << c.name; }
+
 std::vector<GoldenCase> goldenCases() {
     const std::string cornell = (sourceDir() / "data/cornell/cornell.gltf").string();
     const std::string animation = (sourceDir() / "data/cornell/animation.json").string();

@@ -65,7 +65,7 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, float radius, int k
         for (size_t v = r.begin(); v != r.end(); ++v) {
             front.clear();
             for (size_t i = 0; i < index_.size(); ++i) {
-                const float d2 = ImpactIndex::distanceSquared(scene.positions[v], index_.point(i));
+                const float d2 = PointIndex::distanceSquared(scene.positions[v], index_.point(i));
                 if (d2 <= radiusSquared && dot(segmentOf(uint32_t(i)).direction, scene.normals[v]) < 0)
                     front.push_back({d2, uint32_t(i)});
             }

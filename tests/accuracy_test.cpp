@@ -1,0 +1,65 @@
+// The accuracy tooling: error statistics, border vertices, and `qsgi compare` end to end.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "estimate/accuracy.h"
+#include "estimate/impact_count.h"
+#include "output/ply_reader.h"
+#include "output/ply_writer.h"
+#include "test_support.h"
+
+using namespace qsgi;
+namespace fs = std::filesystem;
+
+TEST(Accuracy, ErrorStatsOfAKnownDifference) {
+    const std::vector<Vec3f> reference(100, Vec3f(2.0f));
+    std::vector<Vec3f> values(100, Vec3f(2.0f));
+    for (size_t v = 0; v < 100; ++v) values[v] = Vec3f(v % 2 ? 2.2f : 1.8f);  // ±10 %, no bias
+    const ErrorStats s = errorStats(values, reference);
+    EXPECT_EQ(s.vertices, 100u);
+    EXPECT_NEAR(s.relativeRms, 0.1, 1e-6);
+    EXPECT_NEAR(s.relativeBias, 0.0, 1e-6);
+    const ErrorStats biased = errorStats(std::vector<Vec3f>(100, Vec3f(2.1f)), reference);
+    EXPECT_NEAR(biased.relativeBias, 0.05, 1e-6);
+    EXPECT_NEAR(biased.relativeRms, 0.05, 1e-6);
+}
+
+TEST(Accuracy, BorderVerticesAreThoseNearTheCrease) {
+    const Scene corner = testscenes::corner(20, Vec3f(0.5f));  // 0.1 m spacing, crease along z = y = 0
+    const auto near = verticesNearCreases(corner.positions, corner.normals, 0.15f);
+    for (size_t v = 0; v < corner.vertexCount(); ++v) {
+        const Vec3d p = Vec3d(corner.positions[v]) + corner.worldOrigin;
+        const double distance = corner.normals[v].y > 0.5f ? p.z : p.y;
+        EXPECT_EQ(near[v], distance <= 0.15 + 1e-6) << "vertex " << v << " at distance " << distance;
+    }
+}
+
+TEST(Accuracy, CompareCommandReadsPlysAndRejectsMismatches) {
+    const fs::path dir = testScratchDir("compare");
+    Scene scene = testscenes::plane(1.0f, 10, Vec3f(0.5f));
+    VertexRadiosity a, b;
+    a.radiosity.assign(scene.vertexCount(), Vec3f(1.0f));
+    b.radiosity.assign(scene.vertexCount(), Vec3f(1.1f));
+    writeVertexRadiosityPly(dir / "a.ply", scene, a, PreviewTonemap{});
+    writeVertexRadiosityPly(dir / "b.ply", scene, b, PreviewTonemap{});
+    const VertexRadiosityPly back = readVertexRadiosityPly((dir / "b.ply").string());
+    ASSERT_EQ(back.radiosity.size(), scene.vertexCount());
+    EXPECT_EQ(back.radiosity[5], Vec3f(1.1f));
+    EXPECT_EQ(back.normals[5], scene.normals[5]);
+
+    const CommandResult r = runQsgi("compare " + (dir / "b.ply").string() + " " + (dir / "a.ply").string() + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("\"relative_bias\": 0.1"), std::string::npos) << r.output;
+
+    Scene other = testscenes::plane(1.0f, 4, Vec3f(0.5f));
+    VertexRadiosity c;
+    c.radiosity.assign(other.vertexCount(), Vec3f(1.0f));
+    writeVertexRadiosityPly(dir / "c.ply", other, c, PreviewTonemap{});
+    const CommandResult mismatch = runQsgi("compare " + (dir / "c.ply").string() + " " + (dir / "a.ply").string());
+    EXPECT_EQ(mismatch.exitCode, 2);
+    EXPECT_NE(mismatch.output.find("not the same scene"), std::string::npos) << mismatch.output;
+    const CommandResult notPly = runQsgi("compare " + (sourceDir() / "README.md").string() + " " + (dir / "a.ply").string());
+    EXPECT_EQ(notPly.exitCode, 2);
+    EXPECT_NE(notPly.output.find("not a PLY"), std::string::npos) << notPly.output;
+}
