@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Builds and runs the estimator benchmarks on data/cornell; writes out/bench/estimators.json and
+# prints a table. Repetitions give medians on a noisy machine: BENCH_REPS=3 by default.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
+cmake --build build --target qsgi_bench
+mkdir -p out/bench
+./build/bench/qsgi_bench --benchmark_repetitions="${BENCH_REPS:-3}" --benchmark_report_aggregates_only=true \
+  --benchmark_out=out/bench/estimators.json --benchmark_out_format=json "$@"
