@@ -172,12 +172,11 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
 }
 
 std::vector<uint32_t> segmentMortonOrder(const RayCache& cache) {
-    std::vector<Vec3f> midpoints(cache.segments.size());
-    for (size_t i = 0; i < cache.segments.size(); ++i) {
-        const Segment& s = cache.segments[i];
-        midpoints[i] = s.origin + s.direction * (0.5f * s.length);
-    }
-    return mortonOrder(midpoints);
+    // Most discs a segment crosses sit around its end (the surface it hits), so segments are
+    // ordered by where they end.
+    std::vector<Vec3f> ends(cache.segments.size());
+    for (size_t i = 0; i < cache.segments.size(); ++i) ends[i] = cache.segments[i].impactPoint();
+    return mortonOrder(ends);
 }
 
 }  // namespace qsgi

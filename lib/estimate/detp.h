@@ -49,7 +49,7 @@ constexpr float kFlannCandidateMargin = 0.25f;
 std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius,
                                        const std::vector<uint32_t>& vertexOrder);
 
-// Segment order for coherent tracing: Morton order of the segments' midpoints.
+// Segment order for coherent tracing: Morton order of the segments' end points.
 std::vector<uint32_t> segmentMortonOrder(const RayCache& cache);
 
 }  // namespace qsgi

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <numeric>
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 namespace qsgi {
 
 namespace {
@@ -30,11 +33,14 @@ std::vector<uint32_t> mortonOrder(const std::vector<Vec3f>& points) {
     const Vec3f size = b.diagonal();
     const float scale = maxComponent(size) > 0 ? float((1 << 21) - 1) / maxComponent(size) : 0.0f;
     std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());
-    for (size_t i = 0; i < points.size(); ++i) {
-        const Vec3f q = (points[i] - b.lower) * scale;
-        keyed[i] = {spreadBits(uint64_t(q.x)) | spreadBits(uint64_t(q.y)) << 1 | spreadBits(uint64_t(q.z)) << 2, uint32_t(i)};
-    }
-    std::sort(keyed.begin(), keyed.end());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3f q = (points[i] - b.lower) * scale;
+            keyed[i] = {spreadBits(uint64_t(q.x)) | spreadBits(uint64_t(q.y)) << 1 | spreadBits(uint64_t(q.z)) << 2, uint32_t(i)};
+        }
+    });
+    // (key, index) pairs are unique, so the parallel sort's result does not depend on scheduling.
+    tbb::parallel_sort(keyed.begin(), keyed.end());
     std::vector<uint32_t> order(points.size());
     for (size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
     return order;
