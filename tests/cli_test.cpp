@@ -165,3 +165,25 @@ TEST(Cli, AnInterruptedRunNeverLeavesATruncatedExr) {
     }
     EXPECT_GT(complete, 0) << "the run should have finished some frames within a second";
 }
+
+// Every estimator end to end: PLY, EXR with the estimator and radius in its metadata, and the
+// same choices recorded in timing.json.
+TEST(Cli, EveryEstimatorRendersEndToEnd) {
+    for (const char* estimator : {"detp", "photon-map", "impact-count"}) {
+        const fs::path out = testScratchDir(std::string("estimator_") + estimator);
+        const CommandResult r = runQsgi("render " + cornell() + " --estimator " + estimator +
+                                        " --radius 0.07 --k 30 --photons 20000 --width 80 --height 60 --out " + out.string());
+        ASSERT_EQ(r.exitCode, 0) << estimator << "\n" << r.output;
+        EXPECT_TRUE(fs::exists(out / "frame_0000.ply"));
+        const std::string info = readAll(out / "frame_0000.exr");
+        EXPECT_NE(info.find(estimator), std::string::npos) << "EXR metadata should name " << estimator;
+        const std::string timing = readAll(out / "timing.json");
+        EXPECT_NE(timing.find(std::string("\"estimator\": \"") + estimator + "\""), std::string::npos) << timing;
+        if (std::string(estimator) != "impact-count") EXPECT_NE(timing.find("\"radius\": 0.07"), std::string::npos) << timing;
+    }
+    const fs::path out = fs::path(testScratchDir("estimator_bad")) / "out";
+    expectBadInput("render " + cornell() + " --estimator magic", "magic", out);
+    expectBadInput("render " + cornell() + " --estimator detp --radius -1", "--radius", out);
+    expectBadInput("render " + cornell() + " --estimator detp --detp-index octree", "octree", out);
+    expectBadInput("render " + cornell() + " --estimator photon-map --k 0", "--k", out);
+}
