@@ -172,6 +172,10 @@ int main(int argc, char** argv) {
         if (!o.quiet)
             for (const auto& w : warnings.messages) std::fprintf(stderr, "qsgi: warning: %s\n", w.c_str());
         job.run([&](const qsgi::FrameReport& r) {
+            // Lights far from the geometry waste photons; say so once, with the number.
+            if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet)
+                std::fprintf(stderr, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate rests on the rest "
+                             "(move lights closer or add photons)\n", 100 * r.missedFraction);
             if (o.verbose) std::fprintf(stderr, "qsgi: frame %d (%d/%d) %.3f s\n", r.frame, r.index + 1, r.count, r.seconds);
         });
         return 0;

@@ -103,7 +103,10 @@ TEST(Cli, BadInputGivesOneClearMessageExitCodeTwoAndWritesNothing) {
 
     testscenes::writeQuadGltf((dir / "lit.gltf").string(), true);
     const std::string lit = (dir / "lit.gltf").string();
-    ASSERT_EQ(runQsgi("render " + lit + " --photons 100 --out " + (dir / "ok").string()).exitCode, 0);
+    const CommandResult ok = runQsgi("render " + lit + " --photons 100 --out " + (dir / "ok").string());
+    ASSERT_EQ(ok.exitCode, 0) << ok.output;
+    // A lone emitting quad sends every photon into the void: the user is told.
+    EXPECT_NE(ok.output.find("100% of the photons hit no geometry"), std::string::npos) << ok.output;
 
     writeText(dir / "unknown.json",
               R"({"format":"qsgi-animation","version":1,"frames":[{"frame":0,"nodes":{"Nope":{"translation":[0,0,0]}}}]})");

@@ -48,7 +48,7 @@ void TimingLog::write(const std::filesystem::path& path) const {
         list.push_back({{"frame", f.frame}, {"photon_update_s", f.photonSimulationSeconds},
                         {"estimation_s", f.estimationSeconds}, {"render_s", f.renderSeconds},
                         {"write_s", f.writeSeconds},
-                        {"segments", f.segments}, {"paths_retraced", f.pathsRetraced},
+                        {"segments", f.segments}, {"photons_missing_scene", f.photonsMissingScene}, {"paths_retraced", f.pathsRetraced},
                         {"segments_removed", f.segmentsRemoved}, {"segments_added", f.segmentsAdded},
                         {"vertices_updated", f.verticesUpdated}});
     j["frames"] = list;

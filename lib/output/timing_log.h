@@ -16,6 +16,7 @@ struct FrameTiming {
     double renderSeconds = 0;            // the camera view (EXR/PNG), excluding file writing
     double writeSeconds = 0;             // PLY, EXR and PNG output
     uint64_t segments = 0;               // segments in the ray cache after this frame
+    uint64_t photonsMissingScene = 0;    // photons whose first segment hit nothing
     uint64_t pathsRetraced = 0;
     uint64_t segmentsRemoved = 0, segmentsAdded = 0;
     uint64_t verticesUpdated = 0;

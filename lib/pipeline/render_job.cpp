@@ -167,6 +167,10 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         bar.finish();
         timing.photonSimulationSeconds = clock.seconds();
         timing.segments = cache.segments.size();
+        for (uint64_t path = 0; path < cache.pathCount(); ++path) {
+            const uint64_t first = cache.pathBegin[path];
+            if (first < cache.pathBegin[path + 1] && !cache.segments[first].hasImpact()) ++timing.photonsMissingScene;
+        }
         timing.pathsRetraced = cache.pathCount();
         timing.segmentsAdded = cache.segments.size();
 
@@ -193,7 +197,9 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         }
         timing.writeSeconds = clock.seconds();
         log.frames.push_back(timing);
-        if (onFrame) onFrame(FrameReport{frame, frame - first_, count, frameClock.seconds()});
+        if (onFrame)
+            onFrame(FrameReport{frame, frame - first_, count, frameClock.seconds(),
+                                double(timing.photonsMissingScene) / double(std::max<uint64_t>(settings_.photons, 1))});
     }
     log.write(outDir / "timing.json");
 }

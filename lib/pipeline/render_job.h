@@ -17,6 +17,7 @@ struct FrameReport {
     int frame;
     int index, count;  // position in the run
     double seconds;
+    double missedFraction;  // of the photons emitted this frame, those that hit no geometry
 };
 
 class RenderJob {
