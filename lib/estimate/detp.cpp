@@ -102,12 +102,24 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
     // Start the ray a little before the segment and end it a little past t + r, so plane
     // crossings at t* ≈ 0 or t* ≈ t + r reach the exact test rather than Embree's bounds.
     const float slack = 1e-4f * radius_ + 1e-6f * std::max(1.0f, scene_.bounds().extent());
+    // A reordering is gathered into a copy first, so tracing streams through memory instead of
+    // jumping through the cache by index (which costs more than the coherence gains).
+    bool inputOrder = order.size() == cache.segments.size();
+    for (size_t i = 0; i < order.size() && inputOrder; ++i) inputOrder = order[i] == i;
+    std::vector<Segment> gathered;
+    if (!inputOrder) {
+        gathered.resize(order.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) gathered[i] = cache.segments[order[i]];
+        });
+    }
+    const Segment* ordered = inputOrder ? cache.segments.data() : gathered.data();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         VertexSums& sums = perThread.local();
         uint64_t& hits = hitCount.local();
         std::vector<uint32_t> crossed;
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            const Segment& s = cache.segments[order[i]];
+            const Segment& s = ordered[i];
             crossed.clear();
             DiscQueryContext ctx;
             rtcInitIntersectContext(&ctx.base);
