@@ -167,10 +167,7 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         bar.finish();
         timing.photonSimulationSeconds = clock.seconds();
         timing.segments = cache.segments.size();
-        for (uint64_t path = 0; path < cache.pathCount(); ++path) {
-            const uint64_t first = cache.pathBegin[path];
-            if (first < cache.pathBegin[path + 1] && !cache.segments[first].hasImpact()) ++timing.photonsMissingScene;
-        }
+        timing.photonsMissingScene = cache.pathsMissingScene();
         timing.pathsRetraced = cache.pathCount();
         timing.segmentsAdded = cache.segments.size();
 

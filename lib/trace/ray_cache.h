@@ -32,6 +32,14 @@ struct RayCache {
     float maxPhotonPower = 0;
 
     size_t pathCount() const { return pathBegin.empty() ? 0 : pathBegin.size() - 1; }
+
+    // Photons whose first segment hit nothing (lights pointing away from, or far from, the scene).
+    uint64_t pathsMissingScene() const {
+        uint64_t missed = 0;
+        for (size_t path = 0; path < pathCount(); ++path)
+            if (pathBegin[path] < pathBegin[path + 1] && !segments[pathBegin[path]].hasImpact()) ++missed;
+        return missed;
+    }
 };
 
 }  // namespace qsgi
