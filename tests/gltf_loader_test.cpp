@@ -59,13 +59,18 @@ const std::map<std::string, size_t> kExpectedTriangles = {
 // Mesh_PrimitiveMode README: points and lines (00-03, 07-10) give none; strips, fans, triangles 2.
 size_t primitiveModeTriangles(int model) { return (model <= 3 || (model >= 7 && model <= 10)) ? 0 : 2; }
 
+// ../shared sits beside the repository in CI but not in a user's clone; tests that need its
+// samples skip with this reason there.
+constexpr const char* kNoSharedSamples = "../shared/data/gltf-samples is absent (only beside the repository in CI)";
+fs::path samplesDir() { return sharedDir() / "data" / "gltf-samples"; }
+
 bool isGltf(const fs::path& p) { return p.extension() == ".gltf" || p.extension() == ".glb"; }
 
 }  // namespace
 
 TEST(GltfLoader, EveryValidAndModelSampleLoadsWithTheDocumentedTriangleCount) {
-    const auto samples = sharedDir() / "data" / "gltf-samples";
-    if (!fs::exists(samples)) GTEST_SKIP() << "../shared/data/gltf-samples is absent (only beside the repository in CI)";
+    const auto samples = samplesDir();
+    if (!fs::exists(samples)) GTEST_SKIP() << kNoSharedSamples;
     size_t checked = 0;
     for (const char* folder : {"valid", "models"}) {
         for (const auto& entry : fs::recursive_directory_iterator(samples / folder)) {
@@ -93,8 +98,8 @@ TEST(GltfLoader, EveryValidAndModelSampleLoadsWithTheDocumentedTriangleCount) {
 }
 
 TEST(GltfLoader, EveryInvalidSampleIsRejectedWithAMessageNamingTheFile) {
-    const auto samples = sharedDir() / "data" / "gltf-samples" / "invalid";
-    if (!fs::exists(samples)) GTEST_SKIP() << "../shared/data/gltf-samples is absent (only beside the repository in CI)";
+    const auto samples = samplesDir() / "invalid";
+    if (!fs::exists(samples)) GTEST_SKIP() << kNoSharedSamples;
     size_t checked = 0;
     for (const auto& entry : fs::recursive_directory_iterator(samples)) {
         if (!entry.is_regular_file() || !isGltf(entry.path())) continue;
@@ -113,8 +118,8 @@ TEST(GltfLoader, EveryInvalidSampleIsRejectedWithAMessageNamingTheFile) {
 }
 
 TEST(GltfLoader, SpecificDefectsGiveSpecificMessages) {
-    const auto samples = sharedDir() / "data" / "gltf-samples" / "invalid";
-    if (!fs::exists(samples)) GTEST_SKIP() << "../shared/data/gltf-samples is absent (only beside the repository in CI)";
+    const auto samples = samplesDir() / "invalid";
+    if (!fs::exists(samples)) GTEST_SKIP() << kNoSharedSamples;
     auto problemOf = [&](const std::string& rel) -> std::string {
         Warnings w;
         try {
@@ -132,8 +137,8 @@ TEST(GltfLoader, SpecificDefectsGiveSpecificMessages) {
 }
 
 TEST(GltfLoader, SamplesCarryTheirLightsCamerasAndEmission) {
-    const auto models = sharedDir() / "data" / "gltf-samples" / "models";
-    if (!fs::exists(models)) GTEST_SKIP() << "../shared/data/gltf-samples is absent (only beside the repository in CI)";
+    const auto models = samplesDir() / "models";
+    if (!fs::exists(models)) GTEST_SKIP() << kNoSharedSamples;
     Warnings w;
     const Scene lights = loadGltfScene((models / "PlayCanvasLights/glTF-Binary/Lights.glb").string(), w);
     int point = 0, spot = 0, directional = 0;
@@ -155,8 +160,8 @@ TEST(GltfLoader, SamplesCarryTheirLightsCamerasAndEmission) {
 }
 
 TEST(GltfLoader, NegativeScaleKeepsFrontFacesAlongTheNormals) {
-    const auto file = sharedDir() / "data/gltf-samples/models/NegativeScaleQuad/glTF-Embedded/negativeScaleQuad.gltf";
-    if (!fs::exists(file)) GTEST_SKIP() << "../shared/data/gltf-samples is absent (only beside the repository in CI)";
+    const auto file = samplesDir() / "models/NegativeScaleQuad/glTF-Embedded/negativeScaleQuad.gltf";
+    if (!fs::exists(file)) GTEST_SKIP() << kNoSharedSamples;
     Warnings w;
     const Scene s = loadGltfScene(file.string(), w);
     ASSERT_GT(s.triangleCount(), 0u);

@@ -67,12 +67,14 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
 DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius)
     : scene_(scene), radius_(radius), discs_(device) {
     const size_t n = scene.vertexCount();
+    const float extent = std::max(1.0f, scene.bounds().extent());
+    rayExtension_ = 1e-4f * radius + 1e-6f * extent;
     RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
     auto* vertex = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
     auto* normal = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
     device.checkError("allocating DETP disc buffers");
     // Enlarged discs make Embree's float test a superset of the exact one; the filter decides.
-    const float searchRadius = radius * (1 + 1e-3f) + 1e-6f * std::max(1.0f, scene.bounds().extent());
+    const float searchRadius = radius * (1 + 1e-3f) + 1e-6f * extent;
     for (size_t v = 0; v < n; ++v) {
         const Vec3f& p = scene.positions[v];
         vertex[4 * v] = p.x;
@@ -101,7 +103,7 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
     tbb::enumerable_thread_specific<uint64_t> hitCount(0);
     // Start the ray a little before the segment and end it a little past t + r, so plane
     // crossings at t* ≈ 0 or t* ≈ t + r reach the exact test rather than Embree's bounds.
-    const float slack = 1e-4f * radius_ + 1e-6f * std::max(1.0f, scene_.bounds().extent());
+    const float slack = rayExtension_;
     // A reordering is gathered into a copy first, so tracing streams through memory instead of
     // jumping through the cache by index (which costs more than the coherence gains).
     bool inputOrder = order.size() == cache.segments.size();

@@ -36,6 +36,7 @@ public:
 private:
     const Scene& scene_;
     float radius_;
+    float rayExtension_;  // lets Embree's float tests see crossings at t* ≈ 0 and t* ≈ t + r
     EmbreeScene discs_;
 };
 

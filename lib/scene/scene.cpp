@@ -114,7 +114,8 @@ int Scene::addNode(std::string name, const Transform& local, int parent) {
 
 void Scene::addInstance(int node, std::vector<Vec3f> objectPositions, std::vector<Vec3f> objectNormals,
                         const std::vector<uint32_t>& indices, uint32_t material) {
-    const Transform world = worldTransforms(restLocals())[node];
+    Transform world = nodes[node].local;  // rest pose, composed up the (acyclic) hierarchy
+    for (int p = nodes[node].parent; p >= 0; p = nodes[p].parent) world = nodes[p].local * world;
     MeshInstance inst;
     inst.node = node;
     inst.firstVertex = uint32_t(positions.size());
