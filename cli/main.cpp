@@ -23,7 +23,7 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 1;
 
 struct CliOptions {
-    std::string config, animation, estimator, detpIndex, frames, out;
+    std::string config, animation, estimator, detpIndex, detpBoundary, frames, out;
     // Unset options leave the config's (or the default) value alone.
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
     std::optional<double> exposure, radius;
@@ -40,6 +40,7 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (!o.animation.empty()) s.animationPath = o.animation;
     if (!o.estimator.empty()) s.estimator.kind = qsgi::parseEstimator(o.estimator, "command line");
     if (!o.detpIndex.empty()) s.estimator.detpIndex = qsgi::parseDetpIndex(o.detpIndex, "command line");
+    if (!o.detpBoundary.empty()) s.estimator.boundary = qsgi::parseDetpBoundary(o.detpBoundary, "command line");
     if (o.radius) {
         s.estimator.radius = float(*o.radius);
         s.radiusGiven = true;
@@ -123,6 +124,9 @@ int main(int argc, char** argv) {
     render->add_option("--radius", o.radius, "DETP disc / photon-map search radius, scene units (default 1.5 % of the scene diagonal)");
     render->add_option("--k", o.k, "photon map: nearest impacts per vertex (default 50)");
     render->add_option("--detp-index", o.detpIndex, "DETP index: embree (exact, default) or flann (approximate candidates)");
+    render->add_option("--detp-boundary", o.detpBoundary,
+                       "where discs meet other geometry: clip (default: reachable cells only, no leaks), linear (clip "
+                       "plus a first-order fit at edges) or paper (the published rule; the textbook photon map)");
     render->add_flag("--no-ray-cache", o.noRayCache, "density estimation without any spatial index (brute force)");
     render->add_flag("--no-sort-queries", o.noSortQueries, "queries in input order instead of Morton order");
     render->add_option("--photons", o.photons, "photons traced per frame (default 1000000)");

@@ -3,7 +3,13 @@
 elsewhere, a 0.5x0.5 m emissive ceiling light), finely tessellated walls, a block named "Block",
 a camera looking into the open front, and animation.json moving the block across the floor.
 
-Standard library only. Run from anywhere: python3 scripts/make_cornell.py [OUT_DIR]
+With --ceiling-panel it writes tests/scenes/ceiling_panel instead: the same box with coarser walls
+(32 cells), lit by a 0.6x0.6 m slab 2 mm thick hanging 4 mm under the ceiling and emitting from its
+underside, and no animation. It is the scene where estimators leak light through a thin occluder
+(the ceiling above the slab sees only what comes through the gap), checked against the reference
+in tests/reference/.
+
+Standard library only. Run from anywhere: python3 scripts/make_cornell.py [--ceiling-panel] [OUT_DIR]
 """
 import json
 import math
@@ -127,13 +133,24 @@ class GltfBuilder:
 
 
 def main():
-    folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "data", "cornell")
+    args = [a for a in sys.argv[1:] if a != "--ceiling-panel"]
+    panel = len(args) != len(sys.argv) - 1
+    here = os.path.dirname(__file__)
+    default = os.path.join(here, "..", "tests", "scenes", "ceiling_panel") if panel else os.path.join(here, "..", "data", "cornell")
+    folder = args[0] if args else default
     os.makedirs(folder, exist_ok=True)
+    if panel:
+        build(folder, "ceiling_panel", wall_cells=32, light="slab", animate=False)
+    else:
+        build(folder, "cornell", wall_cells=WALL_CELLS, light="panel", animate=True)
+
+
+def build(folder, stem, wall_cells, light, animate):
     g = GltfBuilder()
     white = g.material("White", WHITE)
     red = g.material("Red", RED)
     green = g.material("Green", GREEN)
-    light = g.material("Light", [0.78, 0.78, 0.78], [1.0, 1.0, 1.0], LIGHT_RADIANCE)
+    light_material = g.material("Light", [0.78, 0.78, 0.78], [1.0, 1.0, 1.0], LIGHT_RADIANCE)
     block = g.material("Block", WHITE)
 
     # Inward-facing walls of the box x in [-1,1], y in [0,2], z in [-1,1]; the front (z=+1) is open.
@@ -145,17 +162,36 @@ def main():
         ("RightWall", [1, 0, -1], [0, 0, 2], [0, 2, 0], green),
     ]
     for name, corner, u, v, mat in walls:
-        p, n, i = grid(corner, u, v, WALL_CELLS)
+        p, n, i = grid(corner, u, v, wall_cells)
         g.node({"name": name, "mesh": g.mesh(name, p, n, i, mat)})
-    # The light hangs 1 mm below the ceiling, emitting downwards.
-    p, n, i = grid([-0.25, 1.999, -0.25], [0.5, 0, 0], [0, 0, 0.5], 4)
-    g.node({"name": "Light", "mesh": g.mesh("Light", p, n, i, light)})
+    if light == "panel":
+        # The light hangs 1 mm below the ceiling, emitting downwards.
+        p, n, i = grid([-0.25, 1.999, -0.25], [0.5, 0, 0], [0, 0, 0.5], 4)
+        g.node({"name": "Light", "mesh": g.mesh("Light", p, n, i, light_material)})
+    else:
+        # A slab 2 mm thick, its top 4 mm under the ceiling: emissive underside, white elsewhere.
+        h = 0.3
+        p, n, i = grid([-h, 1.994, -h], [2 * h, 0, 0], [0, 0, 2 * h], 6)
+        g.node({"name": "Light", "mesh": g.mesh("Light", p, n, i, light_material)})
+        top, sides = [], [([-h, 1.996, h], [2 * h, 0, 0], [0, 0, -2 * h])]
+        sides += [([-h, 1.994, h], [2 * h, 0, 0], [0, 0.002, 0]), ([h, 1.994, -h], [-2 * h, 0, 0], [0, 0.002, 0]),
+                  ([h, 1.994, h], [0, 0, -2 * h], [0, 0.002, 0]), ([-h, 1.994, -h], [0, 0, 2 * h], [0, 0.002, 0])]
+        positions, normals, indices = [], [], []
+        for corner, u, v in sides:
+            p, n, i = grid(corner, u, v, 6)
+            base = len(positions)
+            positions += p
+            normals += n
+            indices += [base + k for k in i]
+        g.node({"name": "LightHousing", "mesh": g.mesh("LightHousing", positions, normals, indices, white)})
     p, n, i = box_faces([0.25, 0.3, 0.25], BLOCK_CELLS)
     g.node({"name": "Block", "mesh": g.mesh("Block", p, n, i, block), "translation": [-0.5, 0, 0.1]})
     g.doc["cameras"].append({"name": "Front", "type": "perspective",
                              "perspective": {"yfov": 0.7, "aspectRatio": 4 / 3, "znear": 0.05}})
     g.node({"name": "Camera", "camera": 0, "translation": [0, 1, 4.0]})
-    g.write(folder, "cornell")
+    g.write(folder, stem)
+    if not animate:
+        return
 
     # The block slides from x=-0.5 to x=+0.5 while turning a quarter turn.
     frames = []

@@ -24,8 +24,10 @@ RayCache trace(const Scene& scene, uint64_t photons, uint64_t seed = 11) {
 }
 
 std::vector<Vec3f> estimate(const Scene& scene, const RayCache& cache, EstimatorKind kind, float radius, int k = 50,
-                            bool useIndex = true, bool sortQueries = true, DetpIndex detpIndex = DetpIndex::Embree) {
+                            bool useIndex = true, bool sortQueries = true, DetpIndex detpIndex = DetpIndex::Embree,
+                            DetpBoundary boundary = DetpBoundary::Clip) {
     EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
     EstimatorSettings s;
     s.kind = kind;
     s.radius = radius;
@@ -33,7 +35,8 @@ std::vector<Vec3f> estimate(const Scene& scene, const RayCache& cache, Estimator
     s.useIndex = useIndex;
     s.sortQueries = sortQueries;
     s.detpIndex = detpIndex;
-    return estimateVertexRadiosity(scene, cache, s, device).irradiance;
+    s.boundary = boundary;
+    return estimateVertexRadiosity(scene, bvh, cache, s, device).irradiance;
 }
 
 float largestComponent(const std::vector<Vec3f>& values) {
@@ -72,39 +75,58 @@ Scene litBoxOnFloor() {
 }  // namespace
 
 // The Cornell walls are 2 m and its vertices 3.1 cm apart: radii from below the spacing to
-// beyond the whole box.
+// beyond the whole box. Every boundary rule, indexed (sorted and unsorted) == brute force.
 TEST(Estimators, IndexedPhotonMapAndDetpEqualBruteForce) {
     for (const auto& [name, scene] : {std::pair{std::string("cornell"), litCornell()},
                                       std::pair{std::string("box on floor"), litBoxOnFloor()}}) {
         const RayCache cache = trace(scene, 3000);
         ASSERT_GT(cache.segments.size(), 3000u);
+        EmbreeDevice device;
+        const SceneBvh bvh(device, scene);
         for (float radius : {0.01f, 0.05f, 0.3f, 3.0f}) {
-            const std::string what = name + ", r = " + std::to_string(radius);
-            const auto detp = estimate(scene, cache, EstimatorKind::Detp, radius);
-            const auto detpBrute = estimate(scene, cache, EstimatorKind::Detp, radius, 50, false);
-            expectEqualToRounding(detp, detpBrute, "DETP " + what);
-            EXPECT_GT(largestComponent(detpBrute), 0.0f) << what;
-            expectEqualToRounding(estimate(scene, cache, EstimatorKind::Detp, radius, 50, true, false), detpBrute,
-                                  "DETP unsorted " + what);
-
-            const auto pm = estimate(scene, cache, EstimatorKind::PhotonMap, radius, 20);
-            const auto pmBrute = estimate(scene, cache, EstimatorKind::PhotonMap, radius, 20, false);
-            expectEqualToRounding(pm, pmBrute, "photon map " + what);
-            expectEqualToRounding(estimate(scene, cache, EstimatorKind::PhotonMap, radius, 20, true, false), pmBrute,
-                                  "photon map unsorted " + what);
-
-            // The FLANN candidate search sees a subset of the segments the exact rule counts.
-            const auto flann = estimate(scene, cache, EstimatorKind::Detp, radius, 50, true, true, DetpIndex::Flann);
-            for (size_t v = 0; v < flann.size(); ++v)
-                for (int c = 0; c < 3; ++c) ASSERT_LE(flann[v][c], detpBrute[v][c]) << what << " vertex " << v;
+            // Regions once per radius: the estimates below differ only in how they search.
+            DiscRegions discs(radius, false), covered(radius, true);
+            discs.computeAll(scene, bvh);
+            covered.computeAll(scene, bvh);
+            auto run = [&](EstimatorKind kind, DetpBoundary rule, bool useIndex, bool sortQueries,
+                           DetpIndex index = DetpIndex::Embree) {
+                EstimatorSettings s;
+                s.kind = kind;
+                s.boundary = rule;
+                s.radius = radius;
+                s.k = 20;
+                s.useIndex = useIndex;
+                s.sortQueries = sortQueries;
+                s.detpIndex = index;
+                return estimateVertexRadiosity(scene, bvh, cache, s, device,
+                                               kind == EstimatorKind::PhotonMap ? &covered : &discs).irradiance;
+            };
+            for (DetpBoundary rule : {DetpBoundary::Clip, DetpBoundary::Linear, DetpBoundary::Paper}) {
+                const std::string what = name + ", r = " + std::to_string(radius) + ", " + detpBoundaryName(rule);
+                const auto detpBrute = run(EstimatorKind::Detp, rule, false, true);
+                expectEqualToRounding(run(EstimatorKind::Detp, rule, true, true), detpBrute, "DETP " + what);
+                expectEqualToRounding(run(EstimatorKind::Detp, rule, true, false), detpBrute, "DETP unsorted " + what);
+                EXPECT_GT(largestComponent(detpBrute), 0.0f) << what;
+                if (rule != DetpBoundary::Linear) {
+                    const auto pmBrute = run(EstimatorKind::PhotonMap, rule, false, true);
+                    expectEqualToRounding(run(EstimatorKind::PhotonMap, rule, true, true), pmBrute, "photon map " + what);
+                    expectEqualToRounding(run(EstimatorKind::PhotonMap, rule, true, false), pmBrute,
+                                          "photon map unsorted " + what);
+                    // The FLANN candidate search sees a subset of the segments the exact rule
+                    // counts (sums of positive powers over the same area).
+                    const auto flann = run(EstimatorKind::Detp, rule, true, true, DetpIndex::Flann);
+                    for (size_t v = 0; v < flann.size(); ++v)
+                        for (int c = 0; c < 3; ++c) ASSERT_LE(flann[v][c], detpBrute[v][c]) << what << " vertex " << v;
+                }
+            }
         }
     }
 }
 
-// Closed sphere, ρ = 0.5, I = 1 W/sr at the centre: E = 2 W/m² (see ImpactCount's test). Each
-// estimator's vertex mean is a mean over ~10^4 overlapping estimates of ≥ 50 impacts; its
-// statistical error is well under 0.5 %, so 2 % bounds the estimators' own bias (DETP's disc
-// leaves the curved surface by r²/2R).
+// Inside of a closed sphere, ρ = 0.5, I = 1 W/sr at the centre: E = 2 W/m² (see ImpactCount's
+// test). Each estimator's vertex mean is a mean over ~10^4 overlapping estimates of ≥ 50 impacts;
+// its statistical error is well under 0.3 %, so the issue's 1 % bounds the estimators' own bias
+// (DETP's band ε⁺ is the sagitta here; the photon map's impacts lie on the curved surface).
 TEST(Estimators, ClosedSphereGivesTwoWattsPerSquareMetreForEveryEstimator) {
     Scene scene = testscenes::closedSphere(1.0f, 5, Vec3f(0.5f));
     testscenes::addPointLight(scene, Vec3f(0.0f), Vec3f(1.0f));
@@ -116,7 +138,7 @@ TEST(Estimators, ClosedSphereGivesTwoWattsPerSquareMetreForEveryEstimator) {
         for (const Vec3f& e : E) sum += e.y;
         const double mean = sum / double(E.size());
         std::printf("sphere, %s: mean E = %.4f W/m^2\n", estimatorName(kind), mean);
-        EXPECT_NEAR(mean, 2.0, 0.04) << estimatorName(kind);
+        EXPECT_NEAR(mean, 2.0, 0.02) << estimatorName(kind);
     }
 }
 
@@ -183,7 +205,8 @@ TEST(Estimators, PlaneUnderPointLightMatchesTheInverseSquareCosineLaw) {
     }
 }
 
-// The paper's claim: photon maps have problems at borders, DETP does not. An inside corner (floor
+// The published rule (`--detp-boundary paper`, kept for ablations; the default rules are tested
+// in detp_boundary_test.cpp). The paper's claim: photon maps have problems at borders, DETP does not. An inside corner (floor
 // and wall, black so only direct light counts) under a point light, at three placements declared
 // before measuring: high above the corner, at 45°, and low.
 //
@@ -195,7 +218,7 @@ TEST(Estimators, PlaneUnderPointLightMatchesTheInverseSquareCosineLaw) {
 // photon map against the true irradiance within one radius of the edge. The issue's criterion
 // (|DETP bias| ≤ ½ |photon-map bias|) is reported, not asserted: it holds only where one surface
 // is lit much more steeply than the other (see the closing note of issue 4 for the numbers).
-TEST(Estimators, DetpMatchesItsExactExpectationAtAnInsideCorner) {
+TEST(Estimators, PaperRuleMatchesItsExactExpectationAtAnInsideCorner) {
     const float r = 0.1f;
     const uint64_t photons = 2000000;
     const double phi0 = 4 * M_PI / double(photons);
@@ -203,8 +226,8 @@ TEST(Estimators, DetpMatchesItsExactExpectationAtAnInsideCorner) {
         Scene scene = testscenes::corner(128, Vec3f(0.0f));
         testscenes::addPointLight(scene, Vec3f(light), Vec3f(1.0f));
         const RayCache cache = trace(scene, photons);
-        const auto detp = estimate(scene, cache, EstimatorKind::Detp, r);
-        const auto pm = estimate(scene, cache, EstimatorKind::PhotonMap, r, 50);
+        const auto detp = estimate(scene, cache, EstimatorKind::Detp, r, 50, true, true, DetpIndex::Embree, DetpBoundary::Paper);
+        const auto pm = estimate(scene, cache, EstimatorKind::PhotonMap, r, 50, true, true, DetpIndex::Embree, DetpBoundary::Paper);
 
         // Expected DETP at vertex p (side 0: floor y = 0, normal +y; side 1: wall z = 0, normal +z).
         auto expectedDetp = [&](const Vec3d& v, int side) {

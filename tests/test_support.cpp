@@ -152,6 +152,63 @@ Scene corner(int cells, Vec3f albedo) {
     return s;
 }
 
+Scene plateOverFloor(int floorCells, float half, float gap, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    addGrid(s, s.addNode("Floor", Transform()), {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, floorCells, m);
+    addGrid(s, s.addNode("Plate", Transform()), {-half, gap, half}, {2 * half, 0, 0}, {0, 0, -2 * half}, 4, m);
+    s.finalize();
+    return s;
+}
+
+Scene partition(int cells, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    addGrid(s, s.addNode("Floor", Transform()), {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, cells, m);
+    addGrid(s, s.addNode("Wall", Transform()), {-1, 0, 0}, {2, 0, 0}, {0, 1, 0}, cells / 2, m);
+    s.finalize();
+    return s;
+}
+
+Scene creasedSheet(int cells, bool welded, Vec3f albedo) {
+    // Rows j = 0..cells run along the floor from z = 1 to the crease (z = 0); rows cells..2·cells
+    // climb the wall. Columns i = 0..cells span x.
+    std::vector<Vec3f> p, n;
+    auto point = [&](int i, int j) {
+        const float x = -1 + 2.0f * float(i) / float(cells);
+        return j <= cells ? Vec3f(x, 0, 1 - float(j) / float(cells)) : Vec3f(x, float(j - cells) / float(cells), 0);
+    };
+    const uint32_t row = uint32_t(cells + 1);
+    for (int j = 0; j <= 2 * cells; ++j)
+        for (int i = 0; i <= cells; ++i) p.push_back(point(i, j));
+    if (!welded)  // a second copy of the crease row, for the wall's triangles
+        for (int i = 0; i <= cells; ++i) p.push_back(point(i, cells));
+    const uint32_t wallCrease = uint32_t(p.size()) - row;
+    auto index = [&](int i, int j, bool wallSide) {
+        if (!welded && wallSide && j == cells) return wallCrease + uint32_t(i);
+        return uint32_t(j) * row + uint32_t(i);
+    };
+    std::vector<uint32_t> idx;
+    for (int j = 0; j < 2 * cells; ++j)
+        for (int i = 0; i < cells; ++i) {
+            const bool wallSide = j >= cells;
+            const uint32_t a = index(i, j, wallSide), b = index(i + 1, j, wallSide), c = index(i + 1, j + 1, wallSide),
+                           d = index(i, j + 1, wallSide);
+            // Floor faces +y, wall faces +z (toward where the floor lies).
+            idx.insert(idx.end(), {a, b, c, a, c, d});
+        }
+    if (!welded) {
+        n.resize(p.size());
+        for (size_t v = 0; v < p.size(); ++v) n[v] = (v < size_t(cells) * row + row) ? Vec3f(0, 1, 0) : Vec3f(0, 0, 1);
+        for (int i = 0; i <= cells; ++i) n[size_t(cells) * row + size_t(i)] = Vec3f(0, 1, 0);
+    }
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    s.addInstance(s.addNode("Sheet", Transform()), std::move(p), std::move(n), idx, m);
+    s.finalize();
+    return s;
+}
+
 void addPointLight(Scene& s, Vec3f position, Vec3f intensity) {
     PunctualLight l;
     l.name = "test point light";

@@ -26,6 +26,17 @@ qsgi::Scene closedBox(int cells);
 qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo);
 // An inside corner: floor y = 0 (x in [-1,1], z in [0,2]) and wall z = 0 (x in [-1,1], y in [0,2]).
 qsgi::Scene corner(int cells, qsgi::Vec3f albedo);
+// A floor y = 0 (x, z in [-1, 1]) with a square opaque plate (half size `half`, zero thickness,
+// facing up) `gap` above it.
+qsgi::Scene plateOverFloor(int floorCells, float half, float gap, qsgi::Vec3f albedo);
+// A floor y = 0 (x, z in [-1, 1]) cut by a zero-thickness wall z = 0 (x in [-1, 1], y in [0, 1])
+// facing +z.
+qsgi::Scene partition(int cells, qsgi::Vec3f albedo);
+// An L-shaped sheet: floor y = 0 (z in [0, 1]) and wall z = 0 (y in [0, 1]), x in [-1, 1]. welded:
+// one mesh whose crease row is shared and whose normals are area-weighted (the crease vertices'
+// normals are 45° from both faces); otherwise the crease row is duplicated, each side with its
+// face normal. Both have the same triangles in the same order.
+qsgi::Scene creasedSheet(int cells, bool welded, qsgi::Vec3f albedo);
 void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
 // Writes a small glTF (a quad; emissive if lit) with an embedded buffer.
 void writeQuadGltf(const std::string& path, bool lit);

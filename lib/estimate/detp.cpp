@@ -9,27 +9,124 @@
 #include "estimate/fixed_point_power.h"
 #include "estimate/impact_index.h"
 #include "estimate/morton_order.h"
+#include "util/symmetric3.h"
 
 namespace qsgi {
 
-bool segmentCrossesDisc(const Segment& s, const Vec3f& centre, const Vec3f& normal, float radius) {
+const char* detpBoundaryName(DetpBoundary rule) {
+    switch (rule) {
+        case DetpBoundary::Clip: return "clip";
+        case DetpBoundary::Linear: return "linear";
+        case DetpBoundary::Paper: return "paper";
+    }
+    return "?";
+}
+
+namespace {
+// The disc of a vertex when no regions were computed (the paper rule needs none).
+const VertexDisc kPaperDisc = [] {
+    VertexDisc d;
+    d.fallback = true;
+    return d;
+}();
+
+const VertexDisc& discOf(const DiscRegions* regions, size_t v) { return regions ? (*regions)[v] : kPaperDisc; }
+}  // namespace
+
+bool detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
+                  DetpBoundary rule, DiscCrossing& where) {
     const Vec3d d(s.direction), n(normal), o(s.origin), v(centre);
     const double dn = dot(d, n);
     if (!(dn < 0)) return false;  // front side only
     const double tStar = dot(v - o, n) / dn;
-    if (!(tStar > 0 && tStar <= double(s.length) + double(radius))) return false;
+    if (!(tStar > 0)) return false;
+    const bool paper = rule == DetpBoundary::Paper || disc.fallback;
+    if (paper) {
+        if (!(tStar <= double(s.length) + double(radius))) return false;
+    } else if (s.hasImpact()) {
+        // The impact lies at most ε⁺ in front of the plane; the cap bounds grazing segments.
+        if (!(tStar <= double(s.length) + std::min(double(disc.epsAbove) / -dn, double(radius)))) return false;
+    }
     const Vec3d offset = o + d * tStar - v;
-    return dot(offset, offset) <= double(radius) * double(radius);
+    const double r = radius;
+    if (!(dot(offset, offset) <= r * r)) return false;
+    if (paper) return true;
+    where.x = dot(offset, Vec3d(disc.tangent)) / r;
+    where.y = dot(offset, Vec3d(disc.bitangent)) / r;
+    where.cell = discCellOf(where.x, where.y);
+    return disc.reachable.test(where.cell);
 }
 
 namespace {
 
-using VertexSums = std::vector<PowerSum>;
+__extension__ typedef __int128 Int128;
 
-std::vector<Vec3f> toIrradiance(const VertexSums& sums, const PowerQuantizer& q, float radius) {
+// Fixed-point sums of one vertex's crossings: Σ Φ and, for `linear`, Σ Φ·x and Σ Φ·y (x, y in
+// units of r, quantised to 2^-20). Integers, so sums are order-independent and exact.
+constexpr double kMomentScale = 1048576.0;  // 2^20
+
+struct DiscSums {
+    PowerSum power;
+    Int128 x[3] = {0, 0, 0}, y[3] = {0, 0, 0};
+
+    void add(const Vec3f& phi, const DiscCrossing& at, const PowerQuantizer& q, bool moments) {
+        power.add(phi, q);
+        if (!moments) return;
+        const int64_t qx = std::llround(at.x * kMomentScale), qy = std::llround(at.y * kMomentScale);
+        for (int c = 0; c < 3; ++c) {
+            const int64_t p = q.quantize(phi[c]);
+            x[c] += Int128(p) * qx;
+            y[c] += Int128(p) * qy;
+        }
+    }
+    DiscSums& operator+=(const DiscSums& o) {
+        power += o.power;
+        for (int c = 0; c < 3; ++c) {
+            x[c] += o.x[c];
+            y[c] += o.y[c];
+        }
+        return *this;
+    }
+};
+using VertexSums = std::vector<DiscSums>;
+
+// Above this the reachable region is too thin for a linear fit to be trusted (DESIGN §5).
+constexpr double kMaxFitCondition = 1e4;
+
+Vec3f vertexIrradiance(const DiscSums& sums, const VertexDisc& disc, float radius, DetpBoundary rule,
+                       const PowerQuantizer& q) {
+    const double r2 = double(radius) * double(radius);
+    const Vec3d flux = sums.power.watts(q);
+    if (rule == DetpBoundary::Paper || disc.fallback) return Vec3f(flux / (M_PI * r2));
+    if (disc.reachableCells == 0) return Vec3f(0.0f);  // buried in geometry
+    const double area = M_PI * r2 * double(disc.reachableCells) / kDiscCells;
+    const Vec3d clip = flux / area;
+    if (rule == DetpBoundary::Clip || disc.reachableCells == kDiscCells) return Vec3f(clip);
+    // Linear: least squares of a + b·x + c·y against the crossings over the reachable cells
+    // (unit-disc coordinates). Normal equations M (a, b, c) = (Σ Φ, Σ Φx, Σ Φy).
+    Symmetric3 m{};
+    for (int c = 0; c < kDiscCells; ++c) {
+        if (!disc.reachable.test(c)) continue;
+        const CellMoments& k = discCellMoments(c);
+        m[0][0] += k.m0, m[0][1] += k.mx, m[0][2] += k.my, m[1][1] += k.mxx, m[1][2] += k.mxy, m[2][2] += k.myy;
+    }
+    m[1][0] = m[0][1], m[2][0] = m[0][2], m[2][1] = m[1][2];
+    if (!(conditionNumber(m) <= kMaxFitCondition)) return Vec3f(clip);
+    const auto w = inverseFirstRow(m);
+    Vec3d out;
+    for (int c = 0; c < 3; ++c) {
+        const double s0 = flux[c], sx = double(sums.x[c]) / kMomentScale * q.quantum(),
+                     sy = double(sums.y[c]) / kMomentScale * q.quantum();
+        const double a = (w[0] * s0 + w[1] * sx + w[2] * sy) / r2;  // density per unit area at v
+        out[c] = a >= 0 ? a : clip[c];
+    }
+    return Vec3f(out);
+}
+
+std::vector<Vec3f> toIrradiance(const VertexSums& sums, const DiscRegions* regions, float radius, DetpBoundary rule,
+                                const PowerQuantizer& q) {
     std::vector<Vec3f> out(sums.size());
-    const double area = M_PI * double(radius) * double(radius);
-    for (size_t v = 0; v < sums.size(); ++v) out[v] = Vec3f(sums[v].watts(q) / area);
+    for (size_t v = 0; v < sums.size(); ++v) out[v] = vertexIrradiance(sums[v], discOf(regions, v), radius, rule, q);
     return out;
 }
 
@@ -42,13 +139,21 @@ VertexSums combine(tbb::enumerable_thread_specific<VertexSums>& perThread, size_
     return total;
 }
 
+struct CrossedDisc {
+    uint32_t vertex;
+    DiscCrossing at;
+    bool operator<(const CrossedDisc& o) const { return vertex < o.vertex; }
+};
+
 // What the Embree filter needs to apply the exact test, passed through the intersect context.
 struct DiscQueryContext {
     RTCIntersectContext base;  // first member: Embree hands back a pointer to it
     const Segment* segment;
     const Scene* scene;
+    const DiscRegions* regions;
     float radius;
-    std::vector<uint32_t>* crossed;
+    DetpBoundary rule;
+    std::vector<CrossedDisc>* crossed;
 };
 
 void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
@@ -56,25 +161,30 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0) continue;
         const uint32_t v = RTCHitN_primID(args->hit, args->N, i);
-        if (segmentCrossesDisc(*ctx->segment, ctx->scene->positions[v], ctx->scene->normals[v], ctx->radius))
-            ctx->crossed->push_back(v);
+        DiscCrossing at;
+        if (detpCrossing(*ctx->segment, ctx->scene->positions[v], ctx->scene->normals[v], discOf(ctx->regions, v),
+                         ctx->radius, ctx->rule, at))
+            ctx->crossed->push_back({v, at});
         args->valid[i] = 0;  // reject, so traversal goes on to every other disc along the ray
     }
 }
 
 }  // namespace
 
-DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius)
-    : scene_(scene), radius_(radius), discs_(device) {
+DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule,
+                     const DiscRegions* regions)
+    : scene_(scene), radius_(radius), rule_(rule), regions_(regions), discs_(device) {
     const size_t n = scene.vertexCount();
-    const float extent = std::max(1.0f, scene.bounds().extent());
-    rayExtension_ = 1e-4f * radius + 1e-6f * extent;
+    const float eps = scene.sceneEpsilon();
+    rayExtension_ = 1e-4f * radius + eps;
+    // Every disc lies within r of a vertex, and every vertex inside the animation's bounds.
+    escapeBounds_ = scene.animationBounds.expanded(radius + 2 * rayExtension_);
     RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
     auto* vertex = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
     auto* normal = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
     device.checkError("allocating DETP disc buffers");
     // Enlarged discs make Embree's float test a superset of the exact one; the filter decides.
-    const float searchRadius = radius * (1 + 1e-3f) + 1e-6f * extent;
+    const float searchRadius = radius * (1 + 1e-3f) + eps;
     for (size_t v = 0; v < n; ++v) {
         const Vec3f& p = scene.positions[v];
         vertex[4 * v] = p.x;
@@ -99,10 +209,9 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
                                          DetpQueryStats* stats) const {
     const size_t vertices = scene_.vertexCount();
     const PowerQuantizer q(cache.maxPhotonPower);
+    const bool moments = rule_ == DetpBoundary::Linear;
     tbb::enumerable_thread_specific<VertexSums> perThread([&] { return VertexSums(vertices); });
     tbb::enumerable_thread_specific<uint64_t> hitCount(0);
-    // Start the ray a little before the segment and end it a little past t + r, so plane
-    // crossings at t* ≈ 0 or t* ≈ t + r reach the exact test rather than Embree's bounds.
     const float slack = rayExtension_;
     // A reordering is gathered into a copy first, so tracing streams through memory instead of
     // jumping through the cache by index (which costs more than the coherence gains).
@@ -119,7 +228,7 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
     tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         VertexSums& sums = perThread.local();
         uint64_t& hits = hitCount.local();
-        std::vector<uint32_t> crossed;
+        std::vector<CrossedDisc> crossed;
         for (size_t i = r.begin(); i != r.end(); ++i) {
             const Segment& s = ordered[i];
             crossed.clear();
@@ -127,14 +236,20 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
             rtcInitIntersectContext(&ctx.base);
             ctx.segment = &s;
             ctx.scene = &scene_;
+            ctx.regions = regions_;
             ctx.radius = radius_;
+            ctx.rule = rule_;
             ctx.crossed = &crossed;
+            // Start a little before the segment and end a little past the farthest point any
+            // rule can count: t + r for an impact, past the padded bounds for an escaping photon.
+            float end = s.length + radius_;
+            if (!s.hasImpact()) end = std::max(end, escapeBounds_.exitDistance(s.origin, s.direction));
             RTCRayHit rh;
             const Vec3f o = s.origin - s.direction * slack;
             rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
             rh.ray.dir_x = s.direction.x; rh.ray.dir_y = s.direction.y; rh.ray.dir_z = s.direction.z;
             rh.ray.tnear = 0;
-            rh.ray.tfar = s.length + radius_ + 2 * slack;
+            rh.ray.tfar = end + 2 * slack;
             rh.ray.time = 0;
             rh.ray.mask = 0xFFFFFFFFu;
             rh.ray.id = 0;
@@ -143,30 +258,39 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
             rtcIntersect1(discs_.get(), &ctx.base, &rh);
             // Embree may report a primitive more than once along one ray (NOTES.md).
             std::sort(crossed.begin(), crossed.end());
-            crossed.erase(std::unique(crossed.begin(), crossed.end()), crossed.end());
-            for (uint32_t v : crossed) sums[v].add(s.power, q);
+            crossed.erase(std::unique(crossed.begin(), crossed.end(),
+                                      [](const CrossedDisc& a, const CrossedDisc& b) { return a.vertex == b.vertex; }),
+                          crossed.end());
+            for (const CrossedDisc& c : crossed) sums[c.vertex].add(s.power, c.at, q, moments);
             hits += crossed.size();
         }
     });
     if (stats)
         for (uint64_t h : hitCount) stats->discHits += h;
-    return toIrradiance(combine(perThread, vertices), q, radius_);
+    return toIrradiance(combine(perThread, vertices), regions_, radius_, rule_, q);
 }
 
-std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius) {
+std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
+                                  const DiscRegions* regions) {
     const PowerQuantizer q(cache.maxPhotonPower);
+    const bool moments = rule == DetpBoundary::Linear;
     VertexSums sums(scene.vertexCount());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, scene.vertexCount(), 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t v = r.begin(); v != r.end(); ++v)
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            const VertexDisc& disc = discOf(regions, v);
+            DiscCrossing at;
             for (const Segment& s : cache.segments)
-                if (segmentCrossesDisc(s, scene.positions[v], scene.normals[v], radius)) sums[v].add(s.power, q);
+                if (detpCrossing(s, scene.positions[v], scene.normals[v], disc, radius, rule, at))
+                    sums[v].add(s.power, at, q, moments);
+        }
     });
-    return toIrradiance(sums, q, radius);
+    return toIrradiance(sums, regions, radius, rule, q);
 }
 
-std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius,
-                                       const std::vector<uint32_t>& vertexOrder) {
+std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
+                                       const DiscRegions* regions, const std::vector<uint32_t>& vertexOrder) {
     const PowerQuantizer q(cache.maxPhotonPower);
+    const bool moments = rule == DetpBoundary::Linear;
     const ImpactIndex index(cache);
     VertexSums sums(scene.vertexCount());
     const float searchRadius = radius * (1 + kFlannCandidateMargin);
@@ -175,14 +299,17 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
         std::vector<float> d2;
         for (size_t i = r.begin(); i != r.end(); ++i) {
             const uint32_t v = vertexOrder[i];
+            const VertexDisc& disc = discOf(regions, v);
             index.withinRadius(scene.positions[v], searchRadius * searchRadius, candidates, d2);
+            DiscCrossing at;
             for (size_t c : candidates) {
                 const Segment& s = cache.segments[index.segment(c)];
-                if (segmentCrossesDisc(s, scene.positions[v], scene.normals[v], radius)) sums[v].add(s.power, q);
+                if (detpCrossing(s, scene.positions[v], scene.normals[v], disc, radius, rule, at))
+                    sums[v].add(s.power, at, q, moments);
             }
         }
     });
-    return toIrradiance(sums, q, radius);
+    return toIrradiance(sums, regions, radius, rule, q);
 }
 
 std::vector<uint32_t> segmentMortonOrder(const RayCache& cache) {

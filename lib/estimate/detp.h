@@ -1,24 +1,44 @@
 // Density estimation on the tangent plane (DESIGN §5, Lastra et al. 2002). Vertex v owns the disc
-// D_v = { p : (p − v)·n_v = 0, |p − v| ≤ r }. Segment s counts when d·n_v < 0 and its line
-// crosses the disc's plane at 0 < t* ≤ t_s + r with |o + t* d − v| ≤ r: the segment is extended
-// by one radius past its impact, so a disc reaching behind an adjacent wall still sees the flux
-// arriving there. E_v = Σ Φ_s / (π r²).
+// D_v = { p : (p − v)·n_v = 0, |p − v| ≤ r }. A segment s crosses it when d·n_v < 0 and its line
+// meets the plane at t* inside the disc, with
+//   clip / linear: 0 < t* ≤ t_s + min(ε_v⁺/|d·n_v|, r) — its impact lies at most ε_v⁺ (the height
+//                  of v's own surface) in front of the plane, so a panel 1 cm under a ceiling does
+//                  not leak through it — and no upper limit for an escaping photon (it keeps going
+//                  past the scene, so discs at an open edge see the photons that pass beside it);
+//                  the crossing must also fall in a cell reachable from v's side (DiscRegions);
+//   paper:         0 < t* ≤ t_s + r, every crossing counts (the published rule, for ablations).
+// E_v = Σ Φ / A_v with A_v = πr² × reachable cells / all cells (clip), or πr² (paper). `linear`
+// takes the constant term of a least-squares linear fit of the flux density over the reachable
+// cells instead, which removes the first-order bias where part of the disc is unreachable.
+// Vertices with an empty own surface use the paper rule (counted in the log).
 //
-// The exact ray–disc test (segmentCrossesDisc) is the definition. The Embree index traces each
-// segment through oriented discs at the vertices — slightly enlarged, so it finds a superset —
-// and keeps exactly the discs the test accepts; brute force applies the same test to every pair.
-// Both therefore count the same set, and fixed-point sums make them equal to the last bit.
+// detpCrossing is the definition. The Embree index traces each segment through oriented discs at
+// the vertices (slightly enlarged, so it finds a superset) and keeps exactly what detpCrossing
+// accepts; brute force applies detpCrossing to every pair. Both count the same set, and
+// fixed-point sums make them equal to the last bit.
 #pragma once
 
 #include <vector>
 
+#include "estimate/disc_regions.h"
 #include "scene/scene.h"
 #include "trace/embree_device.h"
 #include "trace/ray_cache.h"
 
 namespace qsgi {
 
-bool segmentCrossesDisc(const Segment& s, const Vec3f& centre, const Vec3f& normal, float radius);
+enum class DetpBoundary { Clip, Linear, Paper };
+const char* detpBoundaryName(DetpBoundary rule);
+
+// Where a segment crosses a disc: (x, y) in units of r in the disc's frame, and the cell there.
+struct DiscCrossing {
+    double x = 0, y = 0;
+    int cell = 0;
+};
+
+// The definition. disc: the vertex's regions (its fallback flag switches to the paper rule).
+bool detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
+                  DetpBoundary rule, DiscCrossing& where);
 
 struct DetpQueryStats {
     uint64_t discHits = 0;  // accepted (segment, disc) pairs
@@ -26,8 +46,8 @@ struct DetpQueryStats {
 
 class DetpDiscs {
 public:
-    // Builds the disc BVH of the scene's current pose.
-    DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius);
+    // Builds the disc BVH of the scene's current pose. regions may be null for the paper rule.
+    DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule, const DiscRegions* regions);
 
     // Irradiance at every vertex from the given segments (in that order), in parallel.
     std::vector<Vec3f> irradiance(const RayCache& cache, const std::vector<uint32_t>& segmentOrder,
@@ -36,19 +56,23 @@ public:
 private:
     const Scene& scene_;
     float radius_;
-    float rayExtension_;  // lets Embree's float tests see crossings at t* ≈ 0 and t* ≈ t + r
+    DetpBoundary rule_;
+    const DiscRegions* regions_;
+    float rayExtension_;  // lets Embree's float tests see crossings at t* ≈ 0 and at the rule's end
+    Bounds3f escapeBounds_;  // escaping segments are traced until they leave this box
     EmbreeScene discs_;
 };
 
 // Index-free reference: every segment against every disc.
-std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius);
+std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
+                                  const DiscRegions* regions);
 
 // Approximate DETP (--detp-index flann): candidates are the segments whose impact lies within
 // radius·(1 + kFlannCandidateMargin) of the vertex, then the exact test. It misses segments that
 // cross a disc but land far away (silhouettes, convex edges, escaping photons).
 constexpr float kFlannCandidateMargin = 0.25f;
-std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius,
-                                       const std::vector<uint32_t>& vertexOrder);
+std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
+                                       const DiscRegions* regions, const std::vector<uint32_t>& vertexOrder);
 
 // Segment order for coherent tracing: Morton order of the segments' end points.
 std::vector<uint32_t> segmentMortonOrder(const RayCache& cache);

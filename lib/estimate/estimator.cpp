@@ -1,5 +1,7 @@
 #include "estimate/estimator.h"
 
+#include <optional>
+
 #include "estimate/detp.h"
 #include "estimate/impact_count.h"
 #include "estimate/morton_order.h"
@@ -16,9 +18,24 @@ const char* estimatorName(EstimatorKind kind) {
     return "?";
 }
 
-VertexRadiosity estimateVertexRadiosity(const Scene& scene, const RayCache& cache, const EstimatorSettings& settings,
-                                        const EmbreeDevice& device) {
+bool needsDiscRegions(const EstimatorSettings& s) {
+    return s.kind != EstimatorKind::ImpactCount && s.boundary != DetpBoundary::Paper;
+}
+
+DiscRegions makeDiscRegions(const EstimatorSettings& s) { return DiscRegions(s.radius, s.kind == EstimatorKind::PhotonMap); }
+
+VertexRadiosity estimateVertexRadiosity(const Scene& scene, const SceneBvh& bvh, const RayCache& cache,
+                                        const EstimatorSettings& settings, const EmbreeDevice& device,
+                                        const DiscRegions* regions) {
     const auto vertexOrder = [&] { return settings.sortQueries ? mortonOrder(scene.positions) : inputOrder(scene.vertexCount()); };
+    std::optional<DiscRegions> own;
+    if (needsDiscRegions(settings) && !regions) {
+        own.emplace(makeDiscRegions(settings));
+        own->computeAll(scene, bvh);
+        regions = &*own;
+    }
+    if (!needsDiscRegions(settings)) regions = nullptr;
+    const DetpBoundary rule = settings.boundary;
     VertexRadiosity out;
     switch (settings.kind) {
         case EstimatorKind::ImpactCount: {
@@ -28,17 +45,17 @@ VertexRadiosity estimateVertexRadiosity(const Scene& scene, const RayCache& cach
             return estimator.estimate(scene, PowerQuantizer(cache.maxPhotonPower));
         }
         case EstimatorKind::PhotonMap: {
-            const PhotonMap map(cache);
-            out.irradiance = settings.useIndex ? map.irradiance(scene, settings.radius, settings.k, vertexOrder())
-                                               : map.bruteForce(scene, settings.radius, settings.k);
+            const PhotonMap map(cache, scene);
+            out.irradiance = settings.useIndex ? map.irradiance(scene, regions, settings.radius, settings.k, vertexOrder())
+                                               : map.bruteForce(scene, regions, settings.radius, settings.k);
             break;
         }
         case EstimatorKind::Detp: {
-            if (!settings.useIndex) out.irradiance = detpBruteForce(scene, cache, settings.radius);
+            if (!settings.useIndex) out.irradiance = detpBruteForce(scene, cache, settings.radius, rule, regions);
             else if (settings.detpIndex == DetpIndex::Flann)
-                out.irradiance = detpFlannCandidates(scene, cache, settings.radius, vertexOrder());
+                out.irradiance = detpFlannCandidates(scene, cache, settings.radius, rule, regions, vertexOrder());
             else
-                out.irradiance = DetpDiscs(device, scene, settings.radius)
+                out.irradiance = DetpDiscs(device, scene, settings.radius, rule, regions)
                                      .irradiance(cache, settings.sortQueries ? segmentMortonOrder(cache)
                                                                              : inputOrder(cache.segments.size()));
             break;

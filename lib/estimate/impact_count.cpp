@@ -6,16 +6,12 @@ ImpactCount::ImpactCount(const Scene& scene) : sums_(scene.triangleCount()) { up
 
 void ImpactCount::updateGeometry(const Scene& scene) {
     const size_t n = scene.triangleCount();
-    frontNormal_.resize(n);
+    frontNormal_ = scene.frontFaceNormals();
     area_.resize(n);
     degenerate_ = 0;
     for (uint32_t t = 0; t < n; ++t) {
         area_[t] = scene.triangleArea(t);
         if (!(area_[t] > 0)) ++degenerate_;
-        const Triangle& tri = scene.triangles[t];
-        const Vec3f vertexSide = scene.normals[tri.v[0]] + scene.normals[tri.v[1]] + scene.normals[tri.v[2]];
-        const Vec3f g = scene.geometricNormal(t);
-        frontNormal_[t] = dot(g, vertexSide) < 0 ? -g : g;
     }
 }
 

@@ -5,11 +5,29 @@
 #include <algorithm>
 #include <cmath>
 
+#include "estimate/own_surface.h"
+
 namespace qsgi {
 
-PhotonMap::PhotonMap(const RayCache& cache) : cache_(cache), index_(cache), quantizer_(cache.maxPhotonPower) {}
+PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene)
+    : cache_(cache), index_(cache), frontNormals_(scene.frontFaceNormals()), quantizer_(cache.maxPhotonPower) {}
 
-Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, float radius, int k) const {
+PhotonMap::VertexFilter PhotonMap::filterFor(const Scene& scene, const DiscRegions* regions, size_t v) const {
+    const VertexDisc* disc = regions && !(*regions)[v].fallback ? &(*regions)[v] : nullptr;
+    return VertexFilter{Vec3d(scene.positions[v]), Vec3d(scene.normals[v]), disc};
+}
+
+bool PhotonMap::counts(const VertexFilter& f, uint32_t impact) const {
+    const Segment& s = segmentOf(impact);
+    const Vec3f normal(f.normal);
+    if (!(dot(s.direction, normal) < 0)) return false;
+    if (!f.disc) return true;
+    if (!(dot(frontNormals_[s.triangle], normal) > kOwnSurfaceCos)) return false;
+    const double height = dot(Vec3d(index_.point(impact)) - f.position, f.normal);
+    return height <= double(f.disc->epsAbove) && height >= -double(f.disc->epsBelow);
+}
+
+Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const VertexDisc* disc, float radius, int k) const {
     const size_t found = std::min(sortedFront.size(), size_t(k));
     if (found == 0) return Vec3f(0.0f);
     // With k neighbours, the k-th only marks the radius r_k: it lies on the disc's rim, and
@@ -22,10 +40,16 @@ Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, float radiu
     for (size_t i = 0; i < summed; ++i) sum.add(segmentOf(sortedFront[i].impact).power, quantizer_);
     double r = full ? std::sqrt(double(sortedFront[found - 1].distanceSquared)) : double(radius);
     if (!(r > 0)) r = double(radius);  // k coincident impacts: no finite density to report
-    return Vec3f(sum.watts(quantizer_) / (M_PI * r * r));
+    // The part of the r disc that surfaces facing n_v cover (all of it without regions).
+    const double area = disc ? discAreaWithin(disc->covered, disc->coveredCells, std::min(1.0, r / double(radius))) *
+                                   double(radius) * double(radius)
+                             : M_PI * r * r;
+    if (!(area > 0)) return Vec3f(0.0f);
+    return Vec3f(sum.watts(quantizer_) / area);
 }
 
-std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, float radius, int k, const std::vector<uint32_t>& order) const {
+std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, const DiscRegions* regions, float radius, int k,
+                                         const std::vector<uint32_t>& order) const {
     std::vector<Vec3f> out(scene.vertexCount(), Vec3f(0.0f));
     if (index_.size() == 0 || k <= 0) return out;
     const float radiusSquared = radius * radius;
@@ -36,27 +60,27 @@ std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, float radius, int k
         std::vector<Neighbour> front;
         for (size_t q = r.begin(); q != r.end(); ++q) {
             const uint32_t v = order[q];
-            const Vec3f& normal = scene.normals[v];
-            // Back-facing impacts do not count, so ask the tree for more neighbours until k
-            // front-facing ones are found or the candidates run past the radius.
+            const VertexFilter filter = filterFor(scene, regions, v);
+            // Impacts that do not count are skipped, so ask the tree for more neighbours until k
+            // counted ones are found or the candidates run past the radius.
             size_t want = std::min(n, size_t(2 * k));
             while (true) {
                 index_.nearest(scene.positions[v], want, indices, d2);
                 front.clear();
                 for (size_t i = 0; i < want; ++i)
-                    if (d2[i] <= radiusSquared && dot(segmentOf(uint32_t(indices[i])).direction, normal) < 0)
+                    if (d2[i] <= radiusSquared && counts(filter, uint32_t(indices[i])))
                         front.push_back({d2[i], uint32_t(indices[i])});
                 if (front.size() >= size_t(k) || want == n || d2[want - 1] > radiusSquared) break;
                 want = std::min(n, want * 4);
             }
             std::sort(front.begin(), front.end());
-            out[v] = estimate(front, radius, k);
+            out[v] = estimate(front, filter.disc, radius, k);
         }
     });
     return out;
 }
 
-std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, float radius, int k) const {
+std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* regions, float radius, int k) const {
     std::vector<Vec3f> out(scene.vertexCount(), Vec3f(0.0f));
     if (k <= 0) return out;
     const float radiusSquared = radius * radius;
@@ -64,15 +88,16 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, float radius, int k
         std::vector<Neighbour> front;
         for (size_t v = r.begin(); v != r.end(); ++v) {
             front.clear();
+            const VertexFilter filter = filterFor(scene, regions, v);
             for (size_t i = 0; i < index_.size(); ++i) {
                 const float d2 = PointIndex::distanceSquared(scene.positions[v], index_.point(i));
-                if (d2 <= radiusSquared && dot(segmentOf(uint32_t(i)).direction, scene.normals[v]) < 0)
+                if (d2 <= radiusSquared && counts(filter, uint32_t(i)))
                     front.push_back({d2, uint32_t(i)});
             }
             const size_t keep = std::min(front.size(), size_t(k));
             std::partial_sort(front.begin(), front.begin() + keep, front.end());
             front.resize(keep);
-            out[v] = estimate(front, radius, k);
+            out[v] = estimate(front, filter.disc, radius, k);
         }
     });
     return out;

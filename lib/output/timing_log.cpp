@@ -29,6 +29,7 @@ void TimingLog::write(const std::filesystem::path& path) const {
                    {"radius", hasRadius ? nlohmann::json(radius) : nlohmann::json(nullptr)},
                    {"k", estimator == "photon-map" ? nlohmann::json(k) : nlohmann::json(nullptr)},
                    {"detp_index", estimator == "detp" ? nlohmann::json(detpIndex) : nlohmann::json(nullptr)},
+                   {"detp_boundary", hasRadius ? nlohmann::json(boundary) : nlohmann::json(nullptr)},
                    {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute},
                    {"seed", seed}, {"threads", threads}};
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
@@ -50,7 +51,9 @@ void TimingLog::write(const std::filesystem::path& path) const {
                         {"write_s", f.writeSeconds},
                         {"segments", f.segments}, {"photons_missing_scene", f.photonsMissingScene}, {"paths_retraced", f.pathsRetraced},
                         {"segments_removed", f.segmentsRemoved}, {"segments_added", f.segmentsAdded},
-                        {"vertices_updated", f.verticesUpdated}});
+                        {"vertices_updated", f.verticesUpdated}, {"disc_regions_s", f.discRegionsSeconds},
+                        {"disc_regions_updated", f.discRegionsUpdated}, {"own_surface_fallbacks", f.ownSurfaceFallbacks},
+                        {"buried_vertices", f.buriedVertices}});
     j["frames"] = list;
     AtomicFile file(path);
     file.stream() << j.dump(2) << "\n";

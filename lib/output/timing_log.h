@@ -20,6 +20,11 @@ struct FrameTiming {
     uint64_t pathsRetraced = 0;
     uint64_t segmentsRemoved = 0, segmentsAdded = 0;
     uint64_t verticesUpdated = 0;
+    // Disc regions (DESIGN §5): time, vertices (re)computed this frame, and the vertices with an
+    // empty own surface (paper fallback) or no reachable cell (buried: E = 0).
+    double discRegionsSeconds = 0;
+    uint64_t discRegionsUpdated = 0;
+    uint64_t ownSurfaceFallbacks = 0, buriedVertices = 0;
 };
 
 struct TimingLog {
@@ -29,6 +34,7 @@ struct TimingLog {
     int k = 0;
     bool rayCache = true, sortQueries = true;
     std::string detpIndex;
+    std::string boundary;  // DETP / photon-map boundary rule
     uint64_t photons = 0, seed = 0;
     int threads = 0;
     bool fullRecompute = true;

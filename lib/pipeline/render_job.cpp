@@ -55,7 +55,7 @@ PerspectiveCamera resolveCamera(const RenderSettings& s, const Scene& scene, War
     if (scene.camera) return *scene.camera;
     if (s.writeExr || s.writePng)
         warnings.add(s.scenePath + ": no camera in the scene or config; using one that frames the scene's bounds");
-    return framingCamera(scene.bounds(), float(s.width) / float(s.height));
+    return framingCamera(scene.animationBounds, float(s.width) / float(s.height));
 }
 
 }  // namespace
@@ -83,6 +83,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                                                  : Animation::fromTransformFile(settings_.animationPath, scene_);
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, settings_.animationPath);
     scene_.markDynamic(animation_.movedNodes());
+    sweepAnimationBounds(scene_, animation_);
 
     camera_ = resolveCamera(settings_, scene_, warnings);
     if (!settings_.radiusGiven) settings_.estimator.radius = defaultRadius(scene_);
@@ -125,6 +126,7 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     log.rayCache = settings_.estimator.useIndex;
     log.sortQueries = settings_.estimator.sortQueries;
     log.detpIndex = settings_.estimator.detpIndex == DetpIndex::Flann ? "flann" : "embree";
+    log.boundary = detpBoundaryName(settings_.estimator.boundary);
     log.degenerateTriangles = ImpactCount(scene_).degenerateTriangles();
     log.photons = settings_.photons;
     log.seed = settings_.seed;
@@ -151,12 +153,17 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.k : 0);
         return m;
     };
+    // Disc regions persist across frames: static vertices keep theirs unless a mover comes near.
+    std::optional<DiscRegions> regions;
+    if (needsDiscRegions(settings_.estimator)) regions.emplace(makeDiscRegions(settings_.estimator));
     const int count = last_ - first_ + 1;
     for (int frame = first_; frame <= last_; ++frame) {
         Stopwatch frameClock;
         FrameTiming timing;
         timing.frame = frame;
-        scene_.applyPose(animation_.localsAt(frame));
+        std::vector<uint32_t> movedInstances;
+        std::vector<Bounds3f> movedBounds;
+        scene_.applyPose(animation_.localsAt(frame), &movedInstances, &movedBounds);
 
         // Every frame from scratch for now; the incremental update (DESIGN §6) slots in here.
         Stopwatch clock;
@@ -171,8 +178,27 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         timing.pathsRetraced = cache.pathCount();
         timing.segmentsAdded = cache.segments.size();
 
+        // Density estimation: the disc regions of this pose (part of its cost), then the estimate.
         clock.restart();
-        const VertexRadiosity result = estimateVertexRadiosity(scene_, cache, settings_.estimator, device);
+        if (regions) {
+            Stopwatch regionClock;
+            if (frame == first_) {
+                regions->computeAll(scene_, bvh);
+                timing.discRegionsUpdated = scene_.vertexCount();
+            } else {
+                std::vector<uint8_t> vertexMoved(scene_.vertexCount(), 0);
+                for (uint32_t i : movedInstances)
+                    std::fill_n(vertexMoved.begin() + scene_.instances[i].firstVertex, scene_.instances[i].vertexCount, 1);
+                const std::vector<uint32_t> touched = regions->touchedBy(scene_, movedBounds, vertexMoved);
+                regions->recompute(scene_, bvh, touched);
+                timing.discRegionsUpdated = touched.size();
+            }
+            timing.discRegionsSeconds = regionClock.seconds();
+            timing.ownSurfaceFallbacks = regions->fallbackVertices();
+            timing.buriedVertices = regions->buriedVertices();
+        }
+        const VertexRadiosity result =
+            estimateVertexRadiosity(scene_, bvh, cache, settings_.estimator, device, regions ? &*regions : nullptr);
         timing.estimationSeconds = clock.seconds();
         timing.verticesUpdated = scene_.vertexCount();
 

@@ -26,7 +26,15 @@ DetpIndex parseDetpIndex(const std::string& name, const std::string& source) {
     throw InputError(source, "detp_index", "unknown DETP index '" + name + "' (embree: exact, flann: approximate)");
 }
 
-float defaultRadius(const Scene& scene) { return 0.015f * std::max(scene.bounds().extent(), 1e-6f); }
+DetpBoundary parseDetpBoundary(const std::string& name, const std::string& source) {
+    if (name == "clip") return DetpBoundary::Clip;
+    if (name == "linear") return DetpBoundary::Linear;
+    if (name == "paper") return DetpBoundary::Paper;
+    throw InputError(source, "detp_boundary",
+                     "unknown boundary rule '" + name + "' (clip: default, linear: first-order edge correction, paper: the published rule)");
+}
+
+float defaultRadius(const Scene& scene) { return 0.015f * std::max(scene.animationBounds.extent(), 1e-6f); }
 
 FrameRange parseFrameRange(const std::string& text, const std::string& source) {
     auto parseInt = [&](const std::string& s) {
@@ -129,6 +137,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
             if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
             (key == "ray_cache" ? s.estimator.useIndex : s.estimator.sortQueries) = v.get<bool>();
         } else if (key == "detp_index") s.estimator.detpIndex = parseDetpIndex(str(), path);
+        else if (key == "detp_boundary") s.estimator.boundary = parseDetpBoundary(str(), path);
         else if (key == "photons") s.photons = positiveInteger(v, path, key);
         else if (key == "seed") {
             if (!v.is_number_integer() || v.get<int64_t>() < 0) throw InputError(path, key, "must be a non-negative integer");

@@ -51,6 +51,7 @@ void applyConfigFile(const std::string& path, RenderSettings& settings);
 FrameRange parseFrameRange(const std::string& text, const std::string& source);
 EstimatorKind parseEstimator(const std::string& name, const std::string& source);
 DetpIndex parseDetpIndex(const std::string& name, const std::string& source);
+DetpBoundary parseDetpBoundary(const std::string& name, const std::string& source);
 
 // 1.5 % of the scene's bounding-box diagonal: a radius that means the same in any unit.
 float defaultRadius(const Scene& scene);

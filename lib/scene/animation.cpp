@@ -166,4 +166,12 @@ void checkLightsAreStatic(const Scene& scene, const Animation& animation, const 
                              "moves an emissive mesh, but lights must be static");
 }
 
+void sweepAnimationBounds(Scene& scene, const Animation& animation) {
+    Bounds3f swept = scene.bounds();
+    for (int frame = 0; frame <= animation.lastFrame(); ++frame)
+        if (scene.applyPose(animation.localsAt(frame))) swept.extend(scene.bounds());
+    scene.applyPose(scene.restLocals());
+    scene.animationBounds = swept;
+}
+
 }  // namespace qsgi

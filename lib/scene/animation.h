@@ -39,6 +39,11 @@ private:
     double fps_ = 24;
 };
 
+// Poses the scene at every frame of the animation and sets scene.animationBounds to the union of
+// their bounds, then returns the scene to its rest pose. Everything derived from the scene's size
+// uses it, so no value depends on which frame is being rendered (DESIGN §6 step 0).
+void sweepAnimationBounds(Scene& scene, const Animation& animation);
+
 // Lights are static (DESIGN §2): throws InputError if a punctual light or an emissive mesh hangs
 // under a node the animation moves.
 void checkLightsAreStatic(const Scene& scene, const Animation& animation, const std::string& animationFile);

@@ -11,6 +11,17 @@ Bounds3f Scene::bounds() const {
     return b;
 }
 
+std::vector<Vec3f> Scene::frontFaceNormals() const {
+    std::vector<Vec3f> front(triangleCount());
+    for (uint32_t t = 0; t < triangleCount(); ++t) {
+        const Triangle& tri = triangles[t];
+        const Vec3f vertexSide = normals[tri.v[0]] + normals[tri.v[1]] + normals[tri.v[2]];
+        const Vec3f g = geometricNormal(t);
+        front[t] = dot(g, vertexSide) < 0 ? -g : g;
+    }
+    return front;
+}
+
 Vec3f Scene::geometricNormal(uint32_t tri) const {
     const Triangle& t = triangles[tri];
     const Vec3d a(positions[t.v[0]]), b(positions[t.v[1]]), c(positions[t.v[2]]);
@@ -72,16 +83,26 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world) {
     placedWith[instanceIndex] = world;
 }
 
-bool Scene::applyPose(const std::vector<Transform>& locals) {
+Bounds3f Scene::instanceBounds(size_t instanceIndex) const {
+    const MeshInstance& inst = instances[instanceIndex];
+    Bounds3f b;
+    for (uint32_t i = 0; i < inst.vertexCount; ++i) b.extend(positions[inst.firstVertex + i]);
+    return b;
+}
+
+bool Scene::applyPose(const std::vector<Transform>& locals, std::vector<uint32_t>* moved, std::vector<Bounds3f>* movedBounds) {
     const std::vector<Transform> world = worldTransforms(locals);
-    bool moved = false;
+    bool any = false;
     for (size_t i = 0; i < instances.size(); ++i) {
         const Transform& w = world[instances[i].node];
         if (w == placedWith[i]) continue;
+        if (movedBounds) movedBounds->push_back(instanceBounds(i));
         placeInstance(i, w);
-        moved = true;
+        if (movedBounds) movedBounds->push_back(instanceBounds(i));
+        if (moved) moved->push_back(uint32_t(i));
+        any = true;
     }
-    return moved;
+    return any;
 }
 
 void Scene::markDynamic(const std::vector<int>& movedNodes) {
@@ -156,6 +177,7 @@ void Scene::finalize() {
     placedWith.assign(instances.size(), Transform());
     for (size_t i = 0; i < instances.size(); ++i) placeInstance(i, world[instances[i].node]);
     markDynamic({});
+    animationBounds = bounds();
 }
 
 bool Scene::hasDynamicGeometry() const {

@@ -84,8 +84,19 @@ struct Scene {
     size_t vertexCount() const { return positions.size(); }
     size_t triangleCount() const { return triangles.size(); }
 
+    // Bounds of the current pose. Anything that must not change with the pose uses
+    // animationBounds instead (DESIGN §6 step 0).
     Bounds3f bounds() const;
+    // Union of the bounds of every pose the run can show: the rest pose after finalize(), every
+    // frame once the animation is known (sweepAnimationBounds).
+    Bounds3f animationBounds;
+    // 10^-6 of animationBounds' diagonal: the tolerance of the estimators' geometric tests (DESIGN §5).
+    float sceneEpsilon() const { return 1e-6f * std::max(animationBounds.extent(), 1e-6f); }
+
     Vec3f geometricNormal(uint32_t tri) const;  // unit, from the CCW winding (front side)
+    // Geometric normals flipped, where needed, to the side the triangle's vertex normals face:
+    // the side a surface receives light on (impact count, own surfaces, photon-map filter).
+    std::vector<Vec3f> frontFaceNormals() const;
     float triangleArea(uint32_t tri) const;
 
     // World transform of every node for the given local transforms (one per node).
@@ -93,8 +104,11 @@ struct Scene {
     std::vector<Transform> restLocals() const;
 
     // Re-places the instances whose world transform differs from the one they were placed with.
-    // Returns true if any vertex moved.
-    bool applyPose(const std::vector<Transform>& locals);
+    // Returns true if any vertex moved. If `moved` is given, appends the index of every re-placed
+    // instance and, to `movedBounds`, its bounds before and after.
+    bool applyPose(const std::vector<Transform>& locals, std::vector<uint32_t>* moved = nullptr,
+                   std::vector<Bounds3f>* movedBounds = nullptr);
+    Bounds3f instanceBounds(size_t instanceIndex) const;
 
     // Marks the vertices/triangles of every instance at or below one of the given nodes.
     void markDynamic(const std::vector<int>& movedNodes);

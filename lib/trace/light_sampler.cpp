@@ -8,7 +8,7 @@ namespace qsgi {
 
 LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon)
     : scene_(scene), rayEpsilon_(rayEpsilon) {
-    const Bounds3f b = scene.bounds();
+    const Bounds3f b = scene.animationBounds;
     boundsCentre_ = b.center();
     boundsRadius_ = std::max(0.5f * b.extent(), 1e-6f);
 

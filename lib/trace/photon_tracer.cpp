@@ -12,20 +12,7 @@ namespace qsgi {
 
 PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings)
     : scene_(scene), bvh_(bvh), settings_(settings), lights_(scene, settings.photons, bvh.rayEpsilon()),
-      bounds_(scene.bounds()) {}
-
-float PhotonTracer::exitDistance(const Vec3f& o, const Vec3f& d) const {
-    // Slab test against the bounds, padded by an epsilon; the far exit is what we need.
-    float tfar = std::numeric_limits<float>::max();
-    const float pad = bvh_.rayEpsilon();
-    for (int a = 0; a < 3; ++a) {
-        if (d[a] == 0) continue;
-        const float t0 = (bounds_.lower[a] - pad - o[a]) / d[a];
-        const float t1 = (bounds_.upper[a] + pad - o[a]) / d[a];
-        tfar = std::min(tfar, std::max(t0, t1));
-    }
-    return std::max(0.0f, std::isfinite(tfar) && tfar < std::numeric_limits<float>::max() ? tfar : 0.0f);
-}
+      bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {}
 
 void PhotonTracer::tracePath(uint64_t path, std::vector<Segment>& out) const {
     const PhotonEmission e = lights_.sample(PhotonRandom(settings_.seed, path));
@@ -46,7 +33,7 @@ void PhotonTracer::continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Ve
         s.bounce = uint16_t(bounce);
         const auto hit = bvh_.intersect(origin, direction, tnear, std::numeric_limits<float>::infinity());
         if (!hit) {
-            s.length = exitDistance(origin, direction);
+            s.length = bounds_.exitDistance(origin, direction);
             out.push_back(s);
             return;
         }

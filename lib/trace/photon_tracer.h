@@ -35,14 +35,11 @@ public:
     const LightSampler& lights() const { return lights_; }
 
 private:
-    // Length of the ray inside the scene's bounds (for escaping photons).
-    float exitDistance(const Vec3f& origin, const Vec3f& direction) const;
-
     const Scene& scene_;
     const SceneBvh& bvh_;
     TraceSettings settings_;
     LightSampler lights_;
-    Bounds3f bounds_;
+    Bounds3f bounds_;  // the animation's, padded: escaping segments end where they leave it
 };
 
 }  // namespace qsgi

@@ -16,7 +16,7 @@ SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     device_.checkError("building the scene BVH");
     // Positions are re-centred on the scene (Scene::worldOrigin), so the coordinate magnitude is
     // bounded by the extent; float spacing at the extent is ~1e-7 of it, and 1e-5 leaves margin.
-    const Bounds3f b = scene.bounds();
+    const Bounds3f b = scene.animationBounds;
     rayEpsilon_ = std::max(1e-5f * b.extent(), 64 * std::numeric_limits<float>::epsilon() * b.maxAbsCoordinate());
     if (!(rayEpsilon_ > 0)) rayEpsilon_ = 1e-5f;
 }
@@ -93,6 +93,14 @@ std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& 
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
     const Part& part = rh.hit.geomID == static_.geomId ? static_ : dynamic_;
     return SurfaceHit{rh.ray.tfar, part.triangles[rh.hit.primID], rh.hit.u, rh.hit.v};
+}
+
+bool SceneBvh::occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray = makeRay(origin, direction, tnear, tfar).ray;
+    rtcOccluded1(all_.get(), &context, &ray);
+    return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 
 bool SceneBvh::dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {

@@ -24,6 +24,8 @@ public:
     void updateDynamic(const Scene& scene);
 
     std::optional<SurfaceHit> intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // True if any geometry blocks the ray within (tnear, tfar).
+    bool occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // True if the dynamic geometry alone blocks the ray within (tnear, tfar).
     bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
 

@@ -2,6 +2,18 @@
 
 namespace qsgi {
 
+float Bounds3f::exitDistance(const Vec3f& o, const Vec3f& d) const {
+    if (empty()) return 0;
+    float tfar = std::numeric_limits<float>::max();
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0) continue;
+        const float t0 = (lower[a] - o[a]) / d[a];
+        const float t1 = (upper[a] - o[a]) / d[a];
+        tfar = std::min(tfar, std::max(t0, t1));
+    }
+    return std::isfinite(tfar) && tfar < std::numeric_limits<float>::max() ? std::max(0.0f, tfar) : 0.0f;
+}
+
 Transform Transform::fromTRS(const Vec3d& t, const std::array<double, 4>& q, const Vec3d& s) {
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     // Rotation matrix of a unit quaternion; normalise first so slightly-off inputs stay rigid.

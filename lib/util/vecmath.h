@@ -82,6 +82,23 @@ struct Bounds3f {
     Vec3f center() const { return (lower + upper) * 0.5f; }
     Vec3f diagonal() const { return empty() ? Vec3f(0) : upper - lower; }
     float extent() const { return length(diagonal()); }
+    void extend(const Bounds3f& b) {
+        if (!b.empty()) { extend(b.lower); extend(b.upper); }
+    }
+    Bounds3f expanded(float margin) const {
+        if (empty()) return *this;
+        Bounds3f b = *this;
+        b.lower = lower - Vec3f(margin);
+        b.upper = upper + Vec3f(margin);
+        return b;
+    }
+    bool overlaps(const Bounds3f& b) const {
+        return !empty() && !b.empty() && lower.x <= b.upper.x && b.lower.x <= upper.x && lower.y <= b.upper.y &&
+               b.lower.y <= upper.y && lower.z <= b.upper.z && b.lower.z <= upper.z;
+    }
+    // Distance along the ray o + t·d (d ≠ 0) to where it leaves the box; 0 if it starts outside
+    // and never enters or the box is empty. Escaping photons end there (DESIGN §4, §5).
+    float exitDistance(const Vec3f& o, const Vec3f& d) const;
     // Largest coordinate magnitude: what limits float precision of positions.
     float maxAbsCoordinate() const {
         if (empty()) return 0;

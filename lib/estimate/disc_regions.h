@@ -1,0 +1,64 @@
+// What each vertex's disc can receive (DESIGN §5): its own surface's height band, and which cells
+// of its fixed pattern light can reach from v's side. A cell is reachable when the segment from
+// the start point s_v = v + ε_v⁺·n_v + min(10⁻³ r, ε)·u_v to the cell's centre lifted by ε_v⁺
+// meets no geometry: cells behind an adjacent wall, under a box standing beside v or inside a
+// solid are not. For the photon map a cell is also *covered*: reachable, and a probe from its
+// lifted centre along −n_v first meets a surface facing n_v (within 45°) inside [−ε_v⁻, ε_v⁺]
+// — a photon map has impacts only where there is such a surface.
+//
+// Static vertices are computed once; per frame only the vertices whose test region (the
+// cylinder of radius r, |height| ≤ r, around v) a moved object's old or new bounds touch, and
+// the moved vertices themselves, are recomputed — with the same function, so the result equals a
+// from-scratch computation of that frame.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "estimate/disc_pattern.h"
+#include "scene/scene.h"
+#include "trace/scene_bvh.h"
+
+namespace qsgi {
+
+struct VertexDisc {
+    Vec3f tangent{0.0f}, bitangent{0.0f};  // discFrame(n_v)
+    float epsAbove = 0, epsBelow = 0;        // ε_v⁺, ε_v⁻ (own surface)
+    CellMask reachable;                      // DETP `clip` / `linear`
+    CellMask covered;                        // photon map (only with coverage)
+    uint16_t reachableCells = 0, coveredCells = 0;
+    bool fallback = false;  // empty own surface: the estimators use the `paper` rule here
+
+    bool operator==(const VertexDisc& o) const;
+};
+
+class DiscRegions {
+public:
+    // radius: the disc radius r. withCoverage: also find the photon map's covered cells.
+    DiscRegions(float radius, bool withCoverage) : radius_(radius), withCoverage_(withCoverage) {}
+
+    // Every vertex, for the scene's current pose (bvh must hold that pose).
+    void computeAll(const Scene& scene, const SceneBvh& bvh);
+    // The given vertices only (sorted or not); the rest keep their values.
+    void recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices);
+    // Vertices to recompute after a move: those whose test region overlaps one of `movedBounds`
+    // (old and new bounds of each moved object), and those flagged in `vertexMoved`.
+    std::vector<uint32_t> touchedBy(const Scene& scene, const std::vector<Bounds3f>& movedBounds,
+                                    const std::vector<uint8_t>& vertexMoved) const;
+
+    const VertexDisc& operator[](size_t v) const { return discs_[v]; }
+    size_t size() const { return discs_.size(); }
+    float radius() const { return radius_; }
+    bool hasCoverage() const { return withCoverage_; }
+    // Vertices with an empty own surface (paper fallback), and vertices with no reachable cell
+    // (buried in geometry: E = 0). Both are reported in timing.json.
+    uint64_t fallbackVertices() const;
+    uint64_t buriedVertices() const;
+
+private:
+    float radius_;
+    bool withCoverage_;
+    std::vector<VertexDisc> discs_;
+};
+
+}  // namespace qsgi

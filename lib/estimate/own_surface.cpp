@@ -1,0 +1,183 @@
+#include "estimate/own_surface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace qsgi {
+
+namespace {
+
+// A point of a triangle in v's frame: (x, y) on the tangent plane, h along n_v.
+struct Local {
+    double x, y, h;
+};
+
+Local lerp(const Local& a, const Local& b, double s) {
+    return {a.x + (b.x - a.x) * s, a.y + (b.y - a.y) * s, a.h + (b.h - a.h) * s};
+}
+
+// A triangle clipped by two planes has at most five corners.
+struct Polygon {
+    Local p[5];
+    int size = 0;
+    void push(const Local& l) { p[size++] = l; }
+};
+
+// Clips a convex polygon to h ≤ limit (sign = +1) or h ≥ −limit (sign = −1): Sutherland–Hodgman.
+Polygon clipHeight(const Polygon& poly, double limit, double sign) {
+    Polygon out;
+    for (int i = 0; i < poly.size; ++i) {
+        const Local& a = poly.p[i];
+        const Local& b = poly.p[(i + 1) % poly.size];
+        const double da = limit - sign * a.h, db = limit - sign * b.h;  // ≥ 0: inside
+        if (da >= 0) out.push(a);
+        if ((da >= 0) != (db >= 0)) out.push(lerp(a, b, da / (da - db)));
+    }
+    return out;
+}
+
+bool insideConvex(const Polygon& poly, double x, double y) {
+    double sign = 0;
+    for (int i = 0; i < poly.size; ++i) {
+        const Local& a = poly.p[i];
+        const Local& b = poly.p[(i + 1) % poly.size];
+        const double c = (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
+        if (c == 0) continue;
+        if (sign == 0) sign = c;
+        else if ((c > 0) != (sign > 0)) return false;
+    }
+    return true;
+}
+
+// Height range of a triangle clipped to the cylinder {x² + y² ≤ r², |h| ≤ r}. Returns false if
+// the clipped triangle is empty. The height is affine over the triangle, so its extremes over the
+// convex region lie at polygon corners inside the disc, where edges cross the circle, or where
+// the circle touches the height's gradient direction.
+bool clippedHeightRange(const Local tri[3], double r, double& lo, double& hi) {
+    // Cheap rejection first: all corners on one side of the cylinder's bounding box.
+    for (int axis = 0; axis < 3; ++axis) {
+        auto coord = [&](const Local& l) { return axis == 0 ? l.x : axis == 1 ? l.y : l.h; };
+        if (std::min({coord(tri[0]), coord(tri[1]), coord(tri[2])}) > r) return false;
+        if (std::max({coord(tri[0]), coord(tri[1]), coord(tri[2])}) < -r) return false;
+    }
+    Polygon poly;
+    for (int i = 0; i < 3; ++i) poly.push(tri[i]);
+    poly = clipHeight(poly, r, +1);
+    if (poly.size >= 3) poly = clipHeight(poly, r, -1);
+    if (poly.size < 3) return false;
+    lo = std::numeric_limits<double>::max();
+    hi = -std::numeric_limits<double>::max();
+    auto consider = [&](double h) {
+        lo = std::min(lo, h);
+        hi = std::max(hi, h);
+    };
+    const double r2 = r * r;
+    for (int i = 0; i < poly.size; ++i) {
+        const Local& a = poly.p[i];
+        const Local& b = poly.p[(i + 1) % poly.size];
+        if (a.x * a.x + a.y * a.y <= r2) consider(a.h);
+        // |a + s(b − a)|² = r² for s in [0, 1].
+        const double dx = b.x - a.x, dy = b.y - a.y;
+        const double qa = dx * dx + dy * dy, qb = 2 * (a.x * dx + a.y * dy), qc = a.x * a.x + a.y * a.y - r2;
+        const double disc = qb * qb - 4 * qa * qc;
+        if (qa > 0 && disc >= 0) {
+            const double root = std::sqrt(disc);
+            for (double s : {(-qb - root) / (2 * qa), (-qb + root) / (2 * qa)})
+                if (s >= 0 && s <= 1) consider(a.h + (b.h - a.h) * s);
+        }
+    }
+    // Height gradient over the plane from three non-collinear corners of the original triangle.
+    const double ux = tri[1].x - tri[0].x, uy = tri[1].y - tri[0].y, uh = tri[1].h - tri[0].h;
+    const double vx = tri[2].x - tri[0].x, vy = tri[2].y - tri[0].y, vh = tri[2].h - tri[0].h;
+    const double det = ux * vy - uy * vx;
+    if (det != 0) {
+        const double gx = (uh * vy - vh * uy) / det, gy = (vh * ux - uh * vx) / det;
+        const double g = std::hypot(gx, gy);
+        if (g > 0)
+            for (double sign : {1.0, -1.0}) {
+                const double x = sign * r * gx / g, y = sign * r * gy / g;
+                const double h = tri[0].h + gx * (x - tri[0].x) + gy * (y - tri[0].y);
+                if (std::fabs(h) <= r && insideConvex(poly, x, y)) consider(h);
+            }
+    }
+    return lo <= hi;
+}
+
+}  // namespace
+
+OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& topology,
+                          const std::vector<Vec3f>& frontNormals, float radius, OwnSurfaceScratch& scratch) {
+    OwnSurface own;
+    const Vec3d origin(scene.positions[v]), n(scene.normals[v]);
+    Vec3d t, b;
+    orthonormalBasis(n, t, b);
+    const double r = radius;
+    auto local = [&](uint32_t vertex) {
+        const Vec3d d = Vec3d(scene.positions[vertex]) - origin;
+        return Local{dot(d, t), dot(d, b), dot(d, n)};
+    };
+    auto qualifies = [&](uint32_t tri, double& lo, double& hi) {
+        if (!(dot(frontNormals[tri], scene.normals[v]) > kOwnSurfaceCos)) return false;
+        const Triangle& T = scene.triangles[tri];
+        const Local corners[3] = {local(T.v[0]), local(T.v[1]), local(T.v[2])};
+        return clippedHeightRange(corners, r, lo, hi);
+    };
+
+    // Breadth-first over triangles sharing welded vertices, from the triangles at v.
+    double lowest = 0, highest = 0;
+    Vec3d centroidSum(0.0);
+    double areaSum = 0;
+    // Each search stamps the triangles it visits; a new stamp forgets the last search.
+    if (scratch.visitedStamp.size() != scene.triangleCount() || scratch.stamp == UINT32_MAX) {
+        scratch.visitedStamp.assign(scene.triangleCount(), 0);
+        scratch.stamp = 0;
+    }
+    const uint32_t stamp = ++scratch.stamp;
+    auto firstVisit = [&](uint32_t tri) {
+        if (scratch.visitedStamp[tri] == stamp) return false;
+        scratch.visitedStamp[tri] = stamp;
+        return true;
+    };
+    std::vector<uint32_t>& frontier = scratch.frontier;
+    frontier.clear();
+    for (const uint32_t* it = topology.trianglesBegin(v); it != topology.trianglesEnd(v); ++it) {
+        double lo, hi;
+        firstVisit(*it);
+        if (!qualifies(*it, lo, hi)) continue;
+        frontier.push_back(*it);
+        lowest = std::min(lowest, lo);
+        highest = std::max(highest, hi);
+        const Triangle& T = scene.triangles[*it];
+        const double area = scene.triangleArea(*it);
+        centroidSum += (Vec3d(scene.positions[T.v[0]]) + Vec3d(scene.positions[T.v[1]]) + Vec3d(scene.positions[T.v[2]])) *
+                       (area / 3.0);
+        areaSum += area;
+    }
+    own.empty = frontier.empty();
+    const double eps = scene.sceneEpsilon();
+    if (own.empty) return own;
+    for (size_t i = 0; i < frontier.size(); ++i) {
+        const Triangle& T = scene.triangles[frontier[i]];
+        for (uint32_t corner : T.v)
+            for (const uint32_t* it = topology.trianglesBegin(corner); it != topology.trianglesEnd(corner); ++it) {
+                if (!firstVisit(*it)) continue;
+                double lo, hi;
+                if (!qualifies(*it, lo, hi)) continue;
+                frontier.push_back(*it);
+                lowest = std::min(lowest, lo);
+                highest = std::max(highest, hi);
+            }
+    }
+    own.epsAbove = float(std::min(highest, r) + eps);
+    own.epsBelow = float(std::min(-lowest, r) + eps);
+    if (areaSum > 0) {
+        const Vec3d toCentroid = centroidSum / areaSum - origin;
+        const Vec3d tangential = toCentroid - n * dot(toCentroid, n);
+        // Below ~1e-9 of the radius the direction is rounding noise: no preferred side.
+        if (length(tangential) > 1e-9 * r) own.towardSurface = Vec3f(normalize(tangential));
+    }
+    return own;
+}
+
+}  // namespace qsgi

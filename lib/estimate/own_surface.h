@@ -1,0 +1,44 @@
+// The own surface of a vertex (DESIGN §5): the triangles reached from v across shared (welded)
+// vertices whose front face normals lie strictly within 45° of n_v, clipped to the cylinder C_v
+// of radius r around v's normal, |height| ≤ r. Its largest heights above and below v's tangent
+// plane bound where photons that belong to v's surface can land: DETP counts a segment only if
+// its impact lies at most ε_v⁺ in front of the plane, the photon map only impacts within
+// [−ε_v⁻, ε_v⁺]. Other objects never enter it, so a light panel under a ceiling does not widen
+// the ceiling's band.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scene/mesh_topology.h"
+#include "scene/scene.h"
+
+namespace qsgi {
+
+struct OwnSurface {
+    // No incident triangle within 45° of n_v (a crease vertex with an averaged normal): the
+    // estimators fall back to the `paper` rule there.
+    bool empty = true;
+    // ε_v⁺ and ε_v⁻: largest heights of the clipped surface above / below the tangent plane
+    // (each ≤ r by the clip), plus the scene epsilon.
+    float epsAbove = 0, epsBelow = 0;
+    // u_v: unit tangent direction from v toward the area centroid of its incident own-surface
+    // triangles; zero where that centroid is v itself (an interior vertex of a symmetric fan).
+    Vec3f towardSurface{0.0f};
+};
+
+// Cosine of the 45° limit between a face normal and n_v (strict: dot > this).
+constexpr float kOwnSurfaceCos = 0.70710678f;
+
+// Reusable working memory of findOwnSurface (one per thread).
+struct OwnSurfaceScratch {
+    std::vector<uint32_t> visitedStamp;  // per triangle: the search that last visited it
+    uint32_t stamp = 0;
+    std::vector<uint32_t> frontier;
+};
+
+// Own surface of vertex v in the scene's current pose. frontNormals: Scene::frontFaceNormals().
+OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& topology,
+                          const std::vector<Vec3f>& frontNormals, float radius, OwnSurfaceScratch& scratch);
+
+}  // namespace qsgi

@@ -1,0 +1,57 @@
+#include "scene/mesh_topology.h"
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <tuple>
+
+#include "scene/scene.h"
+
+namespace qsgi {
+
+namespace {
+// Bit pattern of a coordinate, with -0 and +0 made equal (they are the same position).
+uint32_t positionBits(float x) {
+    x += 0.0f;
+    uint32_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    return bits;
+}
+}  // namespace
+
+MeshTopology::MeshTopology(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles) {
+    const size_t n = positions.size();
+    // Sort vertex indices by position (then index): each run of equal positions is one weld.
+    std::vector<uint32_t> order(n);
+    std::iota(order.begin(), order.end(), 0u);
+    auto place = [&](uint32_t v) {
+        return std::make_tuple(positionBits(positions[v].x), positionBits(positions[v].y), positionBits(positions[v].z));
+    };
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return std::make_tuple(place(a), a) < std::make_tuple(place(b), b);
+    });
+    welded_.resize(n);
+    for (size_t i = 0; i < n;) {
+        size_t j = i;
+        while (j < n && place(order[j]) == place(order[i])) ++j;
+        for (size_t k = i; k < j; ++k) welded_[order[k]] = order[i];  // order[i] is the run's smallest index
+        i = j;
+    }
+    // Incident triangles per welded id (counting sort keeps triangle order increasing). A
+    // triangle with two corners at one place is listed once there.
+    auto forEachDistinctCorner = [&](const Triangle& t, auto&& visit) {
+        const uint32_t a = welded_[t.v[0]], b = welded_[t.v[1]], c = welded_[t.v[2]];
+        visit(a);
+        if (b != a) visit(b);
+        if (c != a && c != b) visit(c);
+    };
+    first_.assign(n + 1, 0);
+    for (const Triangle& t : triangles) forEachDistinctCorner(t, [&](uint32_t w) { ++first_[w + 1]; });
+    for (size_t i = 0; i < n; ++i) first_[i + 1] += first_[i];
+    incident_.resize(first_[n]);
+    std::vector<uint32_t> fill(first_.begin(), first_.end() - 1);
+    for (uint32_t t = 0; t < triangles.size(); ++t)
+        forEachDistinctCorner(triangles[t], [&](uint32_t w) { incident_[fill[w]++] = t; });
+}
+
+}  // namespace qsgi

@@ -1,0 +1,31 @@
+// Which triangles meet at each vertex, with vertices welded by exact position, so that a UV or
+// normal seam (two vertices at one place) does not cut a surface in two (DESIGN §5, own surface).
+// Built from plain arrays, so the scene and a PLY read back (qsgi compare) use the same rules.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "util/vecmath.h"
+
+namespace qsgi {
+
+struct Triangle;
+
+class MeshTopology {
+public:
+    MeshTopology(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles);
+
+    // The smallest vertex index at v's position: equal for welded vertices.
+    uint32_t weldedId(uint32_t v) const { return welded_[v]; }
+    // Triangles that have a vertex at v's position, in increasing order.
+    const uint32_t* trianglesBegin(uint32_t v) const { return &incident_[first_[welded_[v]]]; }
+    const uint32_t* trianglesEnd(uint32_t v) const { return &incident_[first_[welded_[v] + 1]]; }
+
+private:
+    std::vector<uint32_t> welded_;
+    std::vector<uint32_t> first_;     // CSR offsets by welded id (only welded ids have entries)
+    std::vector<uint32_t> incident_;  // triangle indices
+};
+
+}  // namespace qsgi

@@ -1,0 +1,268 @@
+#!/usr/bin/env python3
+"""Independent per-vertex reference for qsgi, computed with Mitsuba 3 (a renderer nobody here wrote).
+
+Development only (CI reads the committed outputs; it never runs this). It takes the geometry of a
+frame from a qsgi PLY (world-space positions, normals, triangles: exactly the vertices qsgi
+estimates at) and the materials from the glTF scene, renders the irradiance at every vertex with
+Mitsuba's path tracer, and writes a PLY that `qsgi compare` reads, with radiosity B = rho E + pi L_e.
+
+Irradiance at vertex v (normal n), E = E_direct + E_indirect:
+  - E_direct: next-event estimation to the emitters from v (Mitsuba's sample_emitter_direction,
+    visibility tested), times max(0, cos) — for area lights and point lights alike;
+  - E_indirect: pi x the mean radiance along cosine-weighted rays about n from Mitsuba's `path`
+    integrator, minus the emission of each ray's first hit (that light is in E_direct).
+Queries start 1e-4 of the scene's diagonal off the surface along n and a further 5e-4 of it
+towards the centroid of the vertex's incident triangles, so a vertex on an edge is evaluated on
+its own surface, not inside the adjacent wall.
+
+Setup (Debian 12): pip install mitsuba drjit numpy; apt-get install libllvm19. Debian's LLVM 14/15
+make Dr.Jit's JIT fail ("Cannot select fminimum"), so this script points DRJIT_LIBLLVM_PATH at
+LLVM 19 when it is not set.
+
+  scripts/reference.py SCENE.gltf QSGI_FRAME.ply OUT.ply [--spp N] [--seed S] [--config CONFIG]
+
+CONFIG: a qsgi config whose "lights" are added (point lights only here).
+"""
+import argparse
+import base64
+import glob
+import json
+import os
+import struct
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+if "DRJIT_LIBLLVM_PATH" not in os.environ:
+    for pattern in ("/usr/lib/x86_64-linux-gnu/libLLVM.so.19*", "/usr/lib/llvm-19/lib/libLLVM.so*",
+                    "/usr/lib/x86_64-linux-gnu/libLLVM-19.so*"):
+        found = sorted(glob.glob(pattern))
+        if found:
+            os.environ["DRJIT_LIBLLVM_PATH"] = found[0]
+            break
+
+import drjit as dr  # noqa: E402
+import mitsuba as mi  # noqa: E402
+
+# ---------------------------------------------------------------------------------------------
+# PLY in and out (qsgi's frame_NNNN.ply layout)
+
+VERTEX_DTYPE = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("nx", "<f4"), ("ny", "<f4"), ("nz", "<f4"),
+                         ("radiosity_r", "<f4"), ("radiosity_g", "<f4"), ("radiosity_b", "<f4"),
+                         ("red", "u1"), ("green", "u1"), ("blue", "u1")])
+FACE_DTYPE = np.dtype([("n", "u1"), ("v", "<i4", (3,))])
+
+
+def read_ply(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode("ascii").splitlines()
+    vertices = faces = 0
+    for line in header:
+        if line.startswith("element vertex"):
+            vertices = int(line.split()[2])
+        elif line.startswith("element face"):
+            faces = int(line.split()[2])
+    if "property uchar blue" not in header or "format binary_little_endian 1.0" not in header:
+        sys.exit(f"{path}: not a qsgi frame PLY")
+    v = np.frombuffer(data, VERTEX_DTYPE, vertices, end)
+    fa = np.frombuffer(data, FACE_DTYPE, faces, end + vertices * VERTEX_DTYPE.itemsize)
+    positions = np.stack([v["x"], v["y"], v["z"]], 1).astype(np.float64)
+    normals = np.stack([v["nx"], v["ny"], v["nz"]], 1).astype(np.float64)
+    return positions, normals, fa["v"].astype(np.int64)
+
+
+def write_ply(path, positions, normals, faces, radiosity, comment):
+    v = np.zeros(len(positions), VERTEX_DTYPE)
+    for i, k in enumerate("xyz"):
+        v[k] = positions[:, i]
+        v["n" + k] = normals[:, i]
+    for i, k in enumerate(("radiosity_r", "radiosity_g", "radiosity_b")):
+        v[k] = radiosity[:, i]
+    fa = np.zeros(len(faces), FACE_DTYPE)
+    fa["n"] = 3
+    fa["v"] = faces
+    properties = "".join(f"property float {n}\n" for n in VERTEX_DTYPE.names[:9])
+    properties += "".join(f"property uchar {n}\n" for n in VERTEX_DTYPE.names[9:])
+    header = (f"ply\nformat binary_little_endian 1.0\ncomment {comment}\nelement vertex {len(v)}\n{properties}"
+              f"element face {len(fa)}\nproperty list uchar int vertex_indices\nend_header\n")
+    tmp = path + ".tmp"
+    with open(tmp, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(v.tobytes())
+        f.write(fa.tobytes())
+    os.replace(tmp, path)
+
+
+# ---------------------------------------------------------------------------------------------
+# Materials per vertex, in qsgi's flattening order (DESIGN §2; lib/scene/gltf_loader.cpp): scene
+# roots in order, depth-first pre-order, each node's mesh primitives in order.
+
+def gltf_vertex_materials(path):
+    doc = json.load(open(path))
+    scene = doc["scenes"][doc.get("scene", 0)]
+    materials = doc.get("materials", [])
+    albedo, emission = [], []
+    for m in materials:
+        base = m.get("pbrMetallicRoughness", {}).get("baseColorFactor", [1, 1, 1, 1])[:3]
+        strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
+        albedo.append(base)
+        emission.append([c * strength for c in m.get("emissiveFactor", [0, 0, 0])])
+    default = ([1.0, 1.0, 1.0], [0.0, 0.0, 0.0])
+    per_vertex_albedo, per_vertex_emission = [], []
+
+    def visit(n):
+        node = doc["nodes"][n]
+        if "mesh" in node:
+            for prim in doc["meshes"][node["mesh"]]["primitives"]:
+                if prim.get("mode", 4) not in (4, 5, 6):
+                    continue
+                count = doc["accessors"][prim["attributes"]["POSITION"]]["count"]
+                mat = prim.get("material")
+                a, e = (albedo[mat], emission[mat]) if mat is not None else default
+                per_vertex_albedo.extend([a] * count)
+                per_vertex_emission.extend([e] * count)
+        for c in node.get("children", []):
+            visit(c)
+
+    for n in scene["nodes"]:
+        visit(n)
+    return np.array(per_vertex_albedo, np.float64), np.array(per_vertex_emission, np.float64)
+
+
+def gltf_point_lights(path, config):
+    """KHR_lights_punctual point lights on root-level nodes with a translation, plus config lights."""
+    doc = json.load(open(path))
+    lights = []
+    defs = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    for node in doc.get("nodes", []):
+        ext = node.get("extensions", {}).get("KHR_lights_punctual")
+        if ext is None:
+            continue
+        light = defs[ext["light"]]
+        if light["type"] != "point":
+            sys.exit(f"{path}: only point lights are supported by this script")
+        colour = light.get("color", [1, 1, 1])
+        lights.append((node.get("translation", [0, 0, 0]), [c * light.get("intensity", 1.0) for c in colour]))
+    if config:
+        for light in json.load(open(config)).get("lights", []):
+            if light["type"] != "point":
+                sys.exit(f"{config}: only point lights are supported by this script")
+            lights.append((light["position"], light["intensity"]))
+    return lights
+
+
+# ---------------------------------------------------------------------------------------------
+
+def build_scene(positions, faces, albedo, emission, point_lights, workdir):
+    shapes = {"type": "scene", "integrator": {"type": "path", "max_depth": 64, "rr_depth": 8}}
+    # One mesh per material, from the PLY's world-space triangles.
+    face_material = [(tuple(albedo[f[0]]), tuple(emission[f[0]])) for f in faces]
+    groups = {}
+    for i, key in enumerate(face_material):
+        groups.setdefault(key, []).append(i)
+    for g, ((a, e), members) in enumerate(groups.items()):
+        tri = faces[members]
+        used, remap = np.unique(tri.reshape(-1), return_inverse=True)
+        # Each group goes to Mitsuba as a PLY of its own (flat shading: face normals).
+        path = os.path.join(workdir, f"group{g}.ply")
+        verts = positions[used].astype("<f4")
+        with open(path, "wb") as f:
+            f.write((f"ply\nformat binary_little_endian 1.0\nelement vertex {len(verts)}\nproperty float x\n"
+                     f"property float y\nproperty float z\nelement face {len(tri)}\n"
+                     f"property list uchar int vertex_indices\nend_header\n").encode("ascii"))
+            f.write(verts.tobytes())
+            fa = np.zeros(len(tri), FACE_DTYPE)
+            fa["n"] = 3
+            fa["v"] = remap.reshape(-1, 3)
+            f.write(fa.tobytes())
+        shape = {"type": "ply", "filename": path, "face_normals": True,
+                 "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": list(a)}}}
+        if max(e) > 0:
+            shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": list(e)}}
+        shapes[f"group{g}"] = shape
+    for i, (p, intensity) in enumerate(point_lights):
+        shapes[f"light{i}"] = {"type": "point", "position": list(p), "intensity": {"type": "rgb", "value": list(intensity)}}
+    return mi.load_dict(shapes)
+
+
+def query_points(positions, normals, faces, diagonal):
+    """Start points: off the surface along n, and a step toward the incident triangles' centroid."""
+    centroid_sum = np.zeros_like(positions)
+    count = np.zeros(len(positions))
+    centres = positions[faces].mean(1)
+    for k in range(3):
+        np.add.at(centroid_sum, faces[:, k], centres)
+        np.add.at(count, faces[:, k], 1)
+    towards = centroid_sum / np.maximum(count, 1)[:, None] - positions
+    towards -= normals * np.sum(towards * normals, 1, keepdims=True)
+    length = np.linalg.norm(towards, axis=1, keepdims=True)
+    towards = np.where(length > 1e-9 * diagonal, towards / np.maximum(length, 1e-30), 0)
+    return positions + normals * (1e-4 * diagonal) + towards * (5e-4 * diagonal)
+
+
+def irradiance(scene, origins, normals, spp, seed, chunk):
+    integrator = scene.integrator()
+    out = np.zeros((len(origins), 3))
+    for start in range(0, len(origins), chunk):
+        end = min(len(origins), start + chunk)
+        n = end - start
+        size = n * spp
+        sampler = mi.load_dict({"type": "independent"})
+        sampler.seed(seed + start, size)
+        idx = dr.arange(mi.UInt32, size) // spp
+        o = mi.Point3f(*[dr.gather(mi.Float, mi.Float(origins[start:end, k].astype(np.float32)), idx) for k in range(3)])
+        nn = mi.Normal3f(*[dr.gather(mi.Float, mi.Float(normals[start:end, k].astype(np.float32)), idx) for k in range(3)])
+        frame = mi.Frame3f(nn)
+        # Direct light: one emitter sample per path.
+        it = dr.zeros(mi.Interaction3f)
+        it.p = o
+        it.n = nn
+        it.wavelengths = dr.zeros(mi.Color0f)
+        ds, weight = scene.sample_emitter_direction(it, sampler.next_2d(), True)
+        direct = weight * dr.maximum(0, dr.dot(ds.d, nn))
+        # Indirect light: cosine-weighted rays, minus the first hit's own emission.
+        d = frame.to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d()))
+        ray = mi.Ray3f(o, d)
+        L, _, _ = integrator.sample(scene, sampler, ray)
+        si = scene.ray_intersect(ray)
+        emitted = dr.select(si.is_valid(), si.emitter(scene).eval(si), 0)
+        total = direct + dr.pi * (L - emitted)
+        values = np.array(mi.TensorXf(dr.ravel(total), (size, 3)))
+        out[start:end] = values.reshape(n, spp, 3).mean(1)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("scene")
+    ap.add_argument("frame_ply")
+    ap.add_argument("out")
+    ap.add_argument("--spp", type=int, default=1024, help="paths per vertex (default 1024)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--config", help="qsgi config whose point lights are added")
+    ap.add_argument("--chunk", type=int, default=2048, help="vertices per wavefront")
+    args = ap.parse_args()
+
+    mi.set_variant("llvm_ad_rgb")
+    positions, normals, faces = read_ply(args.frame_ply)
+    albedo, emission = gltf_vertex_materials(args.scene)
+    if len(albedo) != len(positions):
+        sys.exit(f"{args.frame_ply} has {len(positions)} vertices but {args.scene} flattens to {len(albedo)}")
+    diagonal = float(np.linalg.norm(positions.max(0) - positions.min(0)))
+    with tempfile.TemporaryDirectory() as workdir:
+        scene = build_scene(positions, faces, albedo, emission, gltf_point_lights(args.scene, args.config), workdir)
+    started = time.time()
+    E = irradiance(scene, query_points(positions, normals, faces, diagonal), normals, args.spp, args.seed, args.chunk)
+    B = albedo * E + np.pi * emission
+    comment = (f"qsgi reference: Mitsuba {mi.__version__} path tracer, {args.spp} paths + emitter samples per vertex, "
+               f"seed {args.seed}, {time.time() - started:.0f} s")
+    write_ply(args.out, positions, normals, faces, B, comment)
+    print(comment)
+
+
+if __name__ == "__main__":
+    main()
