@@ -33,29 +33,42 @@ const VertexDisc kPaperDisc = [] {
 const VertexDisc& discOf(const DiscRegions* regions, size_t v) { return regions ? (*regions)[v] : kPaperDisc; }
 }  // namespace
 
-bool detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
-                  DetpBoundary rule, DiscCrossing& where) {
+CrossingTest detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc,
+                          float radius, DetpBoundary rule, DiscCrossing& where) {
+    constexpr CrossingTest kNo = CrossingTest::None;
     const Vec3d d(s.direction), n(normal), o(s.origin), v(centre);
     const double dn = dot(d, n);
-    if (!(dn < 0)) return false;  // front side only
+    if (!(dn < 0)) return kNo;  // front side only
     const double tStar = dot(v - o, n) / dn;
-    if (!(tStar > 0)) return false;
+    if (!(tStar > 0)) return kNo;
     const bool paper = rule == DetpBoundary::Paper || disc.fallback;
     if (paper) {
-        if (!(tStar <= double(s.length) + double(radius))) return false;
+        if (!(tStar <= double(s.length) + double(radius))) return kNo;
     } else if (s.hasImpact()) {
         // The impact lies at most ε⁺ in front of the plane; the cap bounds grazing segments.
-        if (!(tStar <= double(s.length) + std::min(double(disc.epsAbove) / -dn, double(radius)))) return false;
+        if (!(tStar <= double(s.length) + std::min(double(disc.epsAbove) / -dn, double(radius)))) return kNo;
     }
     const Vec3d offset = o + d * tStar - v;
     const double r = radius;
-    if (!(dot(offset, offset) <= r * r)) return false;
-    if (paper) return true;
+    if (!(dot(offset, offset) <= r * r)) return kNo;
+    if (paper) return CrossingTest::Counts;
     where.x = dot(offset, Vec3d(disc.tangent)) / r;
     where.y = dot(offset, Vec3d(disc.bitangent)) / r;
     where.cell = discCellOf(where.x, where.y);
-    return disc.reachable.test(where.cell);
+    if (disc.reachable.test(where.cell)) return CrossingTest::Counts;
+    return disc.mixed.test(where.cell) ? CrossingTest::TestPoint : kNo;
 }
+
+bool detpCounts(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
+                DetpBoundary rule, const SceneBvh* bvh, DiscCrossing& where) {
+    switch (detpCrossing(s, centre, normal, disc, radius, rule, where)) {
+        case CrossingTest::None: return false;
+        case CrossingTest::Counts: return true;
+        case CrossingTest::TestPoint: return bvh && discPointReachable(disc, centre, normal, radius, where.x, where.y, *bvh);
+    }
+    return false;
+}
+
 
 namespace {
 
@@ -98,17 +111,19 @@ Vec3f vertexIrradiance(const DiscSums& sums, const VertexDisc& disc, float radiu
     const double r2 = double(radius) * double(radius);
     const Vec3d flux = sums.power.watts(q);
     if (rule == DetpBoundary::Paper || disc.fallback) return Vec3f(flux / (M_PI * r2));
-    if (disc.reachableCells == 0) return Vec3f(0.0f);  // buried in geometry
-    const double area = M_PI * r2 * double(disc.reachableCells) / kDiscCells;
+    if (!(disc.reachableArea > 0)) return Vec3f(0.0f);  // buried in geometry
+    const double area = M_PI * r2 * double(disc.reachableArea);
     const Vec3d clip = flux / area;
     if (rule == DetpBoundary::Clip || disc.reachableCells == kDiscCells) return Vec3f(clip);
     // Linear: least squares of a + b·x + c·y against the crossings over the reachable cells
     // (unit-disc coordinates). Normal equations M (a, b, c) = (Σ Φ, Σ Φx, Σ Φy).
     Symmetric3 m{};
     for (int c = 0; c < kDiscCells; ++c) {
-        if (!disc.reachable.test(c)) continue;
+        const double w = disc.cellShare(c);  // a mixed cell by its reachable share
+        if (w == 0) continue;
         const CellMoments& k = discCellMoments(c);
-        m[0][0] += k.m0, m[0][1] += k.mx, m[0][2] += k.my, m[1][1] += k.mxx, m[1][2] += k.mxy, m[2][2] += k.myy;
+        m[0][0] += w * k.m0, m[0][1] += w * k.mx, m[0][2] += w * k.my;
+        m[1][1] += w * k.mxx, m[1][2] += w * k.mxy, m[2][2] += w * k.myy;
     }
     m[1][0] = m[0][1], m[2][0] = m[0][2], m[2][1] = m[1][2];
     if (!(conditionNumber(m) <= kMaxFitCondition)) return Vec3f(clip);
@@ -142,6 +157,7 @@ VertexSums combine(tbb::enumerable_thread_specific<VertexSums>& perThread, size_
 struct CrossedDisc {
     uint32_t vertex;
     DiscCrossing at;
+    bool testPoint;  // in a mixed cell: decided after the traversal
     bool operator<(const CrossedDisc& o) const { return vertex < o.vertex; }
 };
 
@@ -162,9 +178,9 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
         if (args->valid[i] == 0) continue;
         const uint32_t v = RTCHitN_primID(args->hit, args->N, i);
         DiscCrossing at;
-        if (detpCrossing(*ctx->segment, ctx->scene->positions[v], ctx->scene->normals[v], discOf(ctx->regions, v),
-                         ctx->radius, ctx->rule, at))
-            ctx->crossed->push_back({v, at});
+        const CrossingTest test = detpCrossing(*ctx->segment, ctx->scene->positions[v], ctx->scene->normals[v],
+                                               discOf(ctx->regions, v), ctx->radius, ctx->rule, at);
+        if (test != CrossingTest::None) ctx->crossed->push_back({v, at, test == CrossingTest::TestPoint});
         args->valid[i] = 0;  // reject, so traversal goes on to every other disc along the ray
     }
 }
@@ -172,8 +188,8 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
 }  // namespace
 
 DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule,
-                     const DiscRegions* regions)
-    : scene_(scene), radius_(radius), rule_(rule), regions_(regions), discs_(device) {
+                     const DiscRegions* regions, const SceneBvh* bvh)
+    : scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh), discs_(device) {
     const size_t n = scene.vertexCount();
     const float eps = scene.sceneEpsilon();
     rayExtension_ = 1e-4f * radius + eps;
@@ -261,8 +277,13 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
             crossed.erase(std::unique(crossed.begin(), crossed.end(),
                                       [](const CrossedDisc& a, const CrossedDisc& b) { return a.vertex == b.vertex; }),
                           crossed.end());
-            for (const CrossedDisc& c : crossed) sums[c.vertex].add(s.power, c.at, q, moments);
-            hits += crossed.size();
+            for (const CrossedDisc& c : crossed) {
+                if (c.testPoint && !(bvh_ && discPointReachable(discOf(regions_, c.vertex), scene_.positions[c.vertex],
+                                                                scene_.normals[c.vertex], radius_, c.at.x, c.at.y, *bvh_)))
+                    continue;
+                sums[c.vertex].add(s.power, c.at, q, moments);
+                ++hits;
+            }
         }
     });
     if (stats)
@@ -271,7 +292,7 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
 }
 
 std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
-                                  const DiscRegions* regions) {
+                                  const DiscRegions* regions, const SceneBvh* bvh) {
     const PowerQuantizer q(cache.maxPhotonPower);
     const bool moments = rule == DetpBoundary::Linear;
     VertexSums sums(scene.vertexCount());
@@ -280,7 +301,7 @@ std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, flo
             const VertexDisc& disc = discOf(regions, v);
             DiscCrossing at;
             for (const Segment& s : cache.segments)
-                if (detpCrossing(s, scene.positions[v], scene.normals[v], disc, radius, rule, at))
+                if (detpCounts(s, scene.positions[v], scene.normals[v], disc, radius, rule, bvh, at))
                     sums[v].add(s.power, at, q, moments);
         }
     });
@@ -288,7 +309,8 @@ std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, flo
 }
 
 std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
-                                       const DiscRegions* regions, const std::vector<uint32_t>& vertexOrder) {
+                                       const DiscRegions* regions, const SceneBvh* bvh,
+                                       const std::vector<uint32_t>& vertexOrder) {
     const PowerQuantizer q(cache.maxPhotonPower);
     const bool moments = rule == DetpBoundary::Linear;
     const ImpactIndex index(cache);
@@ -304,7 +326,7 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
             DiscCrossing at;
             for (size_t c : candidates) {
                 const Segment& s = cache.segments[index.segment(c)];
-                if (detpCrossing(s, scene.positions[v], scene.normals[v], disc, radius, rule, at))
+                if (detpCounts(s, scene.positions[v], scene.normals[v], disc, radius, rule, bvh, at))
                     sums[v].add(s.power, at, q, moments);
             }
         }

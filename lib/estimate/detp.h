@@ -37,8 +37,14 @@ struct DiscCrossing {
 };
 
 // The definition. disc: the vertex's regions (its fallback flag switches to the paper rule).
-bool detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
-                  DetpBoundary rule, DiscCrossing& where);
+// TestPoint: the crossing lies in a mixed cell, and counts if discPointReachable says so (kept
+// apart so that the Embree index can test it after its traversal).
+enum class CrossingTest { None, Counts, TestPoint };
+CrossingTest detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc,
+                          float radius, DetpBoundary rule, DiscCrossing& where);
+// detpCrossing with a mixed cell's point decided.
+bool detpCounts(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
+                DetpBoundary rule, const SceneBvh* bvh, DiscCrossing& where);
 
 struct DetpQueryStats {
     uint64_t discHits = 0;  // accepted (segment, disc) pairs
@@ -46,8 +52,10 @@ struct DetpQueryStats {
 
 class DetpDiscs {
 public:
-    // Builds the disc BVH of the scene's current pose. regions may be null for the paper rule.
-    DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule, const DiscRegions* regions);
+    // Builds the disc BVH of the scene's current pose. regions (and bvh, the scene's triangles in
+    // that pose) may be null for the paper rule.
+    DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule, const DiscRegions* regions,
+              const SceneBvh* bvh);
 
     // Irradiance at every vertex from the given segments (in that order), in parallel.
     std::vector<Vec3f> irradiance(const RayCache& cache, const std::vector<uint32_t>& segmentOrder,
@@ -58,6 +66,7 @@ private:
     float radius_;
     DetpBoundary rule_;
     const DiscRegions* regions_;
+    const SceneBvh* bvh_;
     float rayExtension_;  // lets Embree's float tests see crossings at t* ≈ 0 and at the rule's end
     Bounds3f escapeBounds_;  // escaping segments are traced until they leave this box
     EmbreeScene discs_;
@@ -65,14 +74,15 @@ private:
 
 // Index-free reference: every segment against every disc.
 std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
-                                  const DiscRegions* regions);
+                                  const DiscRegions* regions, const SceneBvh* bvh);
 
 // Approximate DETP (--detp-index flann): candidates are the segments whose impact lies within
 // radius·(1 + kFlannCandidateMargin) of the vertex, then the exact test. It misses segments that
 // cross a disc but land far away (silhouettes, convex edges, escaping photons).
 constexpr float kFlannCandidateMargin = 0.25f;
 std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
-                                       const DiscRegions* regions, const std::vector<uint32_t>& vertexOrder);
+                                       const DiscRegions* regions, const SceneBvh* bvh,
+                                       const std::vector<uint32_t>& vertexOrder);
 
 // Segment order for coherent tracing: Morton order of the segments' end points.
 std::vector<uint32_t> segmentMortonOrder(const RayCache& cache);

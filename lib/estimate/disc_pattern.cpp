@@ -62,16 +62,13 @@ const CellMoments& discCellMoments(int cell) {
     return table[cell];
 }
 
-double discAreaWithin(const CellMask& cells, int cellCount, double s) {
-    if (cellCount == kDiscCells) return M_PI * s * s;
+double discAreaWithin(const std::array<double, kDiscRings>& ringShare, double s) {
     const double s2 = s * s;
     double area = 0;
     for (int ring = 0; ring < kDiscRings; ++ring) {
         const double lo = double(ring) / kDiscRings, hi = double(ring + 1) / kDiscRings;
         if (s2 <= lo) break;
-        int inRing = 0;
-        for (int sector = 0; sector < kDiscSectors; ++sector) inRing += cells.test(ring * kDiscSectors + sector);
-        area += M_PI * (std::min(s2, hi) - lo) * inRing / kDiscSectors;
+        area += M_PI * (std::min(s2, hi) - lo) * ringShare[ring];
     }
     return area;
 }

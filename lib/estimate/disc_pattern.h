@@ -41,8 +41,8 @@ const CellMoments& discCellMoments(int cell);
 // Fixed tangent frame of a normal (the same for every caller, so cells mean the same everywhere).
 inline void discFrame(const Vec3f& normal, Vec3f& tangent, Vec3f& bitangent) { orthonormalBasis(normal, tangent, bitangent); }
 
-// Area of the part of the disc of radius s (units of r, 0 < s ≤ 1) that lies in the given cells,
-// each ring taken as uniformly covered by its cells: π s² when every cell is in the mask.
-double discAreaWithin(const CellMask& cells, int cellCount, double s);
+// Area of the part of the disc of radius s (units of r, 0 < s ≤ 1) that is covered, given the
+// covered share (0…1) of each ring, each ring taken as uniformly covered.
+double discAreaWithin(const std::array<double, kDiscRings>& ringShare, double s);
 
 }  // namespace qsgi

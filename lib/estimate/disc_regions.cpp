@@ -12,9 +12,45 @@
 namespace qsgi {
 
 bool VertexDisc::operator==(const VertexDisc& o) const {
-    return tangent == o.tangent && bitangent == o.bitangent && epsAbove == o.epsAbove && epsBelow == o.epsBelow &&
-           reachable == o.reachable && covered == o.covered && reachableCells == o.reachableCells &&
-           coveredCells == o.coveredCells && fallback == o.fallback;
+    return tangent == o.tangent && bitangent == o.bitangent && start == o.start && epsAbove == o.epsAbove &&
+           epsBelow == o.epsBelow && reachable == o.reachable && mixed == o.mixed && covered == o.covered &&
+           reachableCells == o.reachableCells && coveredCells == o.coveredCells && mixedShare == o.mixedShare &&
+           reachableArea == o.reachableArea && fallback == o.fallback;
+}
+
+double VertexDisc::cellShare(int cell) const {
+    if (reachable.test(cell)) return 1;
+    if (!mixed.test(cell)) return 0;
+    for (const auto& [c, share] : mixedShare)
+        if (c == cell) return share / 16.0;
+    return 0;
+}
+
+double VertexDisc::coveredArea(double s) const {
+    if (coveredCells == kDiscCells) return M_PI * s * s;
+    std::array<double, kDiscRings> ringShare{};
+    for (int c = 0; c < kDiscCells; ++c)
+        if (covered.test(c)) ringShare[discRingOf(c)] += cellShare(c) / kDiscSectors;
+    return discAreaWithin(ringShare, s);
+}
+
+namespace {
+// The segment from s_v to a lifted point of the disc meets no geometry.
+bool segmentClear(const Vec3d& start, const Vec3d& target, const SceneBvh& bvh) {
+    const Vec3d d = target - start;
+    const double len = length(d);
+    return !(len > 0) || !bvh.occluded(Vec3f(start), Vec3f(d / len), 0.0f, float(len));
+}
+
+Vec3d liftedDiscPoint(const VertexDisc& disc, const Vec3f& centre, const Vec3f& normal, float radius, double x, double y) {
+    return Vec3d(centre) + (Vec3d(disc.tangent) * x + Vec3d(disc.bitangent) * y) * double(radius) +
+           Vec3d(normal) * double(disc.epsAbove);
+}
+}  // namespace
+
+bool discPointReachable(const VertexDisc& disc, const Vec3f& centre, const Vec3f& normal, float radius, double x,
+                        double y, const SceneBvh& bvh) {
+    return segmentClear(Vec3d(disc.start), liftedDiscPoint(disc, centre, normal, radius, x, y), bvh);
 }
 
 namespace {
@@ -33,23 +69,54 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     disc.epsAbove = own.epsAbove;
     disc.epsBelow = own.epsBelow;
     // Double precision for the points, so the float rays start exactly where the rule says.
-    const Vec3d p(scene.positions[v]), n(normal), t(disc.tangent), b(disc.bitangent);
-    const double r = radius, lift = own.epsAbove;
-    const double sideStep = std::min(1e-3 * r, double(scene.sceneEpsilon()));
-    const Vec3d start = p + n * lift + Vec3d(own.towardSurface) * sideStep;
+    const double sideStep = std::min(1e-3 * double(radius), double(scene.sceneEpsilon()));
+    disc.start = Vec3f(Vec3d(scene.positions[v]) + Vec3d(normal) * double(own.epsAbove) + Vec3d(own.towardSurface) * sideStep);
+    const Vec3d start(disc.start);
+    const Vec3f& centre = scene.positions[v];
+    auto clear = [&](double x, double y) { return segmentClear(start, liftedDiscPoint(disc, centre, normal, radius, x, y), bvh); };
+    // Corners of the polar cells (shared between neighbours): ring boundaries × sector boundaries.
+    std::vector<uint8_t> cornerClear(size_t(kDiscRings + 1) * kDiscSectors);
+    for (int i = 0; i <= kDiscRings; ++i)
+        for (int j = 0; j < kDiscSectors; ++j) {
+            const double rho = std::sqrt(double(i) / kDiscRings), phi = 2 * M_PI * j / kDiscSectors;
+            cornerClear[size_t(i) * kDiscSectors + size_t(j)] = i == 0 ? 1 : clear(rho * std::cos(phi), rho * std::sin(phi));
+        }
+    double share = 0;
     for (int c = 0; c < kDiscCells; ++c) {
+        const int ring = c / kDiscSectors, sector = c % kDiscSectors, next = (sector + 1) % kDiscSectors;
         double x, y;
         discCellCentre(c, x, y);
-        const Vec3d centre = p + (t * x + b * y) * r + n * lift;
-        const Vec3d d = centre - start;
-        const double len = length(d);
-        if (len > 0 && bvh.occluded(Vec3f(start), Vec3f(d / len), 0.0f, float(len))) continue;
-        disc.reachable.set(c);
-        if (!withCoverage) continue;
+        const bool centreClear = clear(x, y);
+        // The centre of ring 0's corners is v itself: its own side, reachable by construction.
+        const uint8_t corners[4] = {cornerClear[size_t(ring) * kDiscSectors + size_t(sector)],
+                                    cornerClear[size_t(ring) * kDiscSectors + size_t(next)],
+                                    cornerClear[size_t(ring + 1) * kDiscSectors + size_t(sector)],
+                                    cornerClear[size_t(ring + 1) * kDiscSectors + size_t(next)]};
+        bool uniform = true;
+        for (int k = ring == 0 ? 2 : 0; k < 4; ++k) uniform = uniform && bool(corners[k]) == centreClear;
+        if (uniform) {
+            if (!centreClear) continue;
+            disc.reachable.set(c);
+            share += 1;
+        } else {
+            int clearSubPoints = 0;
+            for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 4; ++j) {
+                    const double rho = std::sqrt((ring + (i + 0.5) / 4) / kDiscRings);
+                    const double phi = 2 * M_PI * (sector + (j + 0.5) / 4) / kDiscSectors;
+                    clearSubPoints += clear(rho * std::cos(phi), rho * std::sin(phi));
+                }
+            disc.mixed.set(c);
+            disc.mixedShare.emplace_back(uint8_t(c), uint8_t(clearSubPoints));
+            share += clearSubPoints / 16.0;
+        }
+        if (!withCoverage || !(centreClear || disc.mixed.test(c))) continue;
         // Probe straight down through the band [−ε⁻, ε⁺] for a surface facing n_v.
-        const auto hit = bvh.intersect(Vec3f(centre), -normal, 0.0f, own.epsAbove + own.epsBelow);
+        const Vec3d lifted = liftedDiscPoint(disc, centre, normal, radius, x, y);
+        const auto hit = bvh.intersect(Vec3f(lifted), -normal, 0.0f, own.epsAbove + own.epsBelow);
         if (hit && dot(frontNormals[hit->triangle], normal) > kOwnSurfaceCos) disc.covered.set(c);
     }
+    disc.reachableArea = float(share / kDiscCells);
     disc.reachableCells = uint16_t(disc.reachable.count());
     disc.coveredCells = uint16_t(disc.covered.count());
     return disc;
@@ -103,7 +170,13 @@ uint64_t DiscRegions::fallbackVertices() const {
 }
 
 uint64_t DiscRegions::buriedVertices() const {
-    return uint64_t(std::count_if(discs_.begin(), discs_.end(), [](const VertexDisc& d) { return !d.fallback && d.reachableCells == 0; }));
+    return uint64_t(std::count_if(discs_.begin(), discs_.end(), [](const VertexDisc& d) { return !d.fallback && !(d.reachableArea > 0); }));
+}
+
+uint64_t DiscRegions::mixedCells() const {
+    uint64_t n = 0;
+    for (const VertexDisc& d : discs_) n += uint64_t(d.mixed.count());
+    return n;
 }
 
 }  // namespace qsgi

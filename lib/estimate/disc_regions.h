@@ -2,7 +2,11 @@
 // of its fixed pattern light can reach from v's side. A cell is reachable when the segment from
 // the start point s_v = v + ε_v⁺·n_v + min(10⁻³ r, ε)·u_v to the cell's centre lifted by ε_v⁺
 // meets no geometry: cells behind an adjacent wall, under a box standing beside v or inside a
-// solid are not. For the photon map a cell is also *covered*: reachable, and a probe from its
+// solid are not. A cell whose corners disagree with its centre is *mixed* (a wall runs through
+// it): a crossing or impact there is tested on its own with the same kind of segment, and the
+// cell's area counts by the reachable share of 4×4 sub-points. So light beyond a thin partition
+// never counts, however the partition cuts the pattern (DESIGN's centre-only rule lets a cell
+// that straddles the partition count the far side's light). For the photon map a cell is also *covered*: reachable, and a probe from its
 // lifted centre along −n_v first meets a surface facing n_v (within 45°) inside [−ε_v⁻, ε_v⁺]
 // — a photon map has impacts only where there is such a surface.
 //
@@ -23,14 +27,28 @@ namespace qsgi {
 
 struct VertexDisc {
     Vec3f tangent{0.0f}, bitangent{0.0f};  // discFrame(n_v)
+    Vec3f start{0.0f};                       // s_v
     float epsAbove = 0, epsBelow = 0;        // ε_v⁺, ε_v⁻ (own surface)
-    CellMask reachable;                      // DETP `clip` / `linear`
-    CellMask covered;                        // photon map (only with coverage)
-    uint16_t reachableCells = 0, coveredCells = 0;
-    bool fallback = false;  // empty own surface: the estimators use the `paper` rule here
+    CellMask reachable;                      // DETP `clip` / `linear`: reachable, centre and corners
+    CellMask mixed;                          // corners disagree: decide per point
+    CellMask covered;                        // photon map (only with coverage): reachable or mixed,
+                                             // and over a surface facing n_v
+    uint16_t reachableCells = 0, coveredCells = 0;  // counts of `reachable` and `covered`
+    // Reachable share (of 16 sub-points) of each mixed cell, in cell order.
+    std::vector<std::pair<uint8_t, uint8_t>> mixedShare;
+    float reachableArea = 0;  // reachable share of the disc: (cells + mixed shares) / kDiscCells
+    bool fallback = false;    // empty own surface: the estimators use the `paper` rule here
 
     bool operator==(const VertexDisc& o) const;
+    // Share (0…1) of a cell that is reachable.
+    double cellShare(int cell) const;
+    // Photon map: area (units of r²) of the disc of radius s·r that covered cells span.
+    double coveredArea(double s) const;
 };
+
+// Whether the point (x, y) of v's disc (units of r), lifted by ε_v⁺, is reachable from s_v.
+bool discPointReachable(const VertexDisc& disc, const Vec3f& centre, const Vec3f& normal, float radius, double x,
+                        double y, const SceneBvh& bvh);
 
 class DiscRegions {
 public:
@@ -54,6 +72,7 @@ public:
     // (buried in geometry: E = 0). Both are reported in timing.json.
     uint64_t fallbackVertices() const;
     uint64_t buriedVertices() const;
+    uint64_t mixedCells() const;  // cells cut by geometry, over all vertices
 
 private:
     float radius_;

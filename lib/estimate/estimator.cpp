@@ -45,17 +45,17 @@ VertexRadiosity estimateVertexRadiosity(const Scene& scene, const SceneBvh& bvh,
             return estimator.estimate(scene, PowerQuantizer(cache.maxPhotonPower));
         }
         case EstimatorKind::PhotonMap: {
-            const PhotonMap map(cache, scene);
+            const PhotonMap map(cache, scene, &bvh);
             out.irradiance = settings.useIndex ? map.irradiance(scene, regions, settings.radius, settings.k, vertexOrder())
                                                : map.bruteForce(scene, regions, settings.radius, settings.k);
             break;
         }
         case EstimatorKind::Detp: {
-            if (!settings.useIndex) out.irradiance = detpBruteForce(scene, cache, settings.radius, rule, regions);
+            if (!settings.useIndex) out.irradiance = detpBruteForce(scene, cache, settings.radius, rule, regions, &bvh);
             else if (settings.detpIndex == DetpIndex::Flann)
-                out.irradiance = detpFlannCandidates(scene, cache, settings.radius, rule, regions, vertexOrder());
+                out.irradiance = detpFlannCandidates(scene, cache, settings.radius, rule, regions, &bvh, vertexOrder());
             else
-                out.irradiance = DetpDiscs(device, scene, settings.radius, rule, regions)
+                out.irradiance = DetpDiscs(device, scene, settings.radius, rule, regions, &bvh)
                                      .irradiance(cache, settings.sortQueries ? segmentMortonOrder(cache)
                                                                              : inputOrder(cache.segments.size()));
             break;

@@ -9,12 +9,12 @@
 
 namespace qsgi {
 
-PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene)
-    : cache_(cache), index_(cache), frontNormals_(scene.frontFaceNormals()), quantizer_(cache.maxPhotonPower) {}
+PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh)
+    : cache_(cache), index_(cache), frontNormals_(scene.frontFaceNormals()), bvh_(bvh), quantizer_(cache.maxPhotonPower) {}
 
 PhotonMap::VertexFilter PhotonMap::filterFor(const Scene& scene, const DiscRegions* regions, size_t v) const {
     const VertexDisc* disc = regions && !(*regions)[v].fallback ? &(*regions)[v] : nullptr;
-    return VertexFilter{Vec3d(scene.positions[v]), Vec3d(scene.normals[v]), disc};
+    return VertexFilter{Vec3d(scene.positions[v]), Vec3d(scene.normals[v]), disc, regions ? regions->radius() : 0.0f};
 }
 
 bool PhotonMap::counts(const VertexFilter& f, uint32_t impact) const {
@@ -23,8 +23,15 @@ bool PhotonMap::counts(const VertexFilter& f, uint32_t impact) const {
     if (!(dot(s.direction, normal) < 0)) return false;
     if (!f.disc) return true;
     if (!(dot(frontNormals_[s.triangle], normal) > kOwnSurfaceCos)) return false;
-    const double height = dot(Vec3d(index_.point(impact)) - f.position, f.normal);
-    return height <= double(f.disc->epsAbove) && height >= -double(f.disc->epsBelow);
+    const Vec3d offset = Vec3d(index_.point(impact)) - f.position;
+    const double height = dot(offset, f.normal);
+    if (!(height <= double(f.disc->epsAbove) && height >= -double(f.disc->epsBelow))) return false;
+    // Only where light can arrive from v's side: not behind a wall beside v, not under a box.
+    const double x = dot(offset, Vec3d(f.disc->tangent)) / f.radius, y = dot(offset, Vec3d(f.disc->bitangent)) / f.radius;
+    const int cell = discCellOf(x, y);
+    if (f.disc->reachable.test(cell)) return true;
+    return f.disc->mixed.test(cell) && bvh_ &&
+           discPointReachable(*f.disc, Vec3f(f.position), Vec3f(f.normal), f.radius, x, y, *bvh_);
 }
 
 Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const VertexDisc* disc, float radius, int k) const {
@@ -41,9 +48,10 @@ Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const Verte
     double r = full ? std::sqrt(double(sortedFront[found - 1].distanceSquared)) : double(radius);
     if (!(r > 0)) r = double(radius);  // k coincident impacts: no finite density to report
     // The part of the r disc that surfaces facing n_v cover (all of it without regions).
-    const double area = disc ? discAreaWithin(disc->covered, disc->coveredCells, std::min(1.0, r / double(radius))) *
-                                   double(radius) * double(radius)
-                             : M_PI * r * r;
+    double area = disc ? disc->coveredArea(std::min(1.0, r / double(radius))) * double(radius) * double(radius) : M_PI * r * r;
+    // Impacts were counted, yet no covered cell lies within r_k: the pattern is too coarse for
+    // this radius (a radius beyond the surface's size). Keep the textbook area there.
+    if (!(area > 0)) area = summed > 0 ? M_PI * r * r : 0;
     if (!(area > 0)) return Vec3f(0.0f);
     return Vec3f(sum.watts(quantizer_) / area);
 }

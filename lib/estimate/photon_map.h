@@ -24,7 +24,8 @@ namespace qsgi {
 class PhotonMap {
 public:
     // Builds the kd-tree once per photon set; keeps a reference to the cache.
-    PhotonMap(const RayCache& cache, const Scene& scene);
+    // bvh: the scene's triangles in the current pose, to decide impacts in mixed cells.
+    PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh);
 
     // Irradiance at every vertex, queries in `order` (a permutation of the vertices), in parallel.
     // regions: with coverage, for the scene's current pose; null for the textbook rule.
@@ -45,6 +46,7 @@ private:
     struct VertexFilter {
         Vec3d position, normal;
         const VertexDisc* disc;  // null: front side only
+        float radius;            // the regions' disc radius
     };
     VertexFilter filterFor(const Scene& scene, const DiscRegions* regions, size_t v) const;
     bool counts(const VertexFilter& f, uint32_t impact) const;
@@ -54,7 +56,8 @@ private:
 
     const RayCache& cache_;
     ImpactIndex index_;
-    std::vector<Vec3f> frontNormals_;  // of the impacted triangles, for the 45° test
+    std::vector<Vec3f> frontNormals_;
+    const SceneBvh* bvh_;  // of the impacted triangles, for the 45° test
     PowerQuantizer quantizer_;
 };
 

@@ -8,6 +8,11 @@ namespace qsgi {
 SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     : device_(device), all_(device), dynamicOnly_(device) {
     rtcSetSceneBuildQuality(all_.get(), RTC_BUILD_QUALITY_HIGH);
+    // Robust traversal never culls a box that a ray touches: whether a ray grazing a surface at
+    // the scene epsilon (the disc regions' tests) hits must not depend on the BVH's layout, which
+    // changes whenever something moves.
+    rtcSetSceneFlags(all_.get(), RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneFlags(dynamicOnly_.get(), RTC_SCENE_FLAG_ROBUST);
     static_ = addPart(all_.get(), scene, false, RTC_BUILD_QUALITY_HIGH);
     dynamic_ = addPart(all_.get(), scene, true, RTC_BUILD_QUALITY_REFIT);
     dynamicAlone_ = addPart(dynamicOnly_.get(), scene, true, RTC_BUILD_QUALITY_REFIT);

@@ -1,0 +1,144 @@
+// Own surfaces, the disc pattern and disc regions (DESIGN §5): heights on flat and curved
+// surfaces, pattern moments, determinism across thread counts, and per-frame updates that equal a
+// from-scratch computation.
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "estimate/disc_regions.h"
+#include "estimate/own_surface.h"
+#include "scene/animation.h"
+#include "scene/gltf_loader.h"
+#include "scene/mesh_topology.h"
+#include "test_support.h"
+
+using namespace qsgi;
+
+namespace {
+OwnSurface ownSurfaceOf(const Scene& scene, uint32_t v, float radius) {
+    const MeshTopology topology(scene.positions, scene.triangles);
+    OwnSurfaceScratch scratch;
+    return findOwnSurface(v, scene, topology, scene.frontFaceNormals(), radius, scratch);
+}
+
+uint32_t nearestVertex(const Scene& scene, const Vec3f& worldPoint) {
+    uint32_t best = 0;
+    float bestD = 1e30f;
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
+        const Vec3f d = Vec3f(Vec3d(scene.positions[v]) + scene.worldOrigin) - worldPoint;
+        if (dot(d, d) < bestD) bestD = dot(d, d), best = v;
+    }
+    return best;
+}
+}  // namespace
+
+// The half-turn symmetry makes the first moments of the whole pattern vanish; the cell areas sum
+// to π; every cell centre maps back to its own cell.
+TEST(DiscPattern, CellsTileTheUnitDiscSymmetrically) {
+    double area = 0, mx = 0, my = 0, mxx = 0, myy = 0;
+    for (int c = 0; c < kDiscCells; ++c) {
+        const CellMoments& m = discCellMoments(c);
+        EXPECT_NEAR(m.m0, M_PI / kDiscCells, 1e-12);
+        area += m.m0, mx += m.mx, my += m.my, mxx += m.mxx, myy += m.myy;
+        double x, y;
+        discCellCentre(c, x, y);
+        EXPECT_EQ(discCellOf(x, y), c);
+    }
+    EXPECT_NEAR(area, M_PI, 1e-12);
+    EXPECT_NEAR(mx, 0, 1e-12);
+    EXPECT_NEAR(my, 0, 1e-12);
+    EXPECT_NEAR(mxx, M_PI / 4, 1e-12);  // ∫x² over the unit disc
+    EXPECT_NEAR(myy, M_PI / 4, 1e-12);
+    std::array<double, kDiscRings> whole, half;
+    whole.fill(1.0);
+    half.fill(0.5);
+    EXPECT_NEAR(discAreaWithin(whole, 0.5), M_PI * 0.25, 1e-12);
+    EXPECT_NEAR(discAreaWithin(half, 1.0), M_PI * 0.5, 1e-12);
+}
+
+// Flat: both heights are the scene epsilon. Inside a sphere of radius R the surface rises toward
+// the centre: ε⁺ is the sagitta of the clipped cap, R − sqrt(R² − r²) (up to the chords of the
+// tessellation, which lie inside the sphere); outside, ε⁻ is. A light panel 1 cm under a
+// ceiling is another object and never raises the ceiling's ε⁺.
+TEST(OwnSurface, HeightsAreZeroOnFlatSurfacesAndTheSagittaOnCurvedOnes) {
+    const float r = 0.1f;
+    const Scene plane = testscenes::plane(1.0f, 32, Vec3f(0.5f));
+    const OwnSurface flat = ownSurfaceOf(plane, nearestVertex(plane, Vec3f(0, 0, 0)), r);
+    EXPECT_FALSE(flat.empty);
+    EXPECT_FLOAT_EQ(flat.epsAbove, plane.sceneEpsilon());
+    EXPECT_FLOAT_EQ(flat.epsBelow, plane.sceneEpsilon());
+
+    const double sagitta = 1.0 - std::sqrt(1.0 - double(r) * r);
+    for (bool inward : {true, false}) {
+        const Scene sphere = testscenes::closedSphere(1.0f, 5, Vec3f(0.5f), inward);
+        const OwnSurface s = ownSurfaceOf(sphere, 0, r);
+        const double rising = inward ? s.epsAbove : s.epsBelow, other = inward ? s.epsBelow : s.epsAbove;
+        EXPECT_NEAR(rising, sagitta, 0.1 * sagitta) << (inward ? "inside" : "outside");
+        EXPECT_LT(other, 1e-5) << (inward ? "inside" : "outside");
+    }
+
+    Warnings w;
+    const Scene cornell = loadGltfScene((sourceDir() / "data/cornell/cornell.gltf").string(), w);
+    const OwnSurface ceiling = ownSurfaceOf(cornell, nearestVertex(cornell, Vec3f(0, 2, 0)), 0.05f);
+    EXPECT_FALSE(ceiling.empty);
+    EXPECT_LT(ceiling.epsAbove, 1e-4f) << "the light panel 1 mm below must not widen the ceiling's band";
+}
+
+// Same bytes for one thread and for two: each vertex's regions depend on the geometry alone.
+TEST(DiscRegions, AreIdenticalForAnyThreadCount) {
+    Warnings w;
+    const Scene scene = loadGltfScene((sourceDir() / "data/cornell/cornell.gltf").string(), w);
+    EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
+    std::vector<DiscRegions> results;
+    for (size_t threads : {1, 2}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        results.emplace_back(0.05f, true);
+        results.back().computeAll(scene, bvh);
+    }
+    for (size_t v = 0; v < scene.vertexCount(); ++v) ASSERT_TRUE(results[0][v] == results[1][v]) << "vertex " << v;
+    // Cornell has inside edges everywhere along its walls: some vertices see part of their disc only.
+    size_t partial = 0;
+    for (size_t v = 0; v < scene.vertexCount(); ++v) partial += results[0][v].reachableCells < kDiscCells;
+    EXPECT_GT(partial, 1000u);
+    EXPECT_EQ(results[0].fallbackVertices(), 0u);
+}
+
+// The block of data/cornell slides across the floor. Regions updated per frame (the moved
+// vertices and the static vertices whose test region the block's old or new bounds touch) must
+// equal regions computed from scratch for that frame, and far fewer vertices are recomputed.
+TEST(DiscRegions, PerFrameUpdatesEqualAFromScratchComputation) {
+    Warnings w;
+    Scene scene = loadGltfScene((sourceDir() / "data/cornell/cornell.gltf").string(), w);
+    const Animation animation = Animation::fromTransformFile((sourceDir() / "data/cornell/animation.json").string(), scene);
+    scene.markDynamic(animation.movedNodes());
+    sweepAnimationBounds(scene, animation);
+    EmbreeDevice device;
+    scene.applyPose(animation.localsAt(0));
+    DiscRegions updated(0.05f, true);
+    {
+        const SceneBvh bvh(device, scene);
+        updated.computeAll(scene, bvh);
+    }
+    for (int frame : {1, 2, 30}) {
+        std::vector<uint32_t> moved;
+        std::vector<Bounds3f> movedBounds;
+        scene.applyPose(animation.localsAt(frame), &moved, &movedBounds);
+        ASSERT_FALSE(moved.empty());
+        std::vector<uint8_t> vertexMoved(scene.vertexCount(), 0);
+        for (uint32_t i : moved)
+            std::fill_n(vertexMoved.begin() + scene.instances[i].firstVertex, scene.instances[i].vertexCount, 1);
+        const SceneBvh bvh(device, scene);
+        const std::vector<uint32_t> touched = updated.touchedBy(scene, movedBounds, vertexMoved);
+        updated.recompute(scene, bvh, touched);
+        DiscRegions fresh(0.05f, true);
+        fresh.computeAll(scene, bvh);
+        for (size_t v = 0; v < scene.vertexCount(); ++v)
+            ASSERT_TRUE(updated[v] == fresh[v]) << "frame " << frame << " vertex " << v;
+        EXPECT_LT(touched.size(), scene.vertexCount() / 4) << "frame " << frame;
+        std::printf("cornell frame %d: %zu of %zu vertices' disc regions recomputed\n", frame, touched.size(),
+                    scene.vertexCount());
+    }
+}
