@@ -77,33 +77,36 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     return s;
 }
 
-// `qsgi compare`: reads both PLYs and prints the accuracy report.
-int runCompare(const std::string& a, const std::string& b, double borderDistance, bool json) {
+// `qsgi compare`: reads both PLYs and prints the accuracy report, overall and by edge region.
+int runCompare(const std::string& a, const std::string& b, std::optional<double> radiusOption, bool json) {
     const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(a);
     const qsgi::VertexRadiosityPly reference = qsgi::readVertexRadiosityPly(b);
     if (solution.positions.size() != reference.positions.size())
         throw qsgi::InputError(a, "", "has " + std::to_string(solution.positions.size()) + " vertices but " + b + " has " +
                                           std::to_string(reference.positions.size()) + ": not the same scene");
-    if (!(borderDistance >= 0) || !std::isfinite(borderDistance))
-        throw qsgi::InputError("command line", "--border", "must be a non-negative distance");
-    const qsgi::AccuracyReport r = qsgi::compareSolutions(reference.positions, reference.normals, solution.radiosity,
-                                                          reference.radiosity, float(borderDistance));
+    if (radiusOption && (!(*radiusOption > 0) || !std::isfinite(*radiusOption)))
+        throw qsgi::InputError("command line", "--radius", "must be a positive distance (scene units)");
+    // Default: qsgi's own default radius, 1.5 % of the bounding-box diagonal.
+    qsgi::Bounds3f bounds;
+    for (const qsgi::Vec3f& p : reference.positions) bounds.extend(p);
+    const float radius = radiusOption ? float(*radiusOption) : 0.015f * std::max(bounds.extent(), 1e-6f);
+    const qsgi::AccuracyReport r = qsgi::compareSolutions(reference.positions, reference.normals, reference.triangles,
+                                                          solution.radiosity, reference.radiosity, radius);
+    const std::pair<const char*, const qsgi::ErrorStats*> rows[] = {
+        {"all", &r.all}, {"edge", &r.edge}, {"near_edge", &r.nearEdge}, {"interior", &r.interior}};
     if (json) {
-        auto stats = [](const qsgi::ErrorStats& s) {
-            return nlohmann::json{{"vertices", s.vertices}, {"relative_rms", s.relativeRms}, {"relative_bias", s.relativeBias}};
-        };
-        nlohmann::json j{{"solution", a}, {"reference", b}, {"all", stats(r.all)}};
-        if (borderDistance > 0) j["border"] = stats(r.border), j["border_distance"] = borderDistance;
+        nlohmann::json j{{"solution", a}, {"reference", b}, {"radius", radius}};
+        for (const auto& [name, s] : rows)
+            j[name] = {{"vertices", s->vertices}, {"relative_rms", s->relativeRms}, {"relative_bias", s->relativeBias}};
         std::printf("%s\n", j.dump(2).c_str());
         return 0;
     }
-    std::printf("%-28s %10s %14s %14s\n", "vertices", "count", "relative RMS", "relative bias");
-    std::printf("%-28s %10zu %14.5f %+14.5f\n", "all", r.all.vertices, r.all.relativeRms, r.all.relativeBias);
-    if (borderDistance > 0) {
-        char label[64];
-        std::snprintf(label, sizeof label, "within %g of a crease", borderDistance);
-        std::printf("%-28s %10zu %14.5f %+14.5f\n", label, r.border.vertices, r.border.relativeRms, r.border.relativeBias);
-    }
+    std::printf("%-34s %10s %14s %14s\n", "vertices", "count", "relative RMS", "relative bias");
+    const std::string nearLabel = "within " + std::to_string(radius).substr(0, 6) + " of an edge";
+    const char* labels[] = {"all", "on an edge (border, crease > 45°)", nearLabel.c_str(), "interior"};
+    for (size_t i = 0; i < 4; ++i)
+        std::printf("%-34s %10zu %14.5f %+14.5f\n", labels[i], rows[i].second->vertices, rows[i].second->relativeRms,
+                    rows[i].second->relativeBias);
     return 0;
 }
 
@@ -146,12 +149,13 @@ int main(int argc, char** argv) {
     render->add_flag("--verbose", o.verbose, "print per-frame timings");
 
     std::string compareA, compareB;
-    double borderDistance = 0;
+    std::optional<double> compareRadius;
     bool compareJson = false;
     CLI::App* compare = app.add_subcommand("compare", "accuracy of one frame_NNNN.ply against a reference PLY of the same scene");
     compare->add_option("PLY", compareA, "the solution to judge")->required();
     compare->add_option("REFERENCE", compareB, "the reference (e.g. the same estimator at many more photons)")->required();
-    compare->add_option("--border", borderDistance, "also report vertices within this distance of a crease (scene units)");
+    compare->add_option("--radius,--border", compareRadius,
+                        "the 'near an edge' distance, scene units (default 1.5 % of the scene diagonal, qsgi's default radius)");
     compare->add_flag("--json", compareJson, "print JSON instead of a table");
 
     try {
@@ -163,7 +167,7 @@ int main(int argc, char** argv) {
 
     if (compare->parsed()) {
         try {
-            return runCompare(compareA, compareB, borderDistance, compareJson);
+            return runCompare(compareA, compareB, compareRadius, compareJson);
         } catch (const qsgi::InputError& e) {
             std::fprintf(stderr, "qsgi: error: %s\n", e.what());
             return kExitBadInput;

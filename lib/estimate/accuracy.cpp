@@ -1,8 +1,11 @@
 #include "estimate/accuracy.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "estimate/point_index.h"
+#include "scene/mesh_topology.h"
 
 namespace qsgi {
 
@@ -46,12 +49,66 @@ ErrorStats errorStats(const std::vector<Vec3f>& values, const std::vector<Vec3f>
     return s;
 }
 
+std::vector<EdgeRegion> edgeRegions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
+                                    const std::vector<Triangle>& triangles, float radius) {
+    const MeshTopology topology(positions, triangles);
+    // Front face normals: geometric, turned to the side the vertex normals face.
+    auto front = [&](const Triangle& t) {
+        const Vec3d a(positions[t.v[0]]), b(positions[t.v[1]]), c(positions[t.v[2]]);
+        const Vec3f g(normalize(cross(b - a, c - a)));
+        return dot(g, normals[t.v[0]] + normals[t.v[1]] + normals[t.v[2]]) < 0 ? -g : g;
+    };
+    // Every edge (pair of welded ids) with the triangles that use it.
+    std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> users;
+    for (uint32_t t = 0; t < triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) {
+            uint32_t a = topology.weldedId(triangles[t].v[k]), b = topology.weldedId(triangles[t].v[(k + 1) % 3]);
+            if (a == b) continue;
+            users[std::minmax(a, b)].push_back(t);
+        }
+    const float cosCrease = 0.70710678f;
+    std::vector<uint8_t> onEdge(positions.size(), 0);
+    std::vector<Vec3f> edgeSamples;
+    for (const auto& [edge, tris] : users) {
+        bool isEdge = tris.size() != 2;
+        if (!isEdge) isEdge = dot(front(triangles[tris[0]]), front(triangles[tris[1]])) < cosCrease;
+        if (!isEdge) continue;
+        onEdge[edge.first] = onEdge[edge.second] = 1;
+        // Points along the segment every radius/8: distances to it are then exact to radius/16.
+        const Vec3f a = positions[edge.first], b = positions[edge.second];
+        const int steps = std::max(1, int(std::ceil(length(b - a) / (radius / 8))));
+        for (int i = 0; i <= steps; ++i) edgeSamples.push_back(a + (b - a) * (float(i) / float(steps)));
+    }
+    std::vector<EdgeRegion> region(positions.size(), EdgeRegion::Interior);
+    const PointIndex index(edgeSamples);
+    std::vector<size_t> found;
+    std::vector<float> d2;
+    for (size_t v = 0; v < positions.size(); ++v) {
+        if (onEdge[topology.weldedId(uint32_t(v))]) {
+            region[v] = EdgeRegion::OnEdge;
+            continue;
+        }
+        if (!(radius > 0) || edgeSamples.empty()) continue;
+        index.nearest(positions[v], 1, found, d2);
+        if (!found.empty() && d2[0] <= radius * radius) region[v] = EdgeRegion::NearEdge;
+    }
+    return region;
+}
+
 AccuracyReport compareSolutions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
-                                const std::vector<Vec3f>& values, const std::vector<Vec3f>& reference,
-                                float borderDistance) {
+                                const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values,
+                                const std::vector<Vec3f>& reference, float radius) {
     AccuracyReport r;
     r.all = errorStats(values, reference);
-    if (borderDistance > 0) r.border = errorStats(values, reference, verticesNearCreases(positions, normals, borderDistance));
+    const std::vector<EdgeRegion> region = edgeRegions(positions, normals, triangles, radius);
+    auto subset = [&](EdgeRegion which) {
+        std::vector<bool> in(region.size());
+        for (size_t v = 0; v < region.size(); ++v) in[v] = region[v] == which;
+        return in;
+    };
+    r.edge = errorStats(values, reference, subset(EdgeRegion::OnEdge));
+    r.nearEdge = errorStats(values, reference, subset(EdgeRegion::NearEdge));
+    r.interior = errorStats(values, reference, subset(EdgeRegion::Interior));
     return r;
 }
 

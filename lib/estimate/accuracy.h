@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "scene/scene.h"
 #include "util/vecmath.h"
 
 namespace qsgi {
@@ -18,8 +19,18 @@ struct ErrorStats {
 
 struct AccuracyReport {
     ErrorStats all;
-    ErrorStats border;  // vertices within `borderDistance` of a crease (empty if distance is 0)
+    ErrorStats edge;      // vertices on an edge of their surface (a border or a crease of more than 45°)
+    ErrorStats nearEdge;  // within one radius of an edge, not on one
+    ErrorStats interior;  // the rest
 };
+
+enum class EdgeRegion : uint8_t { OnEdge, NearEdge, Interior };
+
+// Region of every vertex: on an edge (an edge of its surface used by one triangle, by more than
+// two, or by two whose front faces turn by more than 45°; vertices welded by position), within
+// `radius` of such an edge (distance to the edge segments, exact to radius/16), or interior.
+std::vector<EdgeRegion> edgeRegions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
+                                    const std::vector<Triangle>& triangles, float radius);
 
 // Vertices near a crease: within `distance` of a vertex whose normal turns by more than 30°
 // from theirs (inside corners, convex edges, silhouettes).
@@ -30,7 +41,7 @@ ErrorStats errorStats(const std::vector<Vec3f>& values, const std::vector<Vec3f>
                       const std::vector<bool>& subset = {});
 
 AccuracyReport compareSolutions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
-                                const std::vector<Vec3f>& values, const std::vector<Vec3f>& reference,
-                                float borderDistance);
+                                const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values,
+                                const std::vector<Vec3f>& reference, float radius);
 
 }  // namespace qsgi

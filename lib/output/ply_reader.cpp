@@ -37,8 +37,9 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     if (!in) throw InputError(path, "", "cannot be opened for reading");
     std::string line;
     if (!std::getline(in, line) || line != "ply") throw InputError(path, "line 1", "not a PLY file");
-    size_t vertexCount = 0;
-    bool inVertex = false, binaryLittleEndian = false, sawVertex = false;
+    size_t vertexCount = 0, faceCount = 0;
+    bool inVertex = false, inFace = false, binaryLittleEndian = false, sawVertex = false;
+    std::string faceCountType, faceIndexType;
     struct Property { std::string name, type; size_t offset; };
     std::vector<Property> properties;
     size_t stride = 0;
@@ -57,11 +58,20 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
             std::string name;
             words >> name;
             inVertex = name == "vertex";
+            inFace = name == "face";
+            if (inFace) words >> faceCount;
             if (inVertex) {
                 if (sawVertex || !properties.empty()) throw InputError(path, "line " + std::to_string(lineNo), "vertex must be the first element");
                 words >> vertexCount;
                 sawVertex = true;
             }
+        } else if (word == "property" && inFace) {
+            std::string type, countType, indexType, name;
+            words >> type >> countType >> indexType >> name;
+            if (type != "list" || name != "vertex_indices" || sizeOfType(countType) == 0 || sizeOfType(indexType) == 0)
+                throw InputError(path, "line " + std::to_string(lineNo), "faces must be a single list property vertex_indices");
+            faceCountType = countType;
+            faceIndexType = indexType;
         } else if (word == "property" && inVertex) {
             std::string type, name;
             words >> type >> name;
@@ -96,6 +106,23 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
         out.normals[v] = {f[3], f[4], f[5]};
         out.radiosity[v] = {f[6], f[7], f[8]};
         if (!isFinite(out.radiosity[v])) throw InputError(path, "vertex " + std::to_string(v), "radiosity is not finite");
+    }
+    // Faces (fanned into triangles), for the edge regions of `qsgi compare`.
+    if (faceCount > (size_t(1) << 31)) throw InputError(path, "header", "implausible face count");
+    std::vector<char> buffer(8);
+    for (size_t f = 0; f < faceCount && !faceIndexType.empty(); ++f) {
+        const std::string where = "face " + std::to_string(f);
+        if (!in.read(buffer.data(), std::streamsize(sizeOfType(faceCountType)))) throw InputError(path, where, "file ends here");
+        const double corners = readScalar(buffer.data(), faceCountType);
+        if (!(corners >= 3 && corners <= 255)) throw InputError(path, where, "has fewer than 3 corners");
+        std::vector<uint32_t> index(static_cast<size_t>(corners));
+        for (uint32_t& i : index) {
+            if (!in.read(buffer.data(), std::streamsize(sizeOfType(faceIndexType)))) throw InputError(path, where, "file ends here");
+            const double value = readScalar(buffer.data(), faceIndexType);
+            if (!(value >= 0 && value < double(vertexCount))) throw InputError(path, where, "refers to a vertex that does not exist");
+            i = uint32_t(value);
+        }
+        for (size_t k = 1; k + 1 < index.size(); ++k) out.triangles.push_back(Triangle{{index[0], index[k], index[k + 1]}});
     }
     return out;
 }

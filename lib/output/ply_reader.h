@@ -5,12 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "scene/scene.h"
 #include "util/vecmath.h"
 
 namespace qsgi {
 
 struct VertexRadiosityPly {
     std::vector<Vec3f> positions, normals, radiosity;
+    std::vector<Triangle> triangles;  // from `element face` (polygons fanned), if present
 };
 
 // Throws InputError naming the file for anything it cannot read.
