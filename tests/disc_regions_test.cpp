@@ -101,7 +101,7 @@ TEST(DiscRegions, AreIdenticalForAnyThreadCount) {
     for (size_t v = 0; v < scene.vertexCount(); ++v) ASSERT_TRUE(results[0][v] == results[1][v]) << "vertex " << v;
     // Cornell has inside edges everywhere along its walls: some vertices see part of their disc only.
     size_t partial = 0;
-    for (size_t v = 0; v < scene.vertexCount(); ++v) partial += results[0][v].reachableCells < kDiscCells;
+    for (size_t v = 0; v < scene.vertexCount(); ++v) partial += results[0][v].reachable.count() < kDiscCells;
     EXPECT_GT(partial, 1000u);
     EXPECT_EQ(results[0].fallbackVertices(), 0u);
 }

@@ -17,17 +17,11 @@ using namespace qsgi;
 
 namespace {
 
-RayCache trace(const Scene& scene, uint64_t photons, uint64_t seed = 11) {
-    EmbreeDevice device;
-    SceneBvh bvh(device, scene);
-    return PhotonTracer(scene, bvh, TraceSettings{photons, seed, 32}).traceAll();
-}
+RayCache trace(const Scene& scene, uint64_t photons, uint64_t seed = 11) { return traceScene(scene, photons, seed); }
 
 std::vector<Vec3f> estimate(const Scene& scene, const RayCache& cache, EstimatorKind kind, float radius, int k = 50,
                             bool useIndex = true, bool sortQueries = true, DetpIndex detpIndex = DetpIndex::Embree,
                             DetpBoundary boundary = DetpBoundary::Clip) {
-    EmbreeDevice device;
-    const SceneBvh bvh(device, scene);
     EstimatorSettings s;
     s.kind = kind;
     s.radius = radius;
@@ -36,7 +30,7 @@ std::vector<Vec3f> estimate(const Scene& scene, const RayCache& cache, Estimator
     s.sortQueries = sortQueries;
     s.detpIndex = detpIndex;
     s.boundary = boundary;
-    return estimateVertexRadiosity(scene, bvh, cache, s, device).irradiance;
+    return estimateWith(scene, cache, s).irradiance;
 }
 
 float largestComponent(const std::vector<Vec3f>& values) {

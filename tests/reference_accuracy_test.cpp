@@ -41,14 +41,12 @@ struct Figures {
 
 Figures measure(const Scene& scene, const RayCache& cache, const VertexRadiosityPly& reference, EstimatorKind kind,
                 DetpBoundary rule, float radius) {
-    EmbreeDevice device;
-    const SceneBvh bvh(device, scene);
     EstimatorSettings s;
     s.kind = kind;
     s.boundary = rule;
     s.radius = radius;
     s.k = 50;
-    const VertexRadiosity result = estimateVertexRadiosity(scene, bvh, cache, s, device);
+    const VertexRadiosity result = estimateWith(scene, cache, s);
     Figures f;
     f.report = compareSolutions(reference.positions, reference.normals, reference.triangles, result.radiosity,
                                 reference.radiosity, radius);
@@ -75,9 +73,7 @@ TEST_P(ReferenceAccuracy, EveryEstimatorStaysWithinItsMeasuredError) {
     // QSGI_REFERENCE_SEED lets a developer measure the seed-to-seed spread the bounds rest on.
     const char* seedText = std::getenv("QSGI_REFERENCE_SEED");
     const uint64_t seed = seedText ? std::strtoull(seedText, nullptr, 10) : 1;
-    EmbreeDevice device;
-    const SceneBvh bvh(device, scene);
-    const RayCache cache = PhotonTracer(scene, bvh, TraceSettings{1000000, seed, 32}).traceAll();
+    const RayCache cache = traceScene(scene, 1000000, seed);
     const std::pair<EstimatorKind, DetpBoundary> estimators[4] = {{EstimatorKind::ImpactCount, DetpBoundary::Clip},
                                                                    {EstimatorKind::PhotonMap, DetpBoundary::Clip},
                                                                    {EstimatorKind::Detp, DetpBoundary::Clip},

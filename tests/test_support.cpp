@@ -8,6 +8,8 @@
 #include <fstream>
 #include <map>
 
+#include "trace/photon_tracer.h"
+
 namespace fs = std::filesystem;
 using namespace qsgi;
 
@@ -32,6 +34,18 @@ CommandResult runQsgi(const std::string& arguments) {
     const int status = pclose(pipe);
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
+}
+
+RayCache traceScene(const Scene& scene, uint64_t photons, uint64_t seed) {
+    EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
+    return PhotonTracer(scene, bvh, TraceSettings{photons, seed, 32}).traceAll();
+}
+
+VertexRadiosity estimateWith(const Scene& scene, const RayCache& cache, const EstimatorSettings& settings) {
+    EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
+    return estimateVertexRadiosity(scene, bvh, cache, settings, device);
 }
 
 namespace testscenes {

@@ -4,7 +4,9 @@
 #include <filesystem>
 #include <string>
 
+#include "estimate/estimator.h"
 #include "scene/scene.h"
+#include "trace/ray_cache.h"
 
 std::filesystem::path sourceDir();  // the repository root
 std::filesystem::path sharedDir();  // ../shared beside the repository (may be absent)
@@ -15,6 +17,12 @@ struct CommandResult {
     std::string output;  // stdout and stderr together
 };
 CommandResult runQsgi(const std::string& arguments);
+
+// Every photon of the scene traced once (max 32 bounces), as a render's first frame does.
+qsgi::RayCache traceScene(const qsgi::Scene& scene, uint64_t photons, uint64_t seed);
+// Density estimation of the scene's current pose with these settings (disc regions computed here).
+qsgi::VertexRadiosity estimateWith(const qsgi::Scene& scene, const qsgi::RayCache& cache,
+                                   const qsgi::EstimatorSettings& settings);
 
 // Scenes built in code, with one instance per mesh (see scene_builders.cpp).
 namespace testscenes {

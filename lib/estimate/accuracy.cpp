@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "estimate/own_surface.h"
 #include "estimate/point_index.h"
 #include "scene/mesh_topology.h"
 
@@ -52,12 +53,7 @@ ErrorStats errorStats(const std::vector<Vec3f>& values, const std::vector<Vec3f>
 std::vector<EdgeRegion> edgeRegions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
                                     const std::vector<Triangle>& triangles, float radius) {
     const MeshTopology topology(positions, triangles);
-    // Front face normals: geometric, turned to the side the vertex normals face.
-    auto front = [&](const Triangle& t) {
-        const Vec3d a(positions[t.v[0]]), b(positions[t.v[1]]), c(positions[t.v[2]]);
-        const Vec3f g(normalize(cross(b - a, c - a)));
-        return dot(g, normals[t.v[0]] + normals[t.v[1]] + normals[t.v[2]]) < 0 ? -g : g;
-    };
+    auto front = [&](uint32_t t) { return frontFaceNormal(positions, normals, triangles[t]); };
     // Every edge (pair of welded ids) with the triangles that use it.
     std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> users;
     for (uint32_t t = 0; t < triangles.size(); ++t)
@@ -66,12 +62,12 @@ std::vector<EdgeRegion> edgeRegions(const std::vector<Vec3f>& positions, const s
             if (a == b) continue;
             users[std::minmax(a, b)].push_back(t);
         }
-    const float cosCrease = 0.70710678f;
     std::vector<uint8_t> onEdge(positions.size(), 0);
     std::vector<Vec3f> edgeSamples;
     for (const auto& [edge, tris] : users) {
         bool isEdge = tris.size() != 2;
-        if (!isEdge) isEdge = dot(front(triangles[tris[0]]), front(triangles[tris[1]])) < cosCrease;
+        // A crease turns by more than the own surface's 45° limit.
+        if (!isEdge) isEdge = dot(front(tris[0]), front(tris[1])) < kOwnSurfaceCos;
         if (!isEdge) continue;
         onEdge[edge.first] = onEdge[edge.second] = 1;
         // Points along the segment every radius/8: distances to it are then exact to radius/16.

@@ -31,17 +31,20 @@ const VertexDisc kPaperDisc = [] {
 }();
 
 const VertexDisc& discOf(const DiscRegions* regions, size_t v) { return regions ? (*regions)[v] : kPaperDisc; }
+
+// The published rule applies: chosen, or the vertex has no own surface.
+bool usesPaperRule(DetpBoundary rule, const VertexDisc& disc) { return rule == DetpBoundary::Paper || disc.fallback; }
 }  // namespace
 
-CrossingTest detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc,
-                          float radius, DetpBoundary rule, DiscCrossing& where) {
-    constexpr CrossingTest kNo = CrossingTest::None;
+Reach detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
+                   DetpBoundary rule, DiscCrossing& where) {
+    constexpr Reach kNo = Reach::No;
     const Vec3d d(s.direction), n(normal), o(s.origin), v(centre);
     const double dn = dot(d, n);
     if (!(dn < 0)) return kNo;  // front side only
     const double tStar = dot(v - o, n) / dn;
     if (!(tStar > 0)) return kNo;
-    const bool paper = rule == DetpBoundary::Paper || disc.fallback;
+    const bool paper = usesPaperRule(rule, disc);
     if (paper) {
         if (!(tStar <= double(s.length) + double(radius))) return kNo;
     } else if (s.hasImpact()) {
@@ -51,24 +54,18 @@ CrossingTest detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& no
     const Vec3d offset = o + d * tStar - v;
     const double r = radius;
     if (!(dot(offset, offset) <= r * r)) return kNo;
-    if (paper) return CrossingTest::Counts;
+    if (paper) return Reach::Yes;
     where.x = dot(offset, Vec3d(disc.tangent)) / r;
     where.y = dot(offset, Vec3d(disc.bitangent)) / r;
     where.cell = discCellOf(where.x, where.y);
-    if (disc.reachable.test(where.cell)) return CrossingTest::Counts;
-    return disc.mixed.test(where.cell) ? CrossingTest::TestPoint : kNo;
+    return reachInCell(disc, where.cell);
 }
 
 bool detpCounts(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
                 DetpBoundary rule, const SceneBvh* bvh, DiscCrossing& where) {
-    switch (detpCrossing(s, centre, normal, disc, radius, rule, where)) {
-        case CrossingTest::None: return false;
-        case CrossingTest::Counts: return true;
-        case CrossingTest::TestPoint: return bvh && discPointReachable(disc, centre, normal, radius, where.x, where.y, *bvh);
-    }
-    return false;
+    const Reach reach = detpCrossing(s, centre, normal, disc, radius, rule, where);
+    return pointReachable(reach, disc, centre, normal, radius, where.x, where.y, bvh);
 }
-
 
 namespace {
 
@@ -110,11 +107,11 @@ Vec3f vertexIrradiance(const DiscSums& sums, const VertexDisc& disc, float radiu
                        const PowerQuantizer& q) {
     const double r2 = double(radius) * double(radius);
     const Vec3d flux = sums.power.watts(q);
-    if (rule == DetpBoundary::Paper || disc.fallback) return Vec3f(flux / (M_PI * r2));
+    if (usesPaperRule(rule, disc)) return Vec3f(flux / (M_PI * r2));
     if (!(disc.reachableArea > 0)) return Vec3f(0.0f);  // buried in geometry
     const double area = M_PI * r2 * double(disc.reachableArea);
     const Vec3d clip = flux / area;
-    if (rule == DetpBoundary::Clip || disc.reachableCells == kDiscCells) return Vec3f(clip);
+    if (rule == DetpBoundary::Clip || disc.reachable.count() == kDiscCells) return Vec3f(clip);
     // Linear: least squares of a + b·x + c·y against the crossings over the reachable cells
     // (unit-disc coordinates). Normal equations M (a, b, c) = (Σ Φ, Σ Φx, Σ Φy).
     Symmetric3 m{};
@@ -157,7 +154,7 @@ VertexSums combine(tbb::enumerable_thread_specific<VertexSums>& perThread, size_
 struct CrossedDisc {
     uint32_t vertex;
     DiscCrossing at;
-    bool testPoint;  // in a mixed cell: decided after the traversal
+    Reach reach;  // TestPoint (a mixed cell) is decided after the traversal
     bool operator<(const CrossedDisc& o) const { return vertex < o.vertex; }
 };
 
@@ -178,9 +175,9 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
         if (args->valid[i] == 0) continue;
         const uint32_t v = RTCHitN_primID(args->hit, args->N, i);
         DiscCrossing at;
-        const CrossingTest test = detpCrossing(*ctx->segment, ctx->scene->positions[v], ctx->scene->normals[v],
-                                               discOf(ctx->regions, v), ctx->radius, ctx->rule, at);
-        if (test != CrossingTest::None) ctx->crossed->push_back({v, at, test == CrossingTest::TestPoint});
+        const Reach reach = detpCrossing(*ctx->segment, ctx->scene->positions[v], ctx->scene->normals[v],
+                                         discOf(ctx->regions, v), ctx->radius, ctx->rule, at);
+        if (reach != Reach::No) ctx->crossed->push_back({v, at, reach});
         args->valid[i] = 0;  // reject, so traversal goes on to every other disc along the ray
     }
 }
@@ -278,8 +275,8 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
                                       [](const CrossedDisc& a, const CrossedDisc& b) { return a.vertex == b.vertex; }),
                           crossed.end());
             for (const CrossedDisc& c : crossed) {
-                if (c.testPoint && !(bvh_ && discPointReachable(discOf(regions_, c.vertex), scene_.positions[c.vertex],
-                                                                scene_.normals[c.vertex], radius_, c.at.x, c.at.y, *bvh_)))
+                if (!pointReachable(c.reach, discOf(regions_, c.vertex), scene_.positions[c.vertex], scene_.normals[c.vertex],
+                                    radius_, c.at.x, c.at.y, bvh_))
                     continue;
                 sums[c.vertex].add(s.power, c.at, q, moments);
                 ++hits;

@@ -37,11 +37,10 @@ struct DiscCrossing {
 };
 
 // The definition. disc: the vertex's regions (its fallback flag switches to the paper rule).
-// TestPoint: the crossing lies in a mixed cell, and counts if discPointReachable says so (kept
-// apart so that the Embree index can test it after its traversal).
-enum class CrossingTest { None, Counts, TestPoint };
-CrossingTest detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc,
-                          float radius, DetpBoundary rule, DiscCrossing& where);
+// Reach::TestPoint: the crossing lies in a mixed cell and counts if pointReachable says so
+// (kept apart so that the Embree index can test it after its traversal).
+Reach detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
+                   DetpBoundary rule, DiscCrossing& where);
 // detpCrossing with a mixed cell's point decided.
 bool detpCounts(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
                 DetpBoundary rule, const SceneBvh* bvh, DiscCrossing& where);

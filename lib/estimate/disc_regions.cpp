@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "estimate/own_surface.h"
@@ -14,8 +15,7 @@ namespace qsgi {
 bool VertexDisc::operator==(const VertexDisc& o) const {
     return tangent == o.tangent && bitangent == o.bitangent && start == o.start && epsAbove == o.epsAbove &&
            epsBelow == o.epsBelow && reachable == o.reachable && mixed == o.mixed && covered == o.covered &&
-           reachableCells == o.reachableCells && coveredCells == o.coveredCells && mixedShare == o.mixedShare &&
-           reachableArea == o.reachableArea && fallback == o.fallback;
+           mixedShare == o.mixedShare && reachableArea == o.reachableArea && fallback == o.fallback;
 }
 
 double VertexDisc::cellShare(int cell) const {
@@ -27,7 +27,7 @@ double VertexDisc::cellShare(int cell) const {
 }
 
 double VertexDisc::coveredArea(double s) const {
-    if (coveredCells == kDiscCells) return M_PI * s * s;
+    if (covered.count() == kDiscCells) return M_PI * s * s;
     std::array<double, kDiscRings> ringShare{};
     for (int c = 0; c < kDiscCells; ++c)
         if (covered.test(c)) ringShare[discRingOf(c)] += cellShare(c) / kDiscSectors;
@@ -53,6 +53,12 @@ bool discPointReachable(const VertexDisc& disc, const Vec3f& centre, const Vec3f
     return segmentClear(Vec3d(disc.start), liftedDiscPoint(disc, centre, normal, radius, x, y), bvh);
 }
 
+bool pointReachable(Reach reach, const VertexDisc& disc, const Vec3f& centre, const Vec3f& normal, float radius,
+                    double x, double y, const SceneBvh* bvh) {
+    if (reach != Reach::TestPoint) return reach == Reach::Yes;
+    return bvh && discPointReachable(disc, centre, normal, radius, x, y, *bvh);
+}
+
 namespace {
 
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
@@ -75,7 +81,7 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     const Vec3f& centre = scene.positions[v];
     auto clear = [&](double x, double y) { return segmentClear(start, liftedDiscPoint(disc, centre, normal, radius, x, y), bvh); };
     // Corners of the polar cells (shared between neighbours): ring boundaries × sector boundaries.
-    std::vector<uint8_t> cornerClear(size_t(kDiscRings + 1) * kDiscSectors);
+    std::array<uint8_t, size_t(kDiscRings + 1) * kDiscSectors> cornerClear;
     for (int i = 0; i <= kDiscRings; ++i)
         for (int j = 0; j < kDiscSectors; ++j) {
             const double rho = std::sqrt(double(i) / kDiscRings), phi = 2 * M_PI * j / kDiscSectors;
@@ -117,8 +123,6 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
         if (hit && dot(frontNormals[hit->triangle], normal) > kOwnSurfaceCos) disc.covered.set(c);
     }
     disc.reachableArea = float(share / kDiscCells);
-    disc.reachableCells = uint16_t(disc.reachable.count());
-    disc.coveredCells = uint16_t(disc.covered.count());
     return disc;
 }
 

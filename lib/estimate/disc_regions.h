@@ -33,7 +33,6 @@ struct VertexDisc {
     CellMask mixed;                          // corners disagree: decide per point
     CellMask covered;                        // photon map (only with coverage): reachable or mixed,
                                              // and over a surface facing n_v
-    uint16_t reachableCells = 0, coveredCells = 0;  // counts of `reachable` and `covered`
     // Reachable share (of 16 sub-points) of each mixed cell, in cell order.
     std::vector<std::pair<uint8_t, uint8_t>> mixedShare;
     float reachableArea = 0;  // reachable share of the disc: (cells + mixed shares) / kDiscCells
@@ -46,9 +45,22 @@ struct VertexDisc {
     double coveredArea(double s) const;
 };
 
+// Whether light reaches a point of v's disc, as far as its cell tells: yes, no, or (a mixed
+// cell) only the point's own segment can say.
+enum class Reach { No, Yes, TestPoint };
+inline Reach reachInCell(const VertexDisc& disc, int cell) {
+    if (disc.reachable.test(cell)) return Reach::Yes;
+    return disc.mixed.test(cell) ? Reach::TestPoint : Reach::No;
+}
+
 // Whether the point (x, y) of v's disc (units of r), lifted by ε_v⁺, is reachable from s_v.
 bool discPointReachable(const VertexDisc& disc, const Vec3f& centre, const Vec3f& normal, float radius, double x,
                         double y, const SceneBvh& bvh);
+
+// The decision for a point whose cell gave `reach`: TestPoint is settled by its own segment
+// (no bvh: not reachable). Every estimator decides through here, so they agree to the bit.
+bool pointReachable(Reach reach, const VertexDisc& disc, const Vec3f& centre, const Vec3f& normal, float radius,
+                    double x, double y, const SceneBvh* bvh);
 
 class DiscRegions {
 public:

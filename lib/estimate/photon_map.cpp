@@ -28,10 +28,8 @@ bool PhotonMap::counts(const VertexFilter& f, uint32_t impact) const {
     if (!(height <= double(f.disc->epsAbove) && height >= -double(f.disc->epsBelow))) return false;
     // Only where light can arrive from v's side: not behind a wall beside v, not under a box.
     const double x = dot(offset, Vec3d(f.disc->tangent)) / f.radius, y = dot(offset, Vec3d(f.disc->bitangent)) / f.radius;
-    const int cell = discCellOf(x, y);
-    if (f.disc->reachable.test(cell)) return true;
-    return f.disc->mixed.test(cell) && bvh_ &&
-           discPointReachable(*f.disc, Vec3f(f.position), Vec3f(f.normal), f.radius, x, y, *bvh_);
+    return pointReachable(reachInCell(*f.disc, discCellOf(x, y)), *f.disc, Vec3f(f.position), Vec3f(f.normal), f.radius,
+                          x, y, bvh_);
 }
 
 Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const VertexDisc* disc, float radius, int k) const {

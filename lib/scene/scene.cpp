@@ -11,14 +11,15 @@ Bounds3f Scene::bounds() const {
     return b;
 }
 
+Vec3f frontFaceNormal(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals, const Triangle& t) {
+    const Vec3d a(positions[t.v[0]]), b(positions[t.v[1]]), c(positions[t.v[2]]);
+    const Vec3f g(normalize(cross(b - a, c - a)));
+    return dot(g, normals[t.v[0]] + normals[t.v[1]] + normals[t.v[2]]) < 0 ? -g : g;
+}
+
 std::vector<Vec3f> Scene::frontFaceNormals() const {
     std::vector<Vec3f> front(triangleCount());
-    for (uint32_t t = 0; t < triangleCount(); ++t) {
-        const Triangle& tri = triangles[t];
-        const Vec3f vertexSide = normals[tri.v[0]] + normals[tri.v[1]] + normals[tri.v[2]];
-        const Vec3f g = geometricNormal(t);
-        front[t] = dot(g, vertexSide) < 0 ? -g : g;
-    }
+    for (uint32_t t = 0; t < triangleCount(); ++t) front[t] = frontFaceNormal(positions, normals, triangles[t]);
     return front;
 }
 

@@ -25,6 +25,10 @@ struct Triangle {
     uint32_t v[3];
 };
 
+// Unit geometric normal of a triangle (CCW winding), turned where needed to the side its vertex
+// normals face: the side the surface receives light on.
+Vec3f frontFaceNormal(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals, const Triangle& t);
+
 enum class LightType { Point, Spot, Directional };
 
 // A punctual light, static by definition (DESIGN §2). intensity is W/sr for point and spot
