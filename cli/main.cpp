@@ -28,7 +28,7 @@ struct CliOptions {
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
     std::optional<double> exposure, radius;
     std::optional<int64_t> k;
-    bool noRayCache = false, noSortQueries = false;
+    bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false;
 };
 
@@ -48,6 +48,8 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.k) s.estimator.k = int(std::clamp<int64_t>(*o.k, -1, 1 << 24));
     if (o.noRayCache) s.estimator.useIndex = false;
     if (o.noSortQueries) s.estimator.sortQueries = false;
+    if (o.fullRecompute) s.fullRecompute = true;
+    if (o.noEnvelope) s.useEnvelope = false;
     if (!o.frames.empty()) s.frames = qsgi::parseFrameRange(o.frames, "command line");
     if (!o.out.empty()) s.outDir = o.out;
     if (o.photons) {
@@ -132,6 +134,11 @@ int main(int argc, char** argv) {
                        "plus a first-order fit at edges) or paper (the published rule; the textbook photon map)");
     render->add_flag("--no-ray-cache", o.noRayCache, "density estimation without any spatial index (brute force)");
     render->add_flag("--no-sort-queries", o.noSortQueries, "queries in input order instead of Morton order");
+    render->add_flag("--full-recompute", o.fullRecompute,
+                     "compute every frame from scratch instead of updating the previous one (same bytes, slower)");
+    render->add_flag("--no-envelope", o.noEnvelope,
+                     "track every light path instead of only those that meet the moving geometry's envelope (same "
+                     "bytes, more memory and work per frame)");
     render->add_option("--photons", o.photons, "photons traced per frame (default 1000000)");
     render->add_option("--seed", o.seed, "random seed (default 1); same seed, same bytes");
     render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");

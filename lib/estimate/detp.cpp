@@ -68,43 +68,51 @@ bool detpCounts(const Segment& s, const Vec3f& centre, const Vec3f& normal, cons
 }
 
 namespace {
-
-__extension__ typedef __int128 Int128;
-
-// Fixed-point sums of one vertex's crossings: Σ Φ and, for `linear`, Σ Φ·x and Σ Φ·y (x, y in
-// units of r, quantised to 2^-20). Integers, so sums are order-independent and exact.
+// Fixed-point scale of the crossing coordinates in the `linear` moments.
 constexpr double kMomentScale = 1048576.0;  // 2^20
-
-struct DiscSums {
-    PowerSum power;
-    Int128 x[3] = {0, 0, 0}, y[3] = {0, 0, 0};
-
-    void add(const Vec3f& phi, const DiscCrossing& at, const PowerQuantizer& q, bool moments) {
-        power.add(phi, q);
-        if (!moments) return;
-        const int64_t qx = std::llround(at.x * kMomentScale), qy = std::llround(at.y * kMomentScale);
-        for (int c = 0; c < 3; ++c) {
-            const int64_t p = q.quantize(phi[c]);
-            x[c] += Int128(p) * qx;
-            y[c] += Int128(p) * qy;
-        }
-    }
-    DiscSums& operator+=(const DiscSums& o) {
-        power += o.power;
-        for (int c = 0; c < 3; ++c) {
-            x[c] += o.x[c];
-            y[c] += o.y[c];
-        }
-        return *this;
-    }
-};
-using VertexSums = std::vector<DiscSums>;
-
 // Above this the reachable region is too thin for a linear fit to be trusted (DESIGN §5).
 constexpr double kMaxFitCondition = 1e4;
+}  // namespace
 
-Vec3f vertexIrradiance(const DiscSums& sums, const VertexDisc& disc, float radius, DetpBoundary rule,
-                       const PowerQuantizer& q) {
+void DetpVertexSums::add(const Vec3f& phi, const DiscCrossing& at, const PowerQuantizer& q, bool moments, int sign) {
+    if (sign > 0) power.add(phi, q);
+    else power.subtract(phi, q);
+    if (!moments) return;
+    const int64_t qx = std::llround(at.x * kMomentScale), qy = std::llround(at.y * kMomentScale);
+    for (int c = 0; c < 3; ++c) {
+        const int64_t p = sign * q.quantize(phi[c]);
+        x[c] += Int128(p) * qx;
+        y[c] += Int128(p) * qy;
+    }
+}
+
+DetpVertexSums& DetpVertexSums::operator+=(const DetpVertexSums& o) {
+    power += o.power;
+    for (int c = 0; c < 3; ++c) {
+        x[c] += o.x[c];
+        y[c] += o.y[c];
+    }
+    return *this;
+}
+
+DetpVertexSums& DetpVertexSums::operator-=(const DetpVertexSums& o) {
+    power.r -= o.power.r, power.g -= o.power.g, power.b -= o.power.b;
+    for (int c = 0; c < 3; ++c) {
+        x[c] -= o.x[c];
+        y[c] -= o.y[c];
+    }
+    return *this;
+}
+
+bool DetpVertexSums::operator==(const DetpVertexSums& o) const {
+    bool same = power.r == o.power.r && power.g == o.power.g && power.b == o.power.b;
+    for (int c = 0; c < 3; ++c) same = same && x[c] == o.x[c] && y[c] == o.y[c];
+    return same;
+}
+
+Vec3f detpVertexIrradiance(const DetpVertexSums& sums, const VertexDisc* discOrNull, float radius, DetpBoundary rule,
+                           const PowerQuantizer& q) {
+    const VertexDisc& disc = discOrNull ? *discOrNull : kPaperDisc;
     const double r2 = double(radius) * double(radius);
     const Vec3d flux = sums.power.watts(q);
     if (usesPaperRule(rule, disc)) return Vec3f(flux / (M_PI * r2));
@@ -135,10 +143,15 @@ Vec3f vertexIrradiance(const DiscSums& sums, const VertexDisc& disc, float radiu
     return Vec3f(out);
 }
 
+namespace {
+
+using VertexSums = std::vector<DetpVertexSums>;
+
 std::vector<Vec3f> toIrradiance(const VertexSums& sums, const DiscRegions* regions, float radius, DetpBoundary rule,
                                 const PowerQuantizer& q) {
     std::vector<Vec3f> out(sums.size());
-    for (size_t v = 0; v < sums.size(); ++v) out[v] = vertexIrradiance(sums[v], discOf(regions, v), radius, rule, q);
+    for (size_t v = 0; v < sums.size(); ++v)
+        out[v] = detpVertexIrradiance(sums[v], regions ? &(*regions)[v] : nullptr, radius, rule, q);
     return out;
 }
 
@@ -171,9 +184,10 @@ struct DiscQueryContext {
 
 void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
     auto* ctx = reinterpret_cast<DiscQueryContext*>(args->context);
+    const auto* vertexOf = static_cast<const uint32_t*>(args->geometryUserPtr);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0) continue;
-        const uint32_t v = RTCHitN_primID(args->hit, args->N, i);
+        const uint32_t v = vertexOf[RTCHitN_primID(args->hit, args->N, i)];
         DiscCrossing at;
         const Reach reach = detpCrossing(*ctx->segment, ctx->scene->positions[v], ctx->scene->normals[v],
                                          discOf(ctx->regions, v), ctx->radius, ctx->rule, at);
@@ -184,48 +198,114 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
 
 }  // namespace
 
+struct DetpDiscs::Crossed : CrossedDisc {};
+
 DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule,
                      const DiscRegions* regions, const SceneBvh* bvh)
-    : scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh), discs_(device) {
-    const size_t n = scene.vertexCount();
+    : scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh), staticDiscs_(device), dynamicDiscs_(device) {
     const float eps = scene.sceneEpsilon();
     rayExtension_ = 1e-4f * radius + eps;
+    // Enlarged discs make Embree's float test a superset of the exact one; the filter decides.
+    searchRadius_ = radius * (1 + 1e-3f) + eps;
     // Every disc lies within r of a vertex, and every vertex inside the animation's bounds.
     escapeBounds_ = scene.animationBounds.expanded(radius + 2 * rayExtension_);
-    RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-    auto* vertex = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
-    auto* normal = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
-    device.checkError("allocating DETP disc buffers");
-    // Enlarged discs make Embree's float test a superset of the exact one; the filter decides.
-    const float searchRadius = radius * (1 + 1e-3f) + eps;
-    for (size_t v = 0; v < n; ++v) {
-        const Vec3f& p = scene.positions[v];
-        vertex[4 * v] = p.x;
-        vertex[4 * v + 1] = p.y;
-        vertex[4 * v + 2] = p.z;
-        vertex[4 * v + 3] = searchRadius;
-        normal[3 * v] = scene.normals[v].x;
-        normal[3 * v + 1] = scene.normals[v].y;
-        normal[3 * v + 2] = scene.normals[v].z;
-    }
-    rtcSetGeometryIntersectFilterFunction(geom, recordCrossedDisc);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(discs_.get(), geom);
-    rtcReleaseGeometry(geom);
-    rtcSetSceneFlags(discs_.get(), RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
-    rtcSetSceneBuildQuality(discs_.get(), RTC_BUILD_QUALITY_HIGH);
-    rtcCommitScene(discs_.get());
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v)
+        (scene.vertexDynamic.size() > v && scene.vertexDynamic[v] ? dynamic_ : static_).vertices.push_back(v);
+    addPart(device, staticDiscs_.get(), static_, RTC_BUILD_QUALITY_HIGH);
+    addPart(device, dynamicDiscs_.get(), dynamic_, RTC_BUILD_QUALITY_REFIT);
     device.checkError("building the DETP disc BVH");
 }
 
-std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vector<uint32_t>& order,
-                                         DetpQueryStats* stats) const {
+void DetpDiscs::addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality) {
+    rtcSetSceneFlags(target, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneBuildQuality(target, quality == RTC_BUILD_QUALITY_HIGH ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+    if (!part.vertices.empty()) {
+        const size_t n = part.vertices.size();
+        RTCGeometry geom = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+        rtcSetGeometryBuildQuality(geom, quality);
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n);
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n);
+        device.checkError("allocating DETP disc buffers");
+        fillPart(geom, part);
+        rtcSetGeometryUserData(geom, part.vertices.data());
+        rtcSetGeometryIntersectFilterFunction(geom, recordCrossedDisc);
+        rtcCommitGeometry(geom);
+        part.geomId = rtcAttachGeometry(target, geom);
+        rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(target);
+}
+
+void DetpDiscs::fillPart(RTCGeometry geom, const Part& part) const {
+    auto* vertex = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    auto* normal = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_NORMAL, 0));
+    for (size_t i = 0; i < part.vertices.size(); ++i) {
+        const Vec3f& p = scene_.positions[part.vertices[i]];
+        const Vec3f& n = scene_.normals[part.vertices[i]];
+        vertex[4 * i] = p.x, vertex[4 * i + 1] = p.y, vertex[4 * i + 2] = p.z, vertex[4 * i + 3] = searchRadius_;
+        normal[3 * i] = n.x, normal[3 * i + 1] = n.y, normal[3 * i + 2] = n.z;
+    }
+}
+
+void DetpDiscs::updateDynamic() {
+    if (dynamic_.geomId == RTC_INVALID_GEOMETRY_ID) return;
+    RTCGeometry geom = rtcGetGeometry(dynamicDiscs_.get(), dynamic_.geomId);
+    fillPart(geom, dynamic_);
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_NORMAL, 0);
+    rtcCommitGeometry(geom);
+    rtcCommitScene(dynamicDiscs_.get());
+}
+
+void DetpDiscs::crossings(const Segment& s, std::vector<Crossed>& out) const {
+    std::vector<CrossedDisc> crossed;
+    DiscQueryContext ctx;
+    rtcInitIntersectContext(&ctx.base);
+    ctx.segment = &s;
+    ctx.scene = &scene_;
+    ctx.regions = regions_;
+    ctx.radius = radius_;
+    ctx.rule = rule_;
+    ctx.crossed = &crossed;
+    // Start a little before the segment and end a little past the farthest point any rule can
+    // count: t + r for an impact, past the padded bounds for an escaping photon.
+    const float slack = rayExtension_;
+    float end = s.length + radius_;
+    if (!s.hasImpact()) end = std::max(end, escapeBounds_.exitDistance(s.origin, s.direction));
+    const Vec3f o = s.origin - s.direction * slack;
+    for (const auto* part : {&static_, &dynamic_}) {
+        if (part->geomId == RTC_INVALID_GEOMETRY_ID) continue;
+        RTCRayHit rh;
+        rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
+        rh.ray.dir_x = s.direction.x; rh.ray.dir_y = s.direction.y; rh.ray.dir_z = s.direction.z;
+        rh.ray.tnear = 0;
+        rh.ray.tfar = end + 2 * slack;
+        rh.ray.time = 0;
+        rh.ray.mask = 0xFFFFFFFFu;
+        rh.ray.id = 0;
+        rh.ray.flags = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(part == &static_ ? staticDiscs_.get() : dynamicDiscs_.get(), &ctx.base, &rh);
+    }
+    // Embree may report a primitive more than once along one ray (NOTES.md).
+    std::sort(crossed.begin(), crossed.end());
+    crossed.erase(std::unique(crossed.begin(), crossed.end(),
+                              [](const CrossedDisc& a, const CrossedDisc& b) { return a.vertex == b.vertex; }),
+                  crossed.end());
+    out.clear();
+    for (const CrossedDisc& c : crossed)
+        if (pointReachable(c.reach, discOf(regions_, c.vertex), scene_.positions[c.vertex], scene_.normals[c.vertex], radius_,
+                           c.at.x, c.at.y, bvh_))
+            out.push_back(Crossed{c});
+}
+
+std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, const std::vector<uint32_t>& order,
+                                            DetpQueryStats* stats) const {
     const size_t vertices = scene_.vertexCount();
     const PowerQuantizer q(cache.maxPhotonPower);
     const bool moments = rule_ == DetpBoundary::Linear;
     tbb::enumerable_thread_specific<VertexSums> perThread([&] { return VertexSums(vertices); });
     tbb::enumerable_thread_specific<uint64_t> hitCount(0);
-    const float slack = rayExtension_;
     // A reordering is gathered into a copy first, so tracing streams through memory instead of
     // jumping through the cache by index (which costs more than the coherence gains).
     bool inputOrder = order.size() == cache.segments.size();
@@ -241,51 +321,59 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
     tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         VertexSums& sums = perThread.local();
         uint64_t& hits = hitCount.local();
-        std::vector<CrossedDisc> crossed;
+        std::vector<Crossed> crossed;
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            const Segment& s = ordered[i];
-            crossed.clear();
-            DiscQueryContext ctx;
-            rtcInitIntersectContext(&ctx.base);
-            ctx.segment = &s;
-            ctx.scene = &scene_;
-            ctx.regions = regions_;
-            ctx.radius = radius_;
-            ctx.rule = rule_;
-            ctx.crossed = &crossed;
-            // Start a little before the segment and end a little past the farthest point any
-            // rule can count: t + r for an impact, past the padded bounds for an escaping photon.
-            float end = s.length + radius_;
-            if (!s.hasImpact()) end = std::max(end, escapeBounds_.exitDistance(s.origin, s.direction));
-            RTCRayHit rh;
-            const Vec3f o = s.origin - s.direction * slack;
-            rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
-            rh.ray.dir_x = s.direction.x; rh.ray.dir_y = s.direction.y; rh.ray.dir_z = s.direction.z;
-            rh.ray.tnear = 0;
-            rh.ray.tfar = end + 2 * slack;
-            rh.ray.time = 0;
-            rh.ray.mask = 0xFFFFFFFFu;
-            rh.ray.id = 0;
-            rh.ray.flags = 0;
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(discs_.get(), &ctx.base, &rh);
-            // Embree may report a primitive more than once along one ray (NOTES.md).
-            std::sort(crossed.begin(), crossed.end());
-            crossed.erase(std::unique(crossed.begin(), crossed.end(),
-                                      [](const CrossedDisc& a, const CrossedDisc& b) { return a.vertex == b.vertex; }),
-                          crossed.end());
-            for (const CrossedDisc& c : crossed) {
-                if (!pointReachable(c.reach, discOf(regions_, c.vertex), scene_.positions[c.vertex], scene_.normals[c.vertex],
-                                    radius_, c.at.x, c.at.y, bvh_))
-                    continue;
-                sums[c.vertex].add(s.power, c.at, q, moments);
-                ++hits;
-            }
+            crossings(ordered[i], crossed);
+            for (const Crossed& c : crossed) sums[c.vertex].add(ordered[i].power, c.at, q, moments);
+            hits += crossed.size();
         }
     });
     if (stats)
         for (uint64_t h : hitCount) stats->discHits += h;
-    return toIrradiance(combine(perThread, vertices), regions_, radius_, rule_, q);
+    return combine(perThread, vertices);
+}
+
+std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vector<uint32_t>& order,
+                                         DetpQueryStats* stats) const {
+    return toIrradiance(sums(cache, order, stats), regions_, radius_, rule_, PowerQuantizer(cache.maxPhotonPower));
+}
+
+void DetpDiscs::accumulate(const std::vector<Segment>& segments, const PowerQuantizer& q, int sign,
+                           const std::vector<uint8_t>& skip, std::vector<DetpVertexSums>& sums,
+                           std::vector<uint32_t>& changed) const {
+    const bool moments = rule_ == DetpBoundary::Linear;
+    // Crossings are found in parallel and applied in one thread: few segments change per frame,
+    // and a per-thread copy of every vertex's sums would cost more than the work.
+    struct Hit {
+        uint32_t segment;
+        Crossed at;
+    };
+    tbb::enumerable_thread_specific<std::vector<Hit>> perThread;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        auto& hits = perThread.local();
+        std::vector<Crossed> crossed;
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            crossings(segments[i], crossed);
+            for (const Crossed& c : crossed)
+                if (!skip[c.vertex]) hits.push_back({uint32_t(i), c});
+        }
+    });
+    for (const auto& hits : perThread)
+        for (const Hit& h : hits) {
+            sums[h.at.vertex].add(segments[h.segment].power, h.at.at, q, moments, sign);
+            changed.push_back(h.at.vertex);
+        }
+}
+
+DetpVertexSums detpVertexSums(const Scene& scene, uint32_t v, const std::vector<const Segment*>& segments, float radius,
+                              DetpBoundary rule, const DiscRegions* regions, const SceneBvh* bvh, const PowerQuantizer& q) {
+    DetpVertexSums sums;
+    const VertexDisc& disc = discOf(regions, v);
+    DiscCrossing at;
+    for (const Segment* s : segments)
+        if (detpCounts(*s, scene.positions[v], scene.normals[v], disc, radius, rule, bvh, at))
+            sums.add(s->power, at, q, rule == DetpBoundary::Linear);
+    return sums;
 }
 
 std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "estimate/disc_regions.h"
+#include "estimate/fixed_point_power.h"
 #include "scene/scene.h"
 #include "trace/embree_device.h"
 #include "trace/ray_cache.h"
@@ -49,27 +50,76 @@ struct DetpQueryStats {
     uint64_t discHits = 0;  // accepted (segment, disc) pairs
 };
 
+// One vertex's fixed-point sums: Σ Φ and, for `linear`, Σ Φ·x and Σ Φ·y (x, y in units of r,
+// quantised to 2^-20). Integers, so sums are order-independent, and "+ new − old" is exact.
+struct DetpVertexSums {
+    __extension__ typedef __int128 Int128;
+    PowerSum power;
+    Int128 x[3] = {0, 0, 0}, y[3] = {0, 0, 0};
+
+    void add(const Vec3f& phi, const DiscCrossing& at, const PowerQuantizer& q, bool moments, int sign = 1);
+    DetpVertexSums& operator+=(const DetpVertexSums& o);
+    DetpVertexSums& operator-=(const DetpVertexSums& o);
+    bool operator==(const DetpVertexSums& o) const;
+};
+
+// E_v from its sums and disc (the rule's area or linear fit).
+Vec3f detpVertexIrradiance(const DetpVertexSums& sums, const VertexDisc* disc, float radius, DetpBoundary rule,
+                           const PowerQuantizer& q);
+
 class DetpDiscs {
 public:
-    // Builds the disc BVH of the scene's current pose. regions (and bvh, the scene's triangles in
-    // that pose) may be null for the paper rule.
+    // Builds the disc BVHs: static vertices' discs once, dynamic vertices' discs refitted by
+    // updateDynamic. regions (and bvh, the scene's triangles) may be null for the paper rule;
+    // both are read at query time, so they must hold the pose being queried.
     DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule, const DiscRegions* regions,
               const SceneBvh* bvh);
 
-    // Irradiance at every vertex from the given segments (in that order), in parallel.
+    // Moves the dynamic vertices' discs to the scene's current pose.
+    void updateDynamic();
+
+    // Every vertex's sums from the given segments (in that order), in parallel.
+    std::vector<DetpVertexSums> sums(const RayCache& cache, const std::vector<uint32_t>& segmentOrder,
+                                     DetpQueryStats* stats = nullptr) const;
+    // Irradiance at every vertex from the given segments (in that order).
     std::vector<Vec3f> irradiance(const RayCache& cache, const std::vector<uint32_t>& segmentOrder,
                                   DetpQueryStats* stats = nullptr) const;
+    // Adds (sign +1) or subtracts (−1) the segments' crossings to `sums`, except at vertices
+    // flagged in `skip` (those an update recomputes). Returns the vertices changed (unsorted, may
+    // repeat).
+    void accumulate(const std::vector<Segment>& segments, const PowerQuantizer& q, int sign, const std::vector<uint8_t>& skip,
+                    std::vector<DetpVertexSums>& sums, std::vector<uint32_t>& changed) const;
+
+    const DiscRegions* regions() const { return regions_; }
+    DetpBoundary rule() const { return rule_; }
+    float radius() const { return radius_; }
 
 private:
+    struct Crossed;
+    void crossings(const Segment& s, std::vector<Crossed>& out) const;  // sorted by vertex, decided
+    struct Part {
+        std::vector<uint32_t> vertices;  // primID -> scene vertex
+        unsigned geomId = RTC_INVALID_GEOMETRY_ID;
+    };
+    void addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality);
+    void fillPart(RTCGeometry geom, const Part& part) const;
+
     const Scene& scene_;
     float radius_;
     DetpBoundary rule_;
     const DiscRegions* regions_;
     const SceneBvh* bvh_;
     float rayExtension_;  // lets Embree's float tests see crossings at t* ≈ 0 and at the rule's end
+    float searchRadius_;  // the discs in Embree, slightly enlarged (a superset of the exact test)
     Bounds3f escapeBounds_;  // escaping segments are traced until they leave this box
-    EmbreeScene discs_;
+    EmbreeScene staticDiscs_, dynamicDiscs_;
+    Part static_, dynamic_;
 };
+
+// One vertex's sums from the given segments (the exact test on each; an update's recomputed
+// vertices, with the segments the tracked-path grid lists near the disc).
+DetpVertexSums detpVertexSums(const Scene& scene, uint32_t vertex, const std::vector<const Segment*>& segments, float radius,
+                              DetpBoundary rule, const DiscRegions* regions, const SceneBvh* bvh, const PowerQuantizer& q);
 
 // Index-free reference: every segment against every disc.
 std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,

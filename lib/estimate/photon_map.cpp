@@ -70,16 +70,22 @@ std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, const DiscRegions* 
             // Impacts that do not count are skipped, so ask the tree for more neighbours until k
             // counted ones are found or the candidates run past the radius.
             size_t want = std::min(n, size_t(2 * k));
+            // Distances are recomputed as bruteForce computes them, and the search grows until no
+            // impact beyond the candidates can tie with the k-th counted one.
             while (true) {
                 index_.nearest(scene.positions[v], want, indices, d2);
                 front.clear();
-                for (size_t i = 0; i < want; ++i)
-                    if (d2[i] <= radiusSquared && counts(filter, uint32_t(indices[i])))
-                        front.push_back({d2[i], uint32_t(indices[i])});
-                if (front.size() >= size_t(k) || want == n || d2[want - 1] > radiusSquared) break;
+                float farthest = 0;
+                for (size_t i = 0; i < want; ++i) {
+                    const float dd = PointIndex::distanceSquared(scene.positions[v], index_.point(indices[i]));
+                    farthest = std::max(farthest, dd);
+                    if (dd <= radiusSquared && counts(filter, uint32_t(indices[i]))) front.push_back(neighbour(dd, uint32_t(indices[i])));
+                }
+                std::sort(front.begin(), front.end());
+                if (want == n || farthest > radiusSquared) break;
+                if (front.size() >= size_t(k) && farthest > front[size_t(k) - 1].distanceSquared) break;
                 want = std::min(n, want * 4);
             }
-            std::sort(front.begin(), front.end());
             out[v] = estimate(front, filter.disc, radius, k);
         }
     });
@@ -97,8 +103,7 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
             const VertexFilter filter = filterFor(scene, regions, v);
             for (size_t i = 0; i < index_.size(); ++i) {
                 const float d2 = PointIndex::distanceSquared(scene.positions[v], index_.point(i));
-                if (d2 <= radiusSquared && counts(filter, uint32_t(i)))
-                    front.push_back({d2, uint32_t(i)});
+                if (d2 <= radiusSquared && counts(filter, uint32_t(i))) front.push_back(neighbour(d2, uint32_t(i)));
             }
             const size_t keep = std::min(front.size(), size_t(k));
             std::partial_sort(front.begin(), front.begin() + keep, front.end());

@@ -35,13 +35,20 @@ public:
     std::vector<Vec3f> bruteForce(const Scene& scene, const DiscRegions* regions, float radius, int k) const;
 
 private:
+    // Equal distances are ordered by (path, bounce): the k nearest are the same set whatever
+    // order the cache holds the impacts in (an incremental update reorders it).
     struct Neighbour {
         float distanceSquared;
+        uint64_t pathBounce;
         uint32_t impact;
         bool operator<(const Neighbour& o) const {
-            return distanceSquared < o.distanceSquared || (distanceSquared == o.distanceSquared && impact < o.impact);
+            return distanceSquared < o.distanceSquared || (distanceSquared == o.distanceSquared && pathBounce < o.pathBounce);
         }
     };
+    Neighbour neighbour(float distanceSquared, uint32_t impact) const {
+        const Segment& s = segmentOf(impact);
+        return {distanceSquared, uint64_t(s.path) << 16 | s.bounce, impact};
+    }
     // Whether impact i counts for vertex v (front side, and v's own band with regions).
     struct VertexFilter {
         Vec3d position, normal;

@@ -30,7 +30,7 @@ void TimingLog::write(const std::filesystem::path& path) const {
                    {"k", estimator == "photon-map" ? nlohmann::json(k) : nlohmann::json(nullptr)},
                    {"detp_index", estimator == "detp" ? nlohmann::json(detpIndex) : nlohmann::json(nullptr)},
                    {"detp_boundary", hasRadius ? nlohmann::json(boundary) : nlohmann::json(nullptr)},
-                   {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute},
+                   {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute}, {"envelope", envelope},
                    {"seed", seed}, {"threads", threads}};
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
@@ -46,7 +46,12 @@ void TimingLog::write(const std::filesystem::path& path) const {
                                {"frame_s", summary(estimates)}};
     json list = json::array();
     for (const FrameTiming& f : frames)
-        list.push_back({{"frame", f.frame}, {"photon_update_s", f.photonSimulationSeconds},
+        list.push_back({{"frame", f.frame}, {"from_scratch", f.fromScratch}, {"photon_update_s", f.photonSimulationSeconds},
+                        {"find_affected_s", f.findAffectedSeconds}, {"retrace_s", f.retraceSeconds},
+                        {"paths_affected_by_impact", f.pathsAffectedByImpact},
+                        {"paths_affected_by_blocking", f.pathsAffectedByBlocking}, {"tracked_paths", f.trackedPaths},
+                        {"tracked_segments", f.trackedSegments}, {"tracked_bytes", f.trackedBytes},
+                        {"recompute_s", f.recomputeSeconds}, {"vertices_recomputed", f.verticesRecomputed},
                         {"estimation_s", f.estimationSeconds}, {"render_s", f.renderSeconds},
                         {"write_s", f.writeSeconds},
                         {"segments", f.segments}, {"photons_missing_scene", f.photonsMissingScene}, {"paths_retraced", f.pathsRetraced},

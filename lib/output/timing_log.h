@@ -11,6 +11,8 @@ namespace qsgi {
 
 struct FrameTiming {
     int frame = 0;
+    bool fromScratch = true;             // computed from scratch, or by the incremental update
+    double findAffectedSeconds = 0, retraceSeconds = 0;  // the parts of an update's photon time
     double photonSimulationSeconds = 0;  // tracing (or retracing) photons
     double estimationSeconds = 0;        // density estimation
     double renderSeconds = 0;            // the camera view (EXR/PNG), excluding file writing
@@ -18,8 +20,12 @@ struct FrameTiming {
     uint64_t segments = 0;               // segments in the ray cache after this frame
     uint64_t photonsMissingScene = 0;    // photons whose first segment hit nothing
     uint64_t pathsRetraced = 0;
+    uint64_t pathsAffectedByImpact = 0, pathsAffectedByBlocking = 0;  // DESIGN §6 step 2 (a), (b)
+    uint64_t trackedPaths = 0, trackedSegments = 0, trackedBytes = 0;  // what frames search (§6.5)
     uint64_t segmentsRemoved = 0, segmentsAdded = 0;
     uint64_t verticesUpdated = 0;
+    double recomputeSeconds = 0;    // DETP: recomputing the vertices the move touched
+    uint64_t verticesRecomputed = 0;
     // Disc regions (DESIGN §5): time, vertices (re)computed this frame, and the vertices with an
     // empty own surface (paper fallback) or no reachable cell (buried: E = 0).
     double discRegionsSeconds = 0;
@@ -37,7 +43,9 @@ struct TimingLog {
     std::string boundary;  // DETP / photon-map boundary rule
     uint64_t photons = 0, seed = 0;
     int threads = 0;
-    bool fullRecompute = true;
+    bool fullRecompute = false;
+    bool envelope = true;
+    uint64_t photonsMissingScene = 0;  // at the run's first frame
     // scene
     std::string scene;
     uint64_t vertices = 0, triangles = 0, dynamicVertices = 0, lights = 0;

@@ -15,6 +15,7 @@
 #include "output/ply_writer.h"
 #include "output/radiosity_image.h"
 #include "output/timing_log.h"
+#include "pipeline/frame_solver.h"
 #include "scene/gltf_loader.h"
 #include "trace/photon_tracer.h"
 #include "util/progress.h"
@@ -124,6 +125,8 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     log.radius = settings_.estimator.radius;
     log.k = settings_.estimator.k;
     log.rayCache = settings_.estimator.useIndex;
+    log.fullRecompute = settings_.fullRecompute;
+    log.envelope = settings_.useEnvelope;
     log.sortQueries = settings_.estimator.sortQueries;
     log.detpIndex = settings_.estimator.detpIndex == DetpIndex::Flann ? "flann" : "embree";
     log.boundary = detpBoundaryName(settings_.estimator.boundary);
@@ -139,8 +142,6 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     log.lights = scene_.lights.size();
 
     EmbreeDevice device;
-    std::optional<PreviewTonemap> tonemap;
-    std::optional<float> exposure;  // fixed at the first frame so previews do not flicker
     auto imageMetadata = [&](int frame) {
         ImageMetadata m;
         m.strings = {{"qsgi:estimator", estimatorName(settings_.estimator.kind)}, {"qsgi:version", QSGI_VERSION},
@@ -153,76 +154,82 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.k : 0);
         return m;
     };
-    // Disc regions persist across frames: static vertices keep theirs unless a mover comes near.
-    std::optional<DiscRegions> regions;
-    if (needsDiscRegions(settings_.estimator)) regions.emplace(makeDiscRegions(settings_.estimator));
+    FrameSolverSettings solverSettings;
+    solverSettings.estimator = settings_.estimator;
+    solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces};
+    solverSettings.fullRecompute = settings_.fullRecompute;
+    solverSettings.useEnvelope = settings_.useEnvelope;
+    // Built in the rest pose, before any frame: every run refits the same BVHs (DESIGN §6.0).
+    scene_.applyPose(scene_.restLocals());
+    FrameSolver solver(scene_, device, solverSettings);
+    const ImageSettings imageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.seed};
+
+    // Previews are tonemapped as frame 0 of the animation is (DESIGN §6.0), so that any frame
+    // range writes the bytes one sequential run would. A run that starts later computes frame 0
+    // once for it, then the state at its first frame from scratch.
+    std::optional<PreviewTonemap> tonemap;
+    std::optional<float> exposure = settings_.exposure;
+    auto fixPreviews = [&](const VertexRadiosity& result, const SceneBvh& bvh) {
+        tonemap = PreviewTonemap::fromPercentile(result.radiosity);
+        if (settings_.writePng && !exposure)
+            exposure = automaticExposure(renderRadiosityImage(scene_, bvh, result, camera_, imageSettings));
+    };
+    if (first_ > 0) {
+        FrameWork work;
+        fixPreviews(solver.solve(animation_.localsAt(0), work), solver.bvh());
+        solver.reset();
+    }
+
     const int count = last_ - first_ + 1;
     for (int frame = first_; frame <= last_; ++frame) {
         Stopwatch frameClock;
+        FrameWork work;
+        const VertexRadiosity& result = solver.solve(animation_.localsAt(frame), work);
+        if (!tonemap) fixPreviews(result, solver.bvh());
         FrameTiming timing;
         timing.frame = frame;
-        std::vector<uint32_t> movedInstances;
-        std::vector<Bounds3f> movedBounds;
-        scene_.applyPose(animation_.localsAt(frame), &movedInstances, &movedBounds);
-
-        // Every frame from scratch for now; the incremental update (DESIGN §6) slots in here.
-        Stopwatch clock;
-        const SceneBvh bvh(device, scene_);
-        const PhotonTracer tracer(scene_, bvh, TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces});
-        ProgressBar bar("frame " + std::to_string(frame) + " photons", settings_.photons, settings_.progress);
-        const RayCache cache = tracer.traceAll([&](uint64_t done, uint64_t) { bar.update(done); });
-        bar.finish();
-        timing.photonSimulationSeconds = clock.seconds();
-        timing.segments = cache.segments.size();
-        timing.photonsMissingScene = cache.pathsMissingScene();
-        timing.pathsRetraced = cache.pathCount();
-        timing.segmentsAdded = cache.segments.size();
-
-        // Density estimation: the disc regions of this pose (part of its cost), then the estimate.
-        clock.restart();
-        if (regions) {
-            Stopwatch regionClock;
-            if (frame == first_) {
-                regions->computeAll(scene_, bvh);
-                timing.discRegionsUpdated = scene_.vertexCount();
-            } else {
-                std::vector<uint8_t> vertexMoved(scene_.vertexCount(), 0);
-                for (uint32_t i : movedInstances)
-                    std::fill_n(vertexMoved.begin() + scene_.instances[i].firstVertex, scene_.instances[i].vertexCount, 1);
-                const std::vector<uint32_t> touched = regions->touchedBy(scene_, movedBounds, vertexMoved);
-                regions->recompute(scene_, bvh, touched);
-                timing.discRegionsUpdated = touched.size();
-            }
-            timing.discRegionsSeconds = regionClock.seconds();
-            timing.ownSurfaceFallbacks = regions->fallbackVertices();
-            timing.buriedVertices = regions->buriedVertices();
-        }
-        const VertexRadiosity result =
-            estimateVertexRadiosity(scene_, bvh, cache, settings_.estimator, device, regions ? &*regions : nullptr);
-        timing.estimationSeconds = clock.seconds();
-        timing.verticesUpdated = scene_.vertexCount();
+        timing.fromScratch = work.fromScratch;
+        timing.photonSimulationSeconds = work.photonSeconds;
+        timing.findAffectedSeconds = work.findSeconds;
+        timing.retraceSeconds = work.retraceSeconds;
+        timing.estimationSeconds = work.estimationSeconds;
+        timing.segments = work.segments;
+        timing.photonsMissingScene = work.photonsMissingScene;
+        timing.pathsRetraced = work.pathsRetraced;
+        timing.pathsAffectedByImpact = work.affectedByImpact;
+        timing.pathsAffectedByBlocking = work.affectedByBlocking;
+        timing.segmentsRemoved = work.segmentsRemoved;
+        timing.segmentsAdded = work.segmentsAdded;
+        timing.verticesUpdated = work.verticesUpdated;
+        timing.recomputeSeconds = work.recomputeSeconds;
+        timing.verticesRecomputed = work.verticesRecomputed;
+        timing.trackedPaths = work.trackedPaths;
+        timing.trackedSegments = work.trackedSegments;
+        timing.trackedBytes = work.trackedBytes;
+        timing.discRegionsSeconds = work.discRegionsSeconds;
+        timing.discRegionsUpdated = work.discRegionsUpdated;
+        timing.ownSurfaceFallbacks = solver.ownSurfaceFallbacks();
+        timing.buriedVertices = solver.buriedVertices();
+        if (frame == first_) log.photonsMissingScene = work.photonsMissingScene;
 
         std::optional<RgbImage> image;
+        Stopwatch clock;
         if (settings_.writeExr || settings_.writePng) {
-            clock.restart();
-            image = renderRadiosityImage(scene_, bvh, result, camera_,
-                                         ImageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.seed});
+            image = renderRadiosityImage(scene_, solver.bvh(), result, camera_, imageSettings);
             timing.renderSeconds = clock.seconds();
         }
 
         clock.restart();
-        if (!tonemap) tonemap = PreviewTonemap::fromPercentile(result.radiosity);
         writeVertexRadiosityPly(outDir / frameFileName(frame, "ply"), scene_, result, *tonemap);
         if (settings_.writeExr) writeExr(outDir / frameFileName(frame, "exr"), *image, imageMetadata(frame), settings_.exrHalf);
-        if (settings_.writePng) {
-            if (!exposure) exposure = settings_.exposure ? *settings_.exposure : automaticExposure(*image);
-            writePngPreview(outDir / frameFileName(frame, "png"), *image, *exposure);
-        }
+        if (settings_.writePng) writePngPreview(outDir / frameFileName(frame, "png"), *image, *exposure);
         timing.writeSeconds = clock.seconds();
         log.frames.push_back(timing);
+        // Rewritten after every frame, so it always describes the frames on disk (DESIGN §7).
+        log.write(outDir / "timing.json");
         if (onFrame)
             onFrame(FrameReport{frame, frame - first_, count, frameClock.seconds(),
-                                double(timing.photonsMissingScene) / double(std::max<uint64_t>(settings_.photons, 1))});
+                                double(log.photonsMissingScene) / double(std::max<uint64_t>(settings_.photons, 1))});
     }
     log.write(outDir / "timing.json");
 }

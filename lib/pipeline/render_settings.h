@@ -28,6 +28,8 @@ struct RenderSettings {
     uint64_t seed = 1;
     uint32_t maxBounces = 32;
     int threads = 0;  // 0: all cores
+    bool fullRecompute = false;  // every frame from scratch instead of the incremental update
+    bool useEnvelope = true;     // fold paths that never meet the moving geometry's envelope
     std::optional<FrameRange> frames;
     std::vector<PunctualLight> extraLights;  // world space, from the config
 

@@ -168,10 +168,20 @@ void checkLightsAreStatic(const Scene& scene, const Animation& animation, const 
 
 void sweepAnimationBounds(Scene& scene, const Animation& animation) {
     Bounds3f swept = scene.bounds();
-    for (int frame = 0; frame <= animation.lastFrame(); ++frame)
-        if (scene.applyPose(animation.localsAt(frame))) swept.extend(scene.bounds());
-    scene.applyPose(scene.restLocals());
+    std::vector<Bounds3f> perInstance(scene.instances.size());
+    std::vector<uint32_t> moved;
+    for (int frame = 0; frame <= animation.lastFrame(); ++frame) {
+        moved.clear();
+        if (!scene.applyPose(animation.localsAt(frame), &moved)) continue;
+        swept.extend(scene.bounds());
+        for (uint32_t i : moved) perInstance[i].extend(scene.instanceBounds(i));
+    }
+    moved.clear();
+    scene.applyPose(scene.restLocals(), &moved);
+    // An instance that moved away from its rest pose was somewhere in between at rest too.
+    for (uint32_t i : moved) perInstance[i].extend(scene.instanceBounds(i));
     scene.animationBounds = swept;
+    scene.sweptInstanceBounds = std::move(perInstance);
 }
 
 }  // namespace qsgi

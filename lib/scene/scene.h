@@ -94,6 +94,9 @@ struct Scene {
     // Union of the bounds of every pose the run can show: the rest pose after finalize(), every
     // frame once the animation is known (sweepAnimationBounds).
     Bounds3f animationBounds;
+    // Per instance: the union of its bounds over every frame of the animation, for instances the
+    // animation moves (empty for the others). The incremental update's envelope (DESIGN §6.5).
+    std::vector<Bounds3f> sweptInstanceBounds;
     // 10^-6 of animationBounds' diagonal: the tolerance of the estimators' geometric tests (DESIGN §5).
     float sceneEpsilon() const { return 1e-6f * std::max(animationBounds.extent(), 1e-6f); }
 

@@ -5,19 +5,69 @@
 
 namespace qsgi {
 
+namespace {
+
+// One closest-hit query's state for the tie rule: the hit accepted so far.
+struct TieBreakContext {
+    RTCIntersectContext base;  // first member: Embree hands back a pointer to it
+    float bestT = std::numeric_limits<float>::infinity();
+    unsigned bestPrim = RTC_INVALID_GEOMETRY_ID;
+};
+
+// Embree accepts a candidate at t equal to the current closest (and hands the filter the
+// candidate's t as the ray's tfar), so without this the winner of a tie would be whichever
+// triangle traversal met last. With it, equal t goes to the lowest primitive id; primitive ids
+// follow scene triangle ids within a part, so this is "lowest triangle id".
+void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args) {
+    auto* ctx = reinterpret_cast<TieBreakContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        const float t = RTCRayN_tfar(args->ray, args->N, i);
+        if (t == ctx->bestT && ctx->bestPrim != RTC_INVALID_GEOMETRY_ID && prim > ctx->bestPrim) {
+            args->valid[i] = 0;
+            continue;
+        }
+        ctx->bestT = t;
+        ctx->bestPrim = prim;
+    }
+}
+
+RTCRayHit makeRay(const Vec3f& o, const Vec3f& d, float tnear, float tfar) {
+    RTCRayHit rh;
+    rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.time = 0;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+}
+
+bool occludes(RTCScene scene, const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray = makeRay(origin, direction, tnear, tfar).ray;
+    rtcOccluded1(scene, &context, &ray);
+    return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
+}
+
+}  // namespace
+
 SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
-    : device_(device), all_(device), dynamicOnly_(device) {
-    rtcSetSceneBuildQuality(all_.get(), RTC_BUILD_QUALITY_HIGH);
+    : device_(device), staticScene_(device), dynamicScene_(device) {
     // Robust traversal never culls a box that a ray touches: whether a ray grazing a surface at
-    // the scene epsilon (the disc regions' tests) hits must not depend on the BVH's layout, which
-    // changes whenever something moves.
-    rtcSetSceneFlags(all_.get(), RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneFlags(dynamicOnly_.get(), RTC_SCENE_FLAG_ROBUST);
-    static_ = addPart(all_.get(), scene, false, RTC_BUILD_QUALITY_HIGH);
-    dynamic_ = addPart(all_.get(), scene, true, RTC_BUILD_QUALITY_REFIT);
-    dynamicAlone_ = addPart(dynamicOnly_.get(), scene, true, RTC_BUILD_QUALITY_REFIT);
-    rtcCommitScene(all_.get());
-    rtcCommitScene(dynamicOnly_.get());
+    // the scene epsilon (the disc regions' tests) hits must not depend on a BVH's layout.
+    for (RTCScene s : {staticScene_.get(), dynamicScene_.get()}) rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(staticScene_.get(), RTC_BUILD_QUALITY_HIGH);
+    static_ = addPart(staticScene_.get(), scene, false, RTC_BUILD_QUALITY_HIGH);
+    dynamic_ = addPart(dynamicScene_.get(), scene, true, RTC_BUILD_QUALITY_REFIT);
+    rtcCommitScene(staticScene_.get());
+    rtcCommitScene(dynamicScene_.get());
     device_.checkError("building the scene BVH");
     // Positions are re-centred on the scene (Scene::worldOrigin), so the coordinate magnitude is
     // bounded by the extent; float spacing at the extent is ~1e-7 of it, and 1e-5 leaves margin.
@@ -45,6 +95,7 @@ SceneBvh::Part SceneBvh::addPart(RTCScene target, const Scene& scene, bool dynam
     for (size_t i = 0; i < part.triangles.size(); ++i)
         for (int k = 0; k < 3; ++k) index[3 * i + k] = remap[scene.triangles[part.triangles[i]].v[k]];
     fillVertices(geom, part, scene);
+    rtcSetGeometryIntersectFilterFunction(geom, lowestPrimitiveOnTies);
     rtcCommitGeometry(geom);
     part.geomId = rtcAttachGeometry(target, geom);
     rtcReleaseGeometry(geom);  // the scene holds its own reference
@@ -62,59 +113,44 @@ void SceneBvh::fillVertices(RTCGeometry geom, const Part& part, const Scene& sce
 }
 
 void SceneBvh::updateDynamic(const Scene& scene) {
-    for (auto [target, part] : {std::pair{all_.get(), &dynamic_}, std::pair{dynamicOnly_.get(), &dynamicAlone_}}) {
-        if (part->geomId == RTC_INVALID_GEOMETRY_ID) continue;
-        RTCGeometry geom = rtcGetGeometry(target, part->geomId);
-        fillVertices(geom, *part, scene);
-        rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
-        rtcCommitGeometry(geom);
-        rtcCommitScene(target);
-    }
+    if (dynamic_.empty()) return;
+    RTCGeometry geom = rtcGetGeometry(dynamicScene_.get(), dynamic_.geomId);
+    fillVertices(geom, dynamic_, scene);
+    rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+    rtcCommitScene(dynamicScene_.get());
     device_.checkError("refitting dynamic geometry");
 }
 
-namespace {
-RTCRayHit makeRay(const Vec3f& o, const Vec3f& d, float tnear, float tfar) {
-    RTCRayHit rh;
-    rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
-    rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
-    rh.ray.tnear = tnear;
-    rh.ray.tfar = tfar;
-    rh.ray.time = 0;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    return rh;
-}
-}  // namespace
-
-std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+std::optional<SurfaceHit> SceneBvh::intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
+                                                  const Vec3f& direction, float tnear, float tfar) const {
+    if (part.empty()) return std::nullopt;
+    TieBreakContext context;
+    rtcInitIntersectContext(&context.base);
     RTCRayHit rh = makeRay(origin, direction, tnear, tfar);
-    rtcIntersect1(all_.get(), &context, &rh);
+    rtcIntersect1(embree.get(), &context.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-    const Part& part = rh.hit.geomID == static_.geomId ? static_ : dynamic_;
     return SurfaceHit{rh.ray.tfar, part.triangles[rh.hit.primID], rh.hit.u, rh.hit.v};
 }
 
+std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
+    const std::optional<SurfaceHit> still = intersectPart(staticScene_, static_, origin, direction, tnear, tfar);
+    // The dynamic scene only needs to look as far as the static hit (inclusive: a tie there is
+    // decided below by triangle id).
+    const std::optional<SurfaceHit> moving =
+        intersectPart(dynamicScene_, dynamic_, origin, direction, tnear, still ? still->t : tfar);
+    if (!moving) return still;
+    if (!still || moving->t < still->t || (moving->t == still->t && moving->triangle < still->triangle)) return moving;
+    return still;
+}
+
 bool SceneBvh::occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRay ray = makeRay(origin, direction, tnear, tfar).ray;
-    rtcOccluded1(all_.get(), &context, &ray);
-    return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
+    return (!static_.empty() && occludes(staticScene_.get(), origin, direction, tnear, tfar)) ||
+           dynamicOccludes(origin, direction, tnear, tfar);
 }
 
 bool SceneBvh::dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    if (dynamicAlone_.geomId == RTC_INVALID_GEOMETRY_ID) return false;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    RTCRay ray = makeRay(origin, direction, tnear, tfar).ray;
-    rtcOccluded1(dynamicOnly_.get(), &context, &ray);
-    return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
+    return !dynamic_.empty() && occludes(dynamicScene_.get(), origin, direction, tnear, tfar);
 }
 
 }  // namespace qsgi

@@ -1,5 +1,9 @@
-// The scene's triangles in Embree: static triangles in one geometry built once, dynamic triangles
-// in another that is refitted when the animation moves them (DESIGN §6.1).
+// The scene's triangles in Embree (DESIGN §6 steps 0–1): static triangles in one Embree scene
+// built once per run and never rebuilt, dynamic triangles in another that is refitted when the
+// animation moves them. A ray's closest hit is the nearer of the two scenes' hits; at equal t the
+// lower scene triangle id wins, inside each scene too (an intersection filter), so which triangle
+// a ray hits never depends on a BVH's shape or traversal order. Full recomputation, incremental
+// retraces and camera rays all go through intersect(), so they see identical hits.
 #pragma once
 
 #include <optional>
@@ -18,6 +22,8 @@ struct SurfaceHit {
 
 class SceneBvh {
 public:
+    // Build it from the rest pose (before any frame is applied), so that every run — whatever
+    // its first frame — refits the same dynamic BVH.
     SceneBvh(const EmbreeDevice& device, const Scene& scene);
 
     // Re-reads the dynamic vertices from the scene and refits the dynamic geometry.
@@ -26,7 +32,7 @@ public:
     std::optional<SurfaceHit> intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // True if any geometry blocks the ray within (tnear, tfar).
     bool occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
-    // True if the dynamic geometry alone blocks the ray within (tnear, tfar).
+    // True if the dynamic geometry alone blocks the ray within (tnear, tfar].
     bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
 
     // Offset that lifts spawned rays off surfaces: scaled with the scene, never with metres.
@@ -34,17 +40,19 @@ public:
 
 private:
     struct Part {
-        std::vector<uint32_t> triangles;  // Embree primID -> scene triangle
+        std::vector<uint32_t> triangles;  // Embree primID -> scene triangle (increasing)
         std::vector<uint32_t> vertices;   // Embree vertex -> scene vertex
         unsigned geomId = RTC_INVALID_GEOMETRY_ID;
+        bool empty() const { return geomId == RTC_INVALID_GEOMETRY_ID; }
     };
     Part addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality);
     void fillVertices(RTCGeometry geom, const Part& part, const Scene& scene);
+    std::optional<SurfaceHit> intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
+                                            const Vec3f& direction, float tnear, float tfar) const;
 
     const EmbreeDevice& device_;
-    EmbreeScene all_;
-    EmbreeScene dynamicOnly_;
-    Part static_, dynamic_, dynamicAlone_;
+    EmbreeScene staticScene_, dynamicScene_;
+    Part static_, dynamic_;
     float rayEpsilon_ = 1e-5f;
 };
 

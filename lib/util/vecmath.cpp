@@ -14,6 +14,23 @@ float Bounds3f::exitDistance(const Vec3f& o, const Vec3f& d) const {
     return std::isfinite(tfar) && tfar < std::numeric_limits<float>::max() ? std::max(0.0f, tfar) : 0.0f;
 }
 
+bool Bounds3f::clip(const Vec3f& o, const Vec3f& d, double& t0, double& t1) const {
+    if (empty()) return false;
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0) {
+            if (o[a] < lower[a] || o[a] > upper[a]) return false;
+            continue;
+        }
+        double ta = (double(lower[a]) - double(o[a])) / double(d[a]);
+        double tb = (double(upper[a]) - double(o[a])) / double(d[a]);
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        if (t0 > t1) return false;
+    }
+    return true;
+}
+
 Transform Transform::fromTRS(const Vec3d& t, const std::array<double, 4>& q, const Vec3d& s) {
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     // Rotation matrix of a unit quaternion; normalise first so slightly-off inputs stay rigid.

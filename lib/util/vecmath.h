@@ -99,6 +99,9 @@ struct Bounds3f {
     // Distance along the ray o + t·d (d ≠ 0) to where it leaves the box; 0 if it starts outside
     // and never enters or the box is empty. Escaping photons end there (DESIGN §4, §5).
     float exitDistance(const Vec3f& o, const Vec3f& d) const;
+    // Clips the part [t0, t1] of the ray o + t·d to the box (in double precision, closed box);
+    // false if it misses. t1 may be infinite.
+    bool clip(const Vec3f& o, const Vec3f& d, double& t0, double& t1) const;
     // Largest coordinate magnitude: what limits float precision of positions.
     float maxAbsCoordinate() const {
         if (empty()) return 0;

@@ -1,0 +1,254 @@
+#include "pipeline/frame_solver.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "estimate/morton_order.h"
+#include "util/stopwatch.h"
+
+namespace qsgi {
+
+FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings)
+    : scene_(scene), device_(device), settings_(settings), bvh_(device, scene), tracer_(scene, bvh_, settings.trace) {
+    if (needsDiscRegions(settings_.estimator)) regions_.emplace(makeDiscRegions(settings_.estimator));
+}
+
+FrameSolver::~FrameSolver() = default;
+
+bool FrameSolver::updatesSums() const {
+    const EstimatorSettings& e = settings_.estimator;
+    return e.kind == EstimatorKind::ImpactCount || (e.kind == EstimatorKind::Detp && e.detpIndex == DetpIndex::Embree);
+}
+
+FrameSolver::PoseChange FrameSolver::pose(const std::vector<Transform>& locals) {
+    PoseChange change;
+    const std::vector<Vec3f> before = scene_.positions;
+    change.any = scene_.applyPose(locals, &change.instances, &change.bounds);
+    for (size_t i = 1; i < change.bounds.size(); i += 2) change.newBounds.push_back(change.bounds[i]);
+    // Moved is decided per vertex and triangle: an instance re-placed by a transform that leaves
+    // some of its vertices where they were (or a paused mover) moves nothing there.
+    change.vertexMoved.assign(scene_.vertexCount(), 0);
+    change.triangleMoved.assign(scene_.triangleCount(), 0);
+    for (uint32_t i : change.instances) {
+        const MeshInstance& inst = scene_.instances[i];
+        for (uint32_t v = inst.firstVertex; v < inst.firstVertex + inst.vertexCount; ++v)
+            change.vertexMoved[v] = std::memcmp(&before[v], &scene_.positions[v], sizeof(Vec3f)) != 0;
+        for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t)
+            for (uint32_t v : scene_.triangles[t].v) change.triangleMoved[t] |= change.vertexMoved[v];
+    }
+    if (change.any) bvh_.updateDynamic(scene_);
+    return change;
+}
+
+void FrameSolver::updateRegions(const PoseChange& change, FrameWork& work) {
+    if (!regions_) return;
+    Stopwatch clock;
+    if (!regionsValid_) {
+        regions_->computeAll(scene_, bvh_);
+        work.discRegionsUpdated = scene_.vertexCount();
+        regionsValid_ = true;
+    } else if (change.any) {
+        const std::vector<uint32_t> touched = regions_->touchedBy(scene_, change.bounds, change.vertexMoved);
+        regions_->recompute(scene_, bvh_, touched);
+        work.discRegionsUpdated = touched.size();
+    }
+    work.discRegionsSeconds = clock.seconds();
+}
+
+const VertexRadiosity& FrameSolver::solve(const std::vector<Transform>& locals, FrameWork& work) {
+    work = FrameWork();
+    const PoseChange change = pose(locals);
+    if (!solved_ || settings_.fullRecompute) {
+        if (!solved_) regionsValid_ = false;
+        Stopwatch clock;
+        updateRegions(change, work);
+        const double regionSeconds = clock.seconds();
+        solveFromScratch(work);
+        work.estimationSeconds += regionSeconds;
+        solved_ = true;
+    } else {
+        solveIncrementally(change, work);
+    }
+    if (tracked_) {
+        work.trackedPaths = tracked_->trackedPaths();
+        work.trackedSegments = tracked_->trackedSegments();
+        work.trackedBytes = tracked_->bytes();
+        work.segments = foldedSegments_ + tracked_->trackedSegments();
+    }
+    return result_;
+}
+
+void FrameSolver::solveFromScratch(FrameWork& work) {
+    work.fromScratch = true;
+    Stopwatch clock;
+    const RayCache cache = tracer_.traceAll();
+    work.photonSeconds = clock.seconds();
+    work.segments = cache.segments.size();
+    work.photonsMissingScene = cache.pathsMissingScene();
+    work.pathsRetraced = cache.pathCount();
+    work.segmentsAdded = cache.segments.size();
+    maxPhotonPower_ = cache.maxPhotonPower;
+
+    clock.restart();
+    const EstimatorSettings& e = settings_.estimator;
+    const PowerQuantizer q(cache.maxPhotonPower);
+    if (e.kind == EstimatorKind::ImpactCount) {
+        impactCount_.emplace(scene_);
+        impactCount_->accumulate(cache);
+        result_ = impactCount_->estimate(scene_, q);
+    } else if (updatesSums() && e.useIndex) {
+        if (!discs_) discs_ = std::make_unique<DetpDiscs>(device_, scene_, e.radius, e.boundary, regions(), &bvh_);
+        discs_->updateDynamic();
+        detpSums_ = discs_->sums(cache, e.sortQueries ? segmentMortonOrder(cache) : inputOrder(cache.segments.size()));
+        result_.irradiance.resize(scene_.vertexCount());
+        for (size_t v = 0; v < scene_.vertexCount(); ++v)
+            result_.irradiance[v] = detpVertexIrradiance(detpSums_[v], regions_ ? &(*regions_)[v] : nullptr, e.radius, e.boundary, q);
+        finishRadiosity();
+    } else {
+        result_ = estimateVertexRadiosity(scene_, bvh_, cache, e, device_, regions());
+        if (updatesSums()) {
+            // Brute-force DETP (--no-ray-cache) keeps its sums the index-free way.
+            detpSums_.assign(scene_.vertexCount(), DetpVertexSums());
+            std::vector<const Segment*> all(cache.segments.size());
+            for (size_t i = 0; i < all.size(); ++i) all[i] = &cache.segments[i];
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, scene_.vertexCount(), 16), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t v = r.begin(); v != r.end(); ++v)
+                    detpSums_[v] = detpVertexSums(scene_, uint32_t(v), all, e.radius, e.boundary, regions(), &bvh_, q);
+            });
+        }
+    }
+    work.estimationSeconds = clock.seconds();
+    work.verticesUpdated = scene_.vertexCount();
+
+    if (settings_.fullRecompute) return;
+    // The incremental state: paths that meet the envelope are tracked, the rest folded into the
+    // sums just computed (estimators that re-estimate from every segment track everything).
+    const bool discs = e.kind != EstimatorKind::ImpactCount;
+    const float margin = envelopeMargin(discs, e.radius, scene_.sceneEpsilon());
+    // The photon map keeps the untracked segments (they never change) to re-estimate from.
+    const bool sums = updatesSums();
+    const Envelope envelope = settings_.useEnvelope ? Envelope::ofAnimation(scene_, sums ? margin : scene_.sceneEpsilon())
+                                                    : Envelope::everything();
+    const Bounds3f gridBounds = envelope.isEverything() ? scene_.animationBounds.expanded(margin) : envelope.bounds();
+    // Cells about a disc across, but no more than 64 along an axis (16 for the whole scene).
+    const float cellSize = std::max(discs ? 2 * e.radius : 0.0f, gridBounds.extent() / (envelope.isEverything() ? 16 : 64));
+    staticSegments_.clear();
+    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, sums && discs ? e.radius : 0.0f, gridBounds, cellSize,
+                                              sums ? nullptr : &staticSegments_);
+    foldedSegments_ = cache.segments.size() - tracked_->trackedSegments();
+}
+
+void FrameSolver::finishRadiosity() { computeRadiosity(scene_, result_); }
+
+void FrameSolver::solveIncrementally(const PoseChange& change, FrameWork& work) {
+    if (!change.any) return;  // nothing moved: no path changes, no vertex changes
+    PathChanges changes;
+    const std::vector<AffectedPath> affected =
+        tracked_->findAffected(change.triangleMoved, change.newBounds, bvh_, settings_.gridForBlocking, changes);
+    tracked_->retrace(affected, tracer_, changes);
+    work.findSeconds = changes.findSeconds;
+    work.retraceSeconds = changes.retraceSeconds;
+    work.photonSeconds = changes.findSeconds + changes.retraceSeconds;
+    work.pathsRetraced = changes.pathsRetraced;
+    work.affectedByImpact = changes.affectedByImpact;
+    work.affectedByBlocking = changes.affectedByBlocking;
+    work.blockingCandidates = changes.blockingCandidates;
+    work.segmentsRemoved = changes.removed.size();
+    work.segmentsAdded = changes.added.size();
+
+    Stopwatch clock;
+    updateRegions(change, work);
+    const EstimatorSettings& e = settings_.estimator;
+    const PowerQuantizer q(maxPhotonPower_);
+    if (e.kind == EstimatorKind::ImpactCount) {
+        // Old segments leave with the facing they were counted with, before the triangles move.
+        for (const Segment& s : changes.removed) impactCount_->subtract(s, q);
+        impactCount_->updateGeometry(scene_);
+        for (const Segment& s : changes.added) impactCount_->add(s, q);
+        result_ = impactCount_->estimate(scene_, q);
+        std::vector<uint8_t> updated(scene_.vertexCount(), 0);
+        auto mark = [&](uint32_t t) {
+            for (uint32_t v : scene_.triangles[t].v) updated[v] = 1;
+        };
+        for (const auto* list : {&changes.removed, &changes.added})
+            for (const Segment& s : *list)
+                if (s.hasImpact()) mark(s.triangle);
+        for (uint32_t t = 0; t < scene_.triangleCount(); ++t)
+            if (change.triangleMoved[t]) mark(t);
+        work.verticesUpdated = uint64_t(std::count(updated.begin(), updated.end(), uint8_t(1)));
+    } else if (updatesSums()) {
+        // Vertices whose disc moved or whose regions the move touched are recomputed from the
+        // tracked segments near them; every other vertex takes + new − old.
+        std::vector<uint32_t> recompute;
+        if (regions_) recompute = regions_->touchedBy(scene_, change.bounds, change.vertexMoved);
+        else
+            for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
+                if (change.vertexMoved[v]) recompute.push_back(v);
+        std::vector<uint8_t> skip(scene_.vertexCount(), 0);
+        for (uint32_t v : recompute) skip[v] = 1;
+        std::vector<uint32_t> changed;
+        if (e.useIndex) {
+            discs_->updateDynamic();
+            discs_->accumulate(changes.removed, q, -1, skip, detpSums_, changed);
+            discs_->accumulate(changes.added, q, +1, skip, detpSums_, changed);
+        } else {
+            // Index-free (--no-ray-cache): every changed segment against every disc.
+            std::vector<const Segment*> removed, added;
+            for (const Segment& s : changes.removed) removed.push_back(&s);
+            for (const Segment& s : changes.added) added.push_back(&s);
+            std::vector<uint8_t> touched(scene_.vertexCount(), 0);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, scene_.vertexCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t v = r.begin(); v != r.end(); ++v) {
+                    if (skip[v]) continue;
+                    const DetpVertexSums delta = detpVertexSums(scene_, uint32_t(v), added, e.radius, e.boundary, regions(), &bvh_, q);
+                    const DetpVertexSums gone = detpVertexSums(scene_, uint32_t(v), removed, e.radius, e.boundary, regions(), &bvh_, q);
+                    if (delta == DetpVertexSums() && gone == DetpVertexSums()) continue;
+                    detpSums_[v] += delta;
+                    detpSums_[v] -= gone;
+                    touched[v] = 1;
+                }
+            });
+            for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
+                if (touched[v]) changed.push_back(v);
+        }
+        Stopwatch recomputeClock;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, recompute.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<const Segment*> near;
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const uint32_t v = recompute[i];
+                near.clear();
+                if (e.useIndex) {
+                    Bounds3f box;
+                    box.extend(scene_.positions[v]);
+                    tracked_->segmentsNear(box.expanded(e.radius * 1.001f + 4 * scene_.sceneEpsilon()), near);
+                } else {
+                    tracked_->allSegments(near);
+                }
+                detpSums_[v] = detpVertexSums(scene_, v, near, e.radius, e.boundary, regions(), &bvh_, q);
+            }
+        });
+        work.recomputeSeconds = recomputeClock.seconds();
+        work.verticesRecomputed = recompute.size();
+        changed.insert(changed.end(), recompute.begin(), recompute.end());
+        std::sort(changed.begin(), changed.end());
+        changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+        for (uint32_t v : changed)
+            result_.irradiance[v] = detpVertexIrradiance(detpSums_[v], regions_ ? &(*regions_)[v] : nullptr, e.radius, e.boundary, q);
+        finishRadiosity();
+        work.verticesUpdated = changed.size();
+    } else {
+        // The photon map's k nearest neighbours cannot be folded (DESIGN §6.5): re-estimate from
+        // every segment, the untracked ones kept as they were.
+        RayCache all;
+        all.maxPhotonPower = maxPhotonPower_;
+        all.segments = staticSegments_;
+        tracked_->appendAll(all.segments);
+        result_ = estimateVertexRadiosity(scene_, bvh_, all, e, device_, regions());
+        work.verticesUpdated = scene_.vertexCount();
+    }
+    work.estimationSeconds = clock.seconds();
+}
+
+}  // namespace qsgi

@@ -1,0 +1,44 @@
+// The envelope of the moving geometry (DESIGN §6 step 5): the boxes each moving instance sweeps
+// over the whole animation, dilated by a margin. A light path can change only from a segment that
+// meets it: a moving triangle is hit or blocks inside it, and every disc an update recomputes lies
+// inside it. Paths that never meet it are folded into the estimators' sums once and never searched
+// again; the others are tracked from their first segment that does.
+#pragma once
+
+#include <vector>
+
+#include "scene/scene.h"
+#include "trace/ray_cache.h"
+
+namespace qsgi {
+
+class Envelope {
+public:
+    Envelope() = default;
+    // Everything: every segment meets it (estimators that cannot fold, and --no-envelope).
+    static Envelope everything();
+    // The moving instances' swept bounds (Scene::sweptInstanceBounds) dilated by `margin`.
+    static Envelope ofAnimation(const Scene& scene, float margin);
+
+    // Whether the segment, continued `extension` past its impact (an escaping segment: without
+    // end), meets the envelope.
+    bool meets(const Segment& s, float extension) const;
+    bool isEverything() const { return everything_; }
+    bool isEmpty() const { return !everything_ && boxes_.empty(); }
+    const std::vector<Bounds3f>& boxes() const { return boxes_; }
+    Bounds3f bounds() const;  // of all boxes
+
+private:
+    bool everything_ = false;
+    std::vector<Bounds3f> boxes_;
+};
+
+// How far past its impact an estimator can count a segment, and how far from the moving geometry
+// a vertex can be that the update recomputes: what the envelope's margin must cover.
+// DETP: a crossing counts up to r past the impact, on a disc within r of a vertex, and a vertex
+// is recomputed when its test region (r√2 around it, DiscRegions::touchedBy) meets a mover, so
+// the margin is (1 + √2) r plus the regions' own slack (DESIGN's 2r misses a corner of that).
+// Impact count: nothing beyond the impact itself.
+float envelopeMargin(bool discs, float radius, float sceneEpsilon);
+
+}  // namespace qsgi

@@ -1,0 +1,70 @@
+#include "trace/segment_grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace qsgi {
+
+SegmentGrid::SegmentGrid(const Bounds3f& bounds, float cellSize, int maxCellsPerAxis) : bounds_(bounds) {
+    if (bounds.empty()) return;
+    const Vec3f extent = bounds.diagonal();
+    for (int a = 0; a < 3; ++a) {
+        const float want = cellSize > 0 ? std::ceil(extent[a] / cellSize) : 1.0f;
+        n_[a] = std::clamp(int(std::isfinite(want) ? want : 1.0f), 1, std::max(1, maxCellsPerAxis));
+        cellSize_[a] = extent[a] > 0 ? extent[a] / float(n_[a]) : 1.0f;
+    }
+    cells_.resize(size_t(n_[0]) * size_t(n_[1]) * size_t(n_[2]));
+}
+
+bool SegmentGrid::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
+    if (cells_.empty() || !box.overlaps(bounds_)) return false;
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::clamp(int(std::floor((box.lower[a] - bounds_.lower[a]) / cellSize_[a])), 0, n_[a] - 1);
+        hi[a] = std::clamp(int(std::floor((box.upper[a] - bounds_.lower[a]) / cellSize_[a])), 0, n_[a] - 1);
+    }
+    return true;
+}
+
+void SegmentGrid::insert(const Vec3f& origin, const Vec3f& direction, double end, const SegmentRef& ref) {
+    double t0 = 0, t1 = end;
+    if (cells_.empty() || !bounds_.clip(origin, direction, t0, t1)) return;
+    // Pieces no longer than the smallest cell edge, each listed in every cell its (slightly
+    // padded) box overlaps: conservative, with no floating-point cell walk to get wrong.
+    const double step = 0.5 * double(std::min({cellSize_[0], cellSize_[1], cellSize_[2]}));
+    const Vec3f pad(1e-4f * std::min({cellSize_[0], cellSize_[1], cellSize_[2]}));
+    const size_t pieces = std::max<size_t>(1, size_t(std::ceil((t1 - t0) / step)));
+    size_t last[8];
+    int lastCount = 0;
+    for (size_t i = 0; i < pieces; ++i) {
+        const double a = t0 + (t1 - t0) * double(i) / double(pieces), b = t0 + (t1 - t0) * double(i + 1) / double(pieces);
+        Bounds3f piece;
+        piece.extend(Vec3f(Vec3d(origin) + Vec3d(direction) * a));
+        piece.extend(Vec3f(Vec3d(origin) + Vec3d(direction) * b));
+        piece.lower = piece.lower - pad;
+        piece.upper = piece.upper + pad;
+        int lo[3], hi[3];
+        if (!cellRange(piece, lo, hi)) continue;
+        size_t now[8];
+        int nowCount = 0;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x) {
+                    const size_t c = cellIndex(x, y, z);
+                    if (nowCount < 8) now[nowCount++] = c;
+                    // Consecutive pieces share cells: list the segment once per cell it enters.
+                    if (std::find(last, last + lastCount, c) != last + lastCount) continue;
+                    cells_[c].push_back(ref);
+                    ++entries_;
+                }
+        std::copy(now, now + nowCount, last);
+        lastCount = nowCount;
+    }
+}
+
+size_t SegmentGrid::bytes() const {
+    size_t total = cells_.capacity() * sizeof(cells_[0]);
+    for (const auto& c : cells_) total += c.capacity() * sizeof(SegmentRef);
+    return total;
+}
+
+}  // namespace qsgi

@@ -1,0 +1,78 @@
+// A uniform grid over the envelope that lists, per cell, the tracked segments passing through it
+// (with their extension). It answers "which segments pass near this box" without testing every
+// cached segment: the moved objects' new bounds (segments they may now block) and the discs an
+// update recomputes. Entries are never removed one by one: each carries its path's generation,
+// entries of a path that was retraced since are stale, skipped, and swept out when they outnumber
+// the live ones.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "util/vecmath.h"
+
+namespace qsgi {
+
+struct SegmentRef {
+    uint32_t path = 0;
+    uint32_t generation = 0;
+    uint32_t bounce = 0;
+    bool operator<(const SegmentRef& o) const { return path < o.path || (path == o.path && bounce < o.bounce); }
+    bool operator==(const SegmentRef& o) const { return path == o.path && bounce == o.bounce; }
+};
+
+class SegmentGrid {
+public:
+    SegmentGrid() = default;
+    // bounds: the region queries ask about; cellSize: the target cell edge (at most
+    // maxCellsPerAxis cells along any axis).
+    SegmentGrid(const Bounds3f& bounds, float cellSize, int maxCellsPerAxis = 64);
+
+    // Lists the part [0, end] of the ray o + t·d (end may be infinite) in every cell it passes.
+    void insert(const Vec3f& origin, const Vec3f& direction, double end, const SegmentRef& ref);
+    // Every entry in a cell that overlaps the box, sorted by (path, bounce) and without duplicates;
+    // entries whose generation is not current (isLive) are dropped.
+    template <typename IsLive>
+    void query(const Bounds3f& box, std::vector<SegmentRef>& out, IsLive isLive) const {
+        out.clear();
+        int lo[3], hi[3];
+        if (!cellRange(box, lo, hi)) return;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x)
+                    for (const SegmentRef& r : cells_[cellIndex(x, y, z)])
+                        if (isLive(r)) out.push_back(r);
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    }
+    // Drops stale entries everywhere.
+    template <typename IsLive>
+    void sweep(IsLive isLive) {
+        entries_ = 0;
+        for (auto& cell : cells_) {
+            size_t kept = 0;
+            for (const SegmentRef& r : cell)
+                if (isLive(r)) cell[kept++] = r;
+            cell.resize(kept);
+            cell.shrink_to_fit();
+            entries_ += kept;
+        }
+    }
+
+    size_t entries() const { return entries_; }
+    size_t bytes() const;
+    bool empty() const { return cells_.empty(); }
+
+private:
+    bool cellRange(const Bounds3f& box, int lo[3], int hi[3]) const;
+    size_t cellIndex(int x, int y, int z) const { return (size_t(z) * size_t(n_[1]) + size_t(y)) * size_t(n_[0]) + size_t(x); }
+
+    Bounds3f bounds_;
+    Vec3f cellSize_{1.0f};
+    int n_[3] = {0, 0, 0};
+    std::vector<std::vector<SegmentRef>> cells_;
+    size_t entries_ = 0;
+};
+
+}  // namespace qsgi
