@@ -192,3 +192,46 @@ TEST(Cli, EveryEstimatorRendersEndToEnd) {
     expectBadInput("render " + cornell() + " --estimator detp --detp-index octree", "octree", out);
     expectBadInput("render " + cornell() + " --estimator photon-map --k 0", "--k", out);
 }
+
+// The incremental update writes the bytes --full-recompute writes, for each estimator and rule on
+// data/cornell (timing.json aside: it records how each frame was computed).
+TEST(Cli, IncrementalRunWritesTheBytesOfAFullRecomputation) {
+    const fs::path dir = testScratchDir("incremental");
+    const std::string common = cornell() + " --animation " + cornellAnimation() + " --frames 0:3 --photons 30000 --quiet --no-exr";
+    for (const char* estimator : {"impact-count", "photon-map", "detp --detp-boundary clip", "detp --detp-boundary linear",
+                                  "detp --detp-boundary paper"}) {
+        SCOPED_TRACE(estimator);
+        const fs::path inc = dir / "inc", full = dir / "full";
+        fs::remove_all(inc);
+        fs::remove_all(full);
+        ASSERT_EQ(runQsgi("render " + common + " --estimator " + estimator + " --out " + inc.string()).exitCode, 0);
+        const CommandResult r = runQsgi("render " + common + " --estimator " + estimator + " --full-recompute --out " + full.string());
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+        for (int f = 0; f <= 3; ++f) {
+            const std::string name = "frame_000" + std::to_string(f) + ".ply";
+            const std::string a = readAll(inc / name);
+            ASSERT_GT(a.size(), 1000u);
+            EXPECT_EQ(a, readAll(full / name)) << name;
+        }
+        EXPECT_NE(readAll(inc / "timing.json").find("\"full_recompute\": false"), std::string::npos);
+        EXPECT_NE(readAll(full / "timing.json").find("\"full_recompute\": true"), std::string::npos);
+    }
+}
+
+// A run that starts mid-animation rebuilds the state at its first frame from scratch and takes
+// its previews' tonemap from frame 0, so it writes the sequential run's bytes (PLY colours, EXR, PNG).
+TEST(Cli, FrameRangeStartingMidAnimationWritesTheSequentialBytes) {
+    const fs::path dir = testScratchDir("midrange");
+    const std::string common = cornell() + " --animation " + cornellAnimation() +
+                               " --photons 30000 --estimator detp --width 96 --height 72 --png --quiet";
+    ASSERT_EQ(runQsgi("render " + common + " --frames 0:5 --out " + (dir / "all").string()).exitCode, 0);
+    ASSERT_EQ(runQsgi("render " + common + " --frames 3:5 --out " + (dir / "late").string()).exitCode, 0);
+    for (int f = 3; f <= 5; ++f)
+        for (const char* ext : {".ply", ".exr", ".png"}) {
+            const std::string name = "frame_000" + std::to_string(f) + ext;
+            const std::string a = readAll(dir / "all" / name);
+            ASSERT_GT(a.size(), 500u) << name;
+            EXPECT_EQ(a, readAll(dir / "late" / name)) << name;
+        }
+    EXPECT_FALSE(fs::exists(dir / "late/frame_0002.ply"));
+}

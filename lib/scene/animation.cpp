@@ -167,12 +167,16 @@ void checkLightsAreStatic(const Scene& scene, const Animation& animation, const 
 }
 
 void sweepAnimationBounds(Scene& scene, const Animation& animation) {
+    sweepAnimationBounds(scene, animation.lastFrame(), [&](int frame) { return animation.localsAt(frame); });
+}
+
+void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<std::vector<Transform>(int)>& localsAt) {
     Bounds3f swept = scene.bounds();
     std::vector<Bounds3f> perInstance(scene.instances.size());
     std::vector<uint32_t> moved;
-    for (int frame = 0; frame <= animation.lastFrame(); ++frame) {
+    for (int frame = 0; frame <= lastFrame; ++frame) {
         moved.clear();
-        if (!scene.applyPose(animation.localsAt(frame), &moved)) continue;
+        if (!scene.applyPose(localsAt(frame), &moved)) continue;
         swept.extend(scene.bounds());
         for (uint32_t i : moved) perInstance[i].extend(scene.instanceBounds(i));
     }

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,8 @@ private:
 // their bounds, then returns the scene to its rest pose. Everything derived from the scene's size
 // uses it, so no value depends on which frame is being rendered (DESIGN §6 step 0).
 void sweepAnimationBounds(Scene& scene, const Animation& animation);
+// The same for any source of poses: localsAt(frame) for frames 0…lastFrame.
+void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<std::vector<Transform>(int)>& localsAt);
 
 // Lights are static (DESIGN §2): throws InputError if a punctual light or an emissive mesh hangs
 // under a node the animation moves.

@@ -1,0 +1,82 @@
+// Identical hits (DESIGN §6 step 0): at equal t the lowest triangle id wins, inside the static and
+// the dynamic BVH and between them, so no hit depends on a BVH's shape or traversal order.
+#include <gtest/gtest.h>
+
+#include "trace/scene_bvh.h"
+#include "trace/envelope.h"
+#include "test_support.h"
+
+using namespace qsgi;
+
+namespace {
+
+// Two unit quads in the plane y = 0 over [0,1]², as separate instances (triangles 0–1, 2–3),
+// the diagonal from (0,0,0) to (1,0,1) shared inside each quad.
+Scene coincidentQuads(bool firstDynamic, bool secondDynamic) {
+    Scene s;
+    s.materials.push_back(Material{"grey", Vec3f(0.5f), Vec3f(0.0f)});
+    const std::vector<Vec3f> p = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+    const std::vector<Vec3f> n(4, Vec3f(0, 1, 0));
+    const std::vector<uint32_t> idx = {0, 2, 1, 0, 3, 2};
+    const int a = s.addNode("A", Transform()), b = s.addNode("B", Transform());
+    s.addInstance(a, p, n, idx, 0);
+    s.addInstance(b, p, n, idx, 0);
+    s.finalize();
+    std::vector<int> moving;
+    if (firstDynamic) moving.push_back(a);
+    if (secondDynamic) moving.push_back(b);
+    s.markDynamic(moving);
+    return s;
+}
+
+}  // namespace
+
+TEST(SceneBvh, EqualDistancesGoToTheLowestTriangleId) {
+    EmbreeDevice device;
+    for (auto [firstDynamic, secondDynamic] : {std::pair{false, false}, {true, true}, {false, true}, {true, false}}) {
+        SCOPED_TRACE(std::to_string(firstDynamic) + std::to_string(secondDynamic));
+        const Scene s = coincidentQuads(firstDynamic, secondDynamic);
+        const SceneBvh bvh(device, s);
+        // Rays straight down through a grid of points; re-centring moved the quads by
+        // worldOrigin, so aim at their current positions.
+        const Vec3f corner = s.positions[0];
+        int onDiagonal = 0;
+        for (int i = 1; i < 16; ++i)
+            for (int j = 1; j < 16; ++j) {
+                const Vec3f target = corner + Vec3f(float(i) / 16, 0, float(j) / 16);
+                const auto hit = bvh.intersect(target + Vec3f(0, 1, 0), Vec3f(0, -1, 0), 0, 10);
+                ASSERT_TRUE(hit);
+                // The coincident copy (ids 2, 3) never wins; on the shared diagonal (i == j) both
+                // triangles of the quad are hit at the same t and the lower id (0) wins.
+                EXPECT_LT(hit->triangle, 2u) << i << "," << j;
+                if (i == j) {
+                    EXPECT_EQ(hit->triangle, 0u) << i;
+                    ++onDiagonal;
+                }
+            }
+        EXPECT_EQ(onDiagonal, 15);
+    }
+}
+
+TEST(Envelope, SegmentsMeetItWithTheirExtensionAndEscapingOnesWithoutEnd) {
+    Scene s = testscenes::boxOnFloor(2, 1, Vec3f(0.5f));
+    s.sweptInstanceBounds.assign(s.instances.size(), Bounds3f());
+    Bounds3f mover;
+    mover.extend(Vec3f(0, 0, 0));
+    mover.extend(Vec3f(1, 1, 1));
+    s.sweptInstanceBounds[1] = mover;
+    const Envelope e = Envelope::ofAnimation(s, 0.1f);
+    Segment seg;
+    seg.origin = Vec3f(-2, 0.5f, 0.5f);
+    seg.direction = Vec3f(1, 0, 0);
+    seg.triangle = 0;
+    seg.length = 1.85f;  // ends 0.05 before the dilated box (which starts at x = −0.1)
+    EXPECT_FALSE(e.meets(seg, 0.0f));
+    EXPECT_TRUE(e.meets(seg, 0.06f));  // its extension reaches in
+    seg.triangle = kNoTriangle;        // escaping: no end
+    EXPECT_TRUE(e.meets(seg, 0.0f));
+    seg.direction = Vec3f(-1, 0, 0);   // pointing away
+    EXPECT_FALSE(e.meets(seg, 0.0f));
+    EXPECT_TRUE(Envelope::everything().meets(seg, 0.0f));
+    EXPECT_NEAR(envelopeMargin(true, 0.1f, 0.0f), (1 + std::sqrt(2.0f)) * 0.1f, 1e-3f);
+}
