@@ -202,7 +202,7 @@ struct DetpDiscs::Crossed : CrossedDisc {};
 
 DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule,
                      const DiscRegions* regions, const SceneBvh* bvh)
-    : scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh), staticDiscs_(device), dynamicDiscs_(device) {
+    : device_(device), scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh), staticDiscs_(device), dynamicDiscs_(device) {
     const float eps = scene.sceneEpsilon();
     rayExtension_ = 1e-4f * radius + eps;
     // Enlarged discs make Embree's float test a superset of the exact one; the filter decides.
@@ -216,7 +216,7 @@ DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radiu
     device.checkError("building the DETP disc BVH");
 }
 
-void DetpDiscs::addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality) {
+void DetpDiscs::addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality) const {
     rtcSetSceneFlags(target, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(target, quality == RTC_BUILD_QUALITY_HIGH ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
     if (!part.vertices.empty()) {
@@ -258,6 +258,11 @@ void DetpDiscs::updateDynamic() {
 }
 
 void DetpDiscs::crossings(const Segment& s, std::vector<Crossed>& out) const {
+    crossingsIn(s, {{staticDiscs_.get(), &static_}, {dynamicDiscs_.get(), &dynamic_}}, out);
+}
+
+void DetpDiscs::crossingsIn(const Segment& s, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
+                            std::vector<Crossed>& out) const {
     std::vector<CrossedDisc> crossed;
     DiscQueryContext ctx;
     rtcInitIntersectContext(&ctx.base);
@@ -273,7 +278,7 @@ void DetpDiscs::crossings(const Segment& s, std::vector<Crossed>& out) const {
     float end = s.length + radius_;
     if (!s.hasImpact()) end = std::max(end, escapeBounds_.exitDistance(s.origin, s.direction));
     const Vec3f o = s.origin - s.direction * slack;
-    for (const auto* part : {&static_, &dynamic_}) {
+    for (const auto& [bvh, part] : bvhs) {
         if (part->geomId == RTC_INVALID_GEOMETRY_ID) continue;
         RTCRayHit rh;
         rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
@@ -285,7 +290,7 @@ void DetpDiscs::crossings(const Segment& s, std::vector<Crossed>& out) const {
         rh.ray.id = 0;
         rh.ray.flags = 0;
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(part == &static_ ? staticDiscs_.get() : dynamicDiscs_.get(), &ctx.base, &rh);
+        rtcIntersect1(bvh, &ctx.base, &rh);
     }
     // Embree may report a primitive more than once along one ray (NOTES.md).
     std::sort(crossed.begin(), crossed.end());
@@ -297,6 +302,32 @@ void DetpDiscs::crossings(const Segment& s, std::vector<Crossed>& out) const {
         if (pointReachable(c.reach, discOf(regions_, c.vertex), scene_.positions[c.vertex], scene_.normals[c.vertex], radius_,
                            c.at.x, c.at.y, bvh_))
             out.push_back(Crossed{c});
+}
+
+void DetpDiscs::recompute(const std::vector<Segment>& segments, const PowerQuantizer& q,
+                          const std::vector<uint32_t>& vertices, std::vector<DetpVertexSums>& sums) const {
+    for (uint32_t v : vertices) sums[v] = DetpVertexSums();
+    if (vertices.empty()) return;
+    EmbreeScene bvh(device_);
+    Part part;
+    part.vertices = vertices;
+    addPart(device_, bvh.get(), part, RTC_BUILD_QUALITY_MEDIUM);
+    const bool moments = rule_ == DetpBoundary::Linear;
+    struct Hit {
+        uint32_t segment;
+        Crossed at;
+    };
+    tbb::enumerable_thread_specific<std::vector<Hit>> perThread;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        auto& hits = perThread.local();
+        std::vector<Crossed> crossed;
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            crossingsIn(segments[i], {{bvh.get(), &part}}, crossed);
+            for (const Crossed& c : crossed) hits.push_back({uint32_t(i), c});
+        }
+    });
+    for (const auto& hits : perThread)
+        for (const Hit& h : hits) sums[h.at.vertex].add(segments[h.segment].power, h.at.at, q, moments);
 }
 
 std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, const std::vector<uint32_t>& order,

@@ -90,20 +90,29 @@ public:
     void accumulate(const std::vector<Segment>& segments, const PowerQuantizer& q, int sign, const std::vector<uint8_t>& skip,
                     std::vector<DetpVertexSums>& sums, std::vector<uint32_t>& changed) const;
 
+    // Recomputes the sums of the given vertices from the given segments: a disc BVH of just
+    // those vertices, built for the call (an update's touched vertices).
+    void recompute(const std::vector<Segment>& segments, const PowerQuantizer& q, const std::vector<uint32_t>& vertices,
+                   std::vector<DetpVertexSums>& sums) const;
+
     const DiscRegions* regions() const { return regions_; }
     DetpBoundary rule() const { return rule_; }
     float radius() const { return radius_; }
 
 private:
     struct Crossed;
-    void crossings(const Segment& s, std::vector<Crossed>& out) const;  // sorted by vertex, decided
     struct Part {
         std::vector<uint32_t> vertices;  // primID -> scene vertex
         unsigned geomId = RTC_INVALID_GEOMETRY_ID;
     };
-    void addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality);
+    // The discs the segment crosses in the given disc BVHs, sorted by vertex, decided.
+    void crossings(const Segment& s, std::vector<Crossed>& out) const;
+    void crossingsIn(const Segment& s, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
+                     std::vector<Crossed>& out) const;
+    void addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality) const;
     void fillPart(RTCGeometry geom, const Part& part) const;
 
+    const EmbreeDevice& device_;
     const Scene& scene_;
     float radius_;
     DetpBoundary rule_;

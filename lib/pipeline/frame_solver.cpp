@@ -132,8 +132,9 @@ void FrameSolver::solveFromScratch(FrameWork& work) {
     const Envelope envelope = settings_.useEnvelope ? Envelope::ofAnimation(scene_, sums ? margin : scene_.sceneEpsilon())
                                                     : Envelope::everything();
     const Bounds3f gridBounds = envelope.isEverything() ? scene_.animationBounds.expanded(margin) : envelope.bounds();
-    // Cells about a disc across, but no more than 64 along an axis (16 for the whole scene).
-    const float cellSize = std::max(discs ? 2 * e.radius : 0.0f, gridBounds.extent() / (envelope.isEverything() ? 16 : 64));
+    // Cells a few discs across, no more than 32 along an axis (16 for the whole scene): queries
+    // ask about objects' bounds, and finer cells cost more to fill than they save.
+    const float cellSize = std::max(discs ? 4 * e.radius : 0.0f, gridBounds.extent() / (envelope.isEverything() ? 16 : 32));
     staticSegments_.clear();
     tracked_ = std::make_unique<TrackedPaths>(cache, envelope, sums && discs ? e.radius : 0.0f, gridBounds, cellSize,
                                               sums ? nullptr : &staticSegments_);
@@ -214,21 +215,27 @@ void FrameSolver::solveIncrementally(const PoseChange& change, FrameWork& work) 
                 if (touched[v]) changed.push_back(v);
         }
         Stopwatch recomputeClock;
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, recompute.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
+        for (uint32_t v : recompute) detpSums_[v] = DetpVertexSums();
+        if (e.useIndex) {
+            // The tracked segments near any recomputed disc, gathered once from the grid (every
+            // such disc lies within the envelope margin of a moved object's old or new bounds),
+            // then traced through the disc BVH counting only the recomputed vertices.
+            const float margin = envelopeMargin(true, e.radius, scene_.sceneEpsilon());
             std::vector<const Segment*> near;
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                const uint32_t v = recompute[i];
-                near.clear();
-                if (e.useIndex) {
-                    Bounds3f box;
-                    box.extend(scene_.positions[v]);
-                    tracked_->segmentsNear(box.expanded(e.radius * 1.001f + 4 * scene_.sceneEpsilon()), near);
-                } else {
-                    tracked_->allSegments(near);
-                }
-                detpSums_[v] = detpVertexSums(scene_, v, near, e.radius, e.boundary, regions(), &bvh_, q);
-            }
-        });
+            for (const Bounds3f& b : change.bounds) tracked_->segmentsNear(b.expanded(margin), near);
+            std::sort(near.begin(), near.end());
+            near.erase(std::unique(near.begin(), near.end()), near.end());
+            std::vector<Segment> segments(near.size());
+            for (size_t i = 0; i < near.size(); ++i) segments[i] = *near[i];
+            discs_->recompute(segments, q, recompute, detpSums_);
+        } else {
+            std::vector<const Segment*> all;
+            tracked_->allSegments(all);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, recompute.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t i = r.begin(); i != r.end(); ++i)
+                    detpSums_[recompute[i]] = detpVertexSums(scene_, recompute[i], all, e.radius, e.boundary, regions(), &bvh_, q);
+            });
+        }
         work.recomputeSeconds = recomputeClock.seconds();
         work.verticesRecomputed = recompute.size();
         changed.insert(changed.end(), recompute.begin(), recompute.end());
