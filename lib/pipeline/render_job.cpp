@@ -159,6 +159,7 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces};
     solverSettings.fullRecompute = settings_.fullRecompute;
     solverSettings.useEnvelope = settings_.useEnvelope;
+    solverSettings.gridForBlocking = settings_.blockingGrid;
     // Built in the rest pose, before any frame: every run refits the same BVHs (DESIGN §6.0).
     scene_.applyPose(scene_.restLocals());
     FrameSolver solver(scene_, device, solverSettings);

@@ -133,12 +133,14 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
             s.estimator.radius = v.get<float>();
             s.radiusGiven = true;
         } else if (key == "k") s.estimator.k = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 24));
-        else if (key == "ray_cache" || key == "sort_queries" || key == "full_recompute" || key == "envelope") {
+        else if (key == "ray_cache" || key == "sort_queries" || key == "full_recompute" || key == "envelope" ||
+                 key == "blocking_grid") {
             if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
             bool& target = key == "ray_cache" ? s.estimator.useIndex
                            : key == "sort_queries" ? s.estimator.sortQueries
                            : key == "full_recompute" ? s.fullRecompute
-                                                     : s.useEnvelope;
+                           : key == "envelope"       ? s.useEnvelope
+                                                     : s.blockingGrid;
             target = v.get<bool>();
         } else if (key == "detp_index") s.estimator.detpIndex = parseDetpIndex(str(), path);
         else if (key == "detp_boundary") s.estimator.boundary = parseDetpBoundary(str(), path);
