@@ -312,22 +312,7 @@ void DetpDiscs::recompute(const std::vector<Segment>& segments, const PowerQuant
     Part part;
     part.vertices = vertices;
     addPart(device_, bvh.get(), part, RTC_BUILD_QUALITY_MEDIUM);
-    const bool moments = rule_ == DetpBoundary::Linear;
-    struct Hit {
-        uint32_t segment;
-        Crossed at;
-    };
-    tbb::enumerable_thread_specific<std::vector<Hit>> perThread;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-        auto& hits = perThread.local();
-        std::vector<Crossed> crossed;
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            crossingsIn(segments[i], {{bvh.get(), &part}}, crossed);
-            for (const Crossed& c : crossed) hits.push_back({uint32_t(i), c});
-        }
-    });
-    for (const auto& hits : perThread)
-        for (const Hit& h : hits) sums[h.at.vertex].add(segments[h.segment].power, h.at.at, q, moments);
+    addCrossings(segments, {{bvh.get(), &part}}, nullptr, +1, q, sums, nullptr);
 }
 
 std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, const std::vector<uint32_t>& order,
@@ -372,6 +357,12 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
 void DetpDiscs::accumulate(const std::vector<Segment>& segments, const PowerQuantizer& q, int sign,
                            const std::vector<uint8_t>& skip, std::vector<DetpVertexSums>& sums,
                            std::vector<uint32_t>& changed) const {
+    addCrossings(segments, {{staticDiscs_.get(), &static_}, {dynamicDiscs_.get(), &dynamic_}}, &skip, sign, q, sums, &changed);
+}
+
+void DetpDiscs::addCrossings(const std::vector<Segment>& segments, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
+                             const std::vector<uint8_t>* skip, int sign, const PowerQuantizer& q,
+                             std::vector<DetpVertexSums>& sums, std::vector<uint32_t>* changed) const {
     const bool moments = rule_ == DetpBoundary::Linear;
     // Crossings are found in parallel and applied in one thread: few segments change per frame,
     // and a per-thread copy of every vertex's sums would cost more than the work.
@@ -384,15 +375,15 @@ void DetpDiscs::accumulate(const std::vector<Segment>& segments, const PowerQuan
         auto& hits = perThread.local();
         std::vector<Crossed> crossed;
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            crossings(segments[i], crossed);
+            crossingsIn(segments[i], bvhs, crossed);
             for (const Crossed& c : crossed)
-                if (!skip[c.vertex]) hits.push_back({uint32_t(i), c});
+                if (!skip || !(*skip)[c.vertex]) hits.push_back({uint32_t(i), c});
         }
     });
     for (const auto& hits : perThread)
         for (const Hit& h : hits) {
             sums[h.at.vertex].add(segments[h.segment].power, h.at.at, q, moments, sign);
-            changed.push_back(h.at.vertex);
+            if (changed) changed->push_back(h.at.vertex);
         }
 }
 

@@ -18,6 +18,8 @@
 // fixed-point sums make them equal to the last bit.
 #pragma once
 
+#include <initializer_list>
+#include <utility>
 #include <vector>
 
 #include "estimate/disc_regions.h"
@@ -95,10 +97,6 @@ public:
     void recompute(const std::vector<Segment>& segments, const PowerQuantizer& q, const std::vector<uint32_t>& vertices,
                    std::vector<DetpVertexSums>& sums) const;
 
-    const DiscRegions* regions() const { return regions_; }
-    DetpBoundary rule() const { return rule_; }
-    float radius() const { return radius_; }
-
 private:
     struct Crossed;
     struct Part {
@@ -109,6 +107,11 @@ private:
     void crossings(const Segment& s, std::vector<Crossed>& out) const;
     void crossingsIn(const Segment& s, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
                      std::vector<Crossed>& out) const;
+    // Adds sign × the crossings of every segment in the given disc BVHs to `sums`, except at
+    // vertices flagged in skip (if given); appends each vertex changed to `changed` (if given).
+    void addCrossings(const std::vector<Segment>& segments, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
+                      const std::vector<uint8_t>* skip, int sign, const PowerQuantizer& q,
+                      std::vector<DetpVertexSums>& sums, std::vector<uint32_t>* changed) const;
     void addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality) const;
     void fillPart(RTCGeometry geom, const Part& part) const;
 

@@ -24,7 +24,11 @@ bool FrameSolver::updatesSums() const {
 
 FrameSolver::PoseChange FrameSolver::pose(const std::vector<Transform>& locals) {
     PoseChange change;
-    const std::vector<Vec3f> before = scene_.positions;
+    // Only instances the animation moves can move: keep their positions to compare with.
+    previousPositions_.resize(scene_.vertexCount());
+    for (const MeshInstance& inst : scene_.instances)
+        if (inst.vertexCount > 0 && scene_.vertexDynamic[inst.firstVertex])
+            std::copy_n(scene_.positions.begin() + inst.firstVertex, inst.vertexCount, previousPositions_.begin() + inst.firstVertex);
     change.any = scene_.applyPose(locals, &change.instances, &change.bounds);
     for (size_t i = 1; i < change.bounds.size(); i += 2) change.newBounds.push_back(change.bounds[i]);
     // Moved is decided per vertex and triangle: an instance re-placed by a transform that leaves
@@ -34,7 +38,7 @@ FrameSolver::PoseChange FrameSolver::pose(const std::vector<Transform>& locals) 
     for (uint32_t i : change.instances) {
         const MeshInstance& inst = scene_.instances[i];
         for (uint32_t v = inst.firstVertex; v < inst.firstVertex + inst.vertexCount; ++v)
-            change.vertexMoved[v] = std::memcmp(&before[v], &scene_.positions[v], sizeof(Vec3f)) != 0;
+            change.vertexMoved[v] = std::memcmp(&previousPositions_[v], &scene_.positions[v], sizeof(Vec3f)) != 0;
         for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t)
             for (uint32_t v : scene_.triangles[t].v) change.triangleMoved[t] |= change.vertexMoved[v];
     }
@@ -42,17 +46,24 @@ FrameSolver::PoseChange FrameSolver::pose(const std::vector<Transform>& locals) 
     return change;
 }
 
-void FrameSolver::updateRegions(const PoseChange& change, FrameWork& work) {
+std::vector<uint32_t> FrameSolver::touchedVertices(const PoseChange& change) const {
+    if (regions_) return regions_->touchedBy(scene_, change.bounds, change.vertexMoved);
+    std::vector<uint32_t> moved;
+    for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
+        if (change.vertexMoved[v]) moved.push_back(v);
+    return moved;
+}
+
+void FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameWork& work) {
     if (!regions_) return;
     Stopwatch clock;
     if (!regionsValid_) {
         regions_->computeAll(scene_, bvh_);
         work.discRegionsUpdated = scene_.vertexCount();
         regionsValid_ = true;
-    } else if (change.any) {
-        const std::vector<uint32_t> touched = regions_->touchedBy(scene_, change.bounds, change.vertexMoved);
-        regions_->recompute(scene_, bvh_, touched);
-        work.discRegionsUpdated = touched.size();
+    } else if (touched) {
+        regions_->recompute(scene_, bvh_, *touched);
+        work.discRegionsUpdated = touched->size();
     }
     work.discRegionsSeconds = clock.seconds();
 }
@@ -61,9 +72,9 @@ const VertexRadiosity& FrameSolver::solve(const std::vector<Transform>& locals, 
     work = FrameWork();
     const PoseChange change = pose(locals);
     if (!solved_ || settings_.fullRecompute) {
-        if (!solved_) regionsValid_ = false;
         Stopwatch clock;
-        updateRegions(change, work);
+        const std::vector<uint32_t> touched = regionsValid_ && change.any ? touchedVertices(change) : std::vector<uint32_t>();
+        updateRegions(regionsValid_ && change.any ? &touched : nullptr, work);
         const double regionSeconds = clock.seconds();
         solveFromScratch(work);
         work.estimationSeconds += regionSeconds;
@@ -98,26 +109,22 @@ void FrameSolver::solveFromScratch(FrameWork& work) {
         impactCount_.emplace(scene_);
         impactCount_->accumulate(cache);
         result_ = impactCount_->estimate(scene_, q);
-    } else if (updatesSums() && e.useIndex) {
-        if (!discs_) discs_ = std::make_unique<DetpDiscs>(device_, scene_, e.radius, e.boundary, regions(), &bvh_);
-        discs_->updateDynamic();
-        detpSums_ = discs_->sums(cache, e.sortQueries ? segmentMortonOrder(cache) : inputOrder(cache.segments.size()));
-        result_.irradiance.resize(scene_.vertexCount());
-        for (size_t v = 0; v < scene_.vertexCount(); ++v)
-            result_.irradiance[v] = detpVertexIrradiance(detpSums_[v], regions_ ? &(*regions_)[v] : nullptr, e.radius, e.boundary, q);
-        finishRadiosity();
-    } else {
-        result_ = estimateVertexRadiosity(scene_, bvh_, cache, e, device_, regions());
-        if (updatesSums()) {
-            // Brute-force DETP (--no-ray-cache) keeps its sums the index-free way.
-            detpSums_.assign(scene_.vertexCount(), DetpVertexSums());
+    } else if (updatesSums()) {
+        if (e.useIndex) {
+            if (!discs_) discs_ = std::make_unique<DetpDiscs>(device_, scene_, e.radius, e.boundary, regions(), &bvh_);
+            discs_->updateDynamic();
+            detpSums_ = discs_->sums(cache, e.sortQueries ? segmentMortonOrder(cache) : inputOrder(cache.segments.size()));
+        } else {
             std::vector<const Segment*> all(cache.segments.size());
             for (size_t i = 0; i < all.size(); ++i) all[i] = &cache.segments[i];
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, scene_.vertexCount(), 16), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t v = r.begin(); v != r.end(); ++v)
-                    detpSums_[v] = detpVertexSums(scene_, uint32_t(v), all, e.radius, e.boundary, regions(), &bvh_, q);
-            });
+            detpSums_.assign(scene_.vertexCount(), DetpVertexSums());
+            detpBruteForceSums(inputOrder(scene_.vertexCount()), all, q);
         }
+        result_.irradiance.resize(scene_.vertexCount());
+        for (uint32_t v = 0; v < scene_.vertexCount(); ++v) result_.irradiance[v] = detpIrradiance(v, q);
+        computeRadiosity(scene_, result_);
+    } else {
+        result_ = estimateVertexRadiosity(scene_, bvh_, cache, e, device_, regions());
     }
     work.estimationSeconds = clock.seconds();
     work.verticesUpdated = scene_.vertexCount();
@@ -141,7 +148,19 @@ void FrameSolver::solveFromScratch(FrameWork& work) {
     foldedSegments_ = cache.segments.size() - tracked_->trackedSegments();
 }
 
-void FrameSolver::finishRadiosity() { computeRadiosity(scene_, result_); }
+Vec3f FrameSolver::detpIrradiance(uint32_t v, const PowerQuantizer& q) const {
+    const EstimatorSettings& e = settings_.estimator;
+    return detpVertexIrradiance(detpSums_[v], regions_ ? &(*regions_)[v] : nullptr, e.radius, e.boundary, q);
+}
+
+void FrameSolver::detpBruteForceSums(const std::vector<uint32_t>& vertices, const std::vector<const Segment*>& segments,
+                                     const PowerQuantizer& q) {
+    const EstimatorSettings& e = settings_.estimator;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i)
+            detpSums_[vertices[i]] = detpVertexSums(scene_, vertices[i], segments, e.radius, e.boundary, regions(), &bvh_, q);
+    });
+}
 
 void FrameSolver::solveIncrementally(const PoseChange& change, FrameWork& work) {
     if (!change.any) return;  // nothing moved: no path changes, no vertex changes
@@ -160,7 +179,9 @@ void FrameSolver::solveIncrementally(const PoseChange& change, FrameWork& work) 
     work.segmentsAdded = changes.added.size();
 
     Stopwatch clock;
-    updateRegions(change, work);
+    // Vertices whose disc moved or whose regions the move touched.
+    const std::vector<uint32_t> touched = touchedVertices(change);
+    updateRegions(&touched, work);
     const EstimatorSettings& e = settings_.estimator;
     const PowerQuantizer q(maxPhotonPower_);
     if (e.kind == EstimatorKind::ImpactCount) {
@@ -182,11 +203,7 @@ void FrameSolver::solveIncrementally(const PoseChange& change, FrameWork& work) 
     } else if (updatesSums()) {
         // Vertices whose disc moved or whose regions the move touched are recomputed from the
         // tracked segments near them; every other vertex takes + new − old.
-        std::vector<uint32_t> recompute;
-        if (regions_) recompute = regions_->touchedBy(scene_, change.bounds, change.vertexMoved);
-        else
-            for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
-                if (change.vertexMoved[v]) recompute.push_back(v);
+        const std::vector<uint32_t>& recompute = touched;
         std::vector<uint8_t> skip(scene_.vertexCount(), 0);
         for (uint32_t v : recompute) skip[v] = 1;
         std::vector<uint32_t> changed;
@@ -231,19 +248,15 @@ void FrameSolver::solveIncrementally(const PoseChange& change, FrameWork& work) 
         } else {
             std::vector<const Segment*> all;
             tracked_->allSegments(all);
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, recompute.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t i = r.begin(); i != r.end(); ++i)
-                    detpSums_[recompute[i]] = detpVertexSums(scene_, recompute[i], all, e.radius, e.boundary, regions(), &bvh_, q);
-            });
+            detpBruteForceSums(recompute, all, q);
         }
         work.recomputeSeconds = recomputeClock.seconds();
         work.verticesRecomputed = recompute.size();
         changed.insert(changed.end(), recompute.begin(), recompute.end());
         std::sort(changed.begin(), changed.end());
         changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-        for (uint32_t v : changed)
-            result_.irradiance[v] = detpVertexIrradiance(detpSums_[v], regions_ ? &(*regions_)[v] : nullptr, e.radius, e.boundary, q);
-        finishRadiosity();
+        for (uint32_t v : changed) result_.irradiance[v] = detpIrradiance(v, q);
+        computeRadiosity(scene_, result_);
         work.verticesUpdated = changed.size();
     } else {
         // The photon map's k nearest neighbours cannot be folded (DESIGN §6.5): re-estimate from

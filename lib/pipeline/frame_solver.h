@@ -56,8 +56,8 @@ public:
 
     // Poses the scene with the frame's local transforms and computes its radiosity.
     const VertexRadiosity& solve(const std::vector<Transform>& locals, FrameWork& work);
-    // The next solve starts from scratch.
-    void reset() { solved_ = false; }
+    // The next solve starts from scratch, disc regions included.
+    void reset() { solved_ = regionsValid_ = false; }
 
     const SceneBvh& bvh() const { return bvh_; }
     const DiscRegions* regions() const { return regions_ ? &*regions_ : nullptr; }
@@ -73,13 +73,19 @@ private:
         bool any = false;
     };
     PoseChange pose(const std::vector<Transform>& locals);
-    void updateRegions(const PoseChange& change, FrameWork& work);
+    // Vertices whose disc moved or whose regions the move touched (the moved ones without regions).
+    std::vector<uint32_t> touchedVertices(const PoseChange& change) const;
+    // Computes every vertex's regions the first time, afterwards only the touched ones (if given).
+    void updateRegions(const std::vector<uint32_t>* touched, FrameWork& work);
     void solveFromScratch(FrameWork& work);
     void solveIncrementally(const PoseChange& change, FrameWork& work);
     // Whether the estimator keeps per-vertex sums that "+ new − old" can update; the others
     // re-estimate from every segment, so nothing can be folded.
     bool updatesSums() const;
-    void finishRadiosity();
+    Vec3f detpIrradiance(uint32_t vertex, const PowerQuantizer& q) const;
+    // DETP sums of the given vertices from the given segments, without an index.
+    void detpBruteForceSums(const std::vector<uint32_t>& vertices, const std::vector<const Segment*>& segments,
+                            const PowerQuantizer& q);
 
     Scene& scene_;
     const EmbreeDevice& device_;
@@ -89,7 +95,7 @@ private:
     std::optional<DiscRegions> regions_;
     bool regionsValid_ = false;
     bool solved_ = false;
-
+    std::vector<Vec3f> previousPositions_;  // the moving instances' vertices before a pose
     // Incremental state: the tracked paths and the estimator's sums.
     std::unique_ptr<TrackedPaths> tracked_;
     uint64_t foldedSegments_ = 0;

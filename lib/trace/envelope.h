@@ -24,7 +24,6 @@ public:
     // end), meets the envelope.
     bool meets(const Segment& s, float extension) const;
     bool isEverything() const { return everything_; }
-    bool isEmpty() const { return !everything_ && boxes_.empty(); }
     const std::vector<Bounds3f>& boxes() const { return boxes_; }
     Bounds3f bounds() const;  // of all boxes
 

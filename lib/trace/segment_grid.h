@@ -62,7 +62,6 @@ public:
 
     size_t entries() const { return entries_; }
     size_t bytes() const;
-    bool empty() const { return cells_.empty(); }
 
 private:
     bool cellRange(const Bounds3f& box, int lo[3], int hi[3]) const;
