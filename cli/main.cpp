@@ -45,31 +45,24 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
         s.estimator.radius = float(*o.radius);
         s.radiusGiven = true;
     }
-    if (o.k) s.estimator.k = int(std::clamp<int64_t>(*o.k, -1, 1 << 24));
+    const std::string cli = "command line";
+    if (o.k) s.estimator.k = int(qsgi::checkedInteger(*o.k, 1, qsgi::kMaxK, cli, "--k"));
     if (o.noRayCache) s.estimator.useIndex = false;
     if (o.noSortQueries) s.estimator.sortQueries = false;
     if (o.fullRecompute) s.fullRecompute = true;
     if (o.noEnvelope) s.useEnvelope = false;
-    if (!o.frames.empty()) s.frames = qsgi::parseFrameRange(o.frames, "command line");
+    if (!o.frames.empty()) {
+        s.frames = qsgi::parseFrameRange(o.frames, cli);
+        s.framesSource = cli;
+    }
     if (!o.out.empty()) s.outDir = o.out;
-    if (o.photons) {
-        if (*o.photons <= 0) throw qsgi::InputError("command line", "--photons", "must be a positive integer");
-        s.photons = uint64_t(*o.photons);
-    }
-    if (o.seed) {
-        if (*o.seed < 0) throw qsgi::InputError("command line", "--seed", "must be a non-negative integer");
-        s.seed = uint64_t(*o.seed);
-    }
-    if (o.threads) {
-        if (*o.threads < 0) throw qsgi::InputError("command line", "--threads", "must be a non-negative integer (0: all cores)");
-        s.threads = int(std::min<int64_t>(*o.threads, 1024));
-    }
-    // Out-of-range sizes are clamped into int range here and rejected by validateSettings.
-    auto clampToInt = [](int64_t v) { return int(std::clamp<int64_t>(v, -1, 1 << 24)); };
-    if (o.width) s.width = clampToInt(*o.width);
-    if (o.height) s.height = clampToInt(*o.height);
-    if (o.spp) s.samplesPerPixel = clampToInt(*o.spp);
-    if (o.camera) s.cameraIndex = clampToInt(*o.camera);
+    if (o.photons) s.photons = qsgi::checkedPhotons(*o.photons, cli, "--photons");
+    if (o.seed) s.seed = uint64_t(qsgi::checkedInteger(*o.seed, 0, qsgi::kMaxSeed, cli, "--seed"));
+    if (o.threads) s.threads = int(qsgi::checkedInteger(*o.threads, 0, qsgi::kMaxThreads, cli, "--threads", " (0: all cores)"));
+    if (o.width) s.width = int(qsgi::checkedInteger(*o.width, 1, qsgi::kMaxImageSide, cli, "--width"));
+    if (o.height) s.height = int(qsgi::checkedInteger(*o.height, 1, qsgi::kMaxImageSide, cli, "--height"));
+    if (o.spp) s.samplesPerPixel = int(qsgi::checkedInteger(*o.spp, 1, qsgi::kMaxSamplesPerPixel, cli, "--spp"));
+    if (o.camera) s.cameraIndex = int(qsgi::checkedInteger(*o.camera, 0, INT32_MAX, cli, "--camera"));
     if (o.exposure) s.exposure = float(*o.exposure);
     if (o.png) s.writePng = true;
     if (o.noExr) s.writeExr = false;

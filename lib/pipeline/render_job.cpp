@@ -95,7 +95,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         first_ = settings_.frames->first;
         last_ = settings_.frames->last < 0 ? animation_.lastFrame() : settings_.frames->last;
         if (last_ > animation_.lastFrame())
-            throw InputError("command line", "--frames",
+            throw InputError(settings_.framesSource.empty() ? "command line" : settings_.framesSource, "frames",
                              std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the animation's last frame " +
                                  std::to_string(animation_.lastFrame()));
     }

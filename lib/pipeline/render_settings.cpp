@@ -7,17 +7,38 @@
 #include <filesystem>
 
 #include "util/error.h"
+#include "trace/ray_cache.h"
 #include "util/json_file.h"
+#include "util/memory.h"
+#include "util/nearest_name.h"
 
 namespace qsgi {
 
 using nlohmann::json;
 
+int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string& source, const std::string& place,
+                       const std::string& why) {
+    if (value < lo || value > hi)
+        throw InputError(source, place, std::to_string(value) + " is outside " + std::to_string(lo) + ".." +
+                                            std::to_string(hi) + why);
+    return value;
+}
+
+uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place) {
+    const uint64_t photons = uint64_t(checkedInteger(value, 1, kMaxPhotons, source, place, " (2^32: the path index is 32 bits)"));
+    refuseBeyondMemory(photons * (sizeof(Segment) + sizeof(uint64_t)), source, place,
+                       std::to_string(photons) + " photons (at least one " + std::to_string(sizeof(Segment)) +
+                           "-byte segment each)");
+    return photons;
+}
+
 EstimatorKind parseEstimator(const std::string& name, const std::string& source) {
     if (name == "impact-count") return EstimatorKind::ImpactCount;
     if (name == "photon-map") return EstimatorKind::PhotonMap;
     if (name == "detp") return EstimatorKind::Detp;
-    throw InputError(source, "estimator", "unknown estimator '" + name + "' (available: detp, photon-map, impact-count)");
+    throw InputError(source, "estimator", "unknown estimator '" + name + "'" +
+                                              didYouMean(name, {"detp", "photon-map", "impact-count"}) +
+                                              " (available: detp, photon-map, impact-count)");
 }
 
 DetpIndex parseDetpIndex(const std::string& name, const std::string& source) {
@@ -64,9 +85,32 @@ Vec3f vec3(const json& j, const std::string& file, const std::string& place) {
     return v;
 }
 
+// Keys starting with "_" and "comment" are notes for people.
+void refuseUnknownKeys(const json& j, const std::vector<std::string>& known, const std::string& file,
+                       const std::string& place) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& key = it.key();
+        if (std::find(known.begin(), known.end(), key) != known.end() || key.rfind("_", 0) == 0 || key == "comment")
+            continue;
+        throw InputError(file, place.empty() ? key : place + "." + key, "unknown key" + didYouMean(key, known));
+    }
+}
+
+// An integer, also when written as 1e6 (a float with no fraction); never wrapped.
+int64_t jsonInteger(const json& v, const std::string& file, const std::string& key) {
+    if (v.is_number_unsigned()) return v.get<uint64_t>() > uint64_t(INT64_MAX) ? INT64_MAX : int64_t(v.get<uint64_t>());
+    if (v.is_number_integer()) return v.get<int64_t>();
+    if (v.is_number_float()) {
+        const double d = v.get<double>();
+        if (std::floor(d) == d && std::fabs(d) < 9.0e18) return int64_t(d);
+    }
+    throw InputError(file, key, "must be an integer");
+}
+
 PunctualLight parseLight(const json& j, const std::string& file, const std::string& place) {
     if (!j.is_object() || !j.contains("type") || !j["type"].is_string())
         throw InputError(file, place, "must be an object with a \"type\" (point or directional)");
+    refuseUnknownKeys(j, {"type", "position", "intensity", "direction", "irradiance", "name"}, file, place);
     PunctualLight l;
     const std::string type = j["type"];
     l.name = place;
@@ -93,11 +137,10 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
     return l;
 }
 
-uint64_t positiveInteger(const json& j, const std::string& file, const std::string& key) {
-    if (!j.is_number_integer() || j.get<int64_t>() <= 0)
-        throw InputError(file, key, "must be a positive integer");
-    return j.get<uint64_t>();
-}
+const std::vector<std::string> kConfigKeys = {
+    "scene", "animation", "out", "estimator", "radius", "k", "ray_cache", "sort_queries", "full_recompute",
+    "envelope", "blocking_grid", "detp_index", "detp_boundary", "photons", "seed", "max_bounces", "threads",
+    "frames", "lights", "width", "height", "spp", "exr", "exr_half", "png", "exposure", "camera"};
 
 void applyConfig(const std::string& path, const json& doc, RenderSettings& s);
 }  // namespace
@@ -132,7 +175,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
                 throw InputError(path, key, "must be a positive number (scene units)");
             s.estimator.radius = v.get<float>();
             s.radiusGiven = true;
-        } else if (key == "k") s.estimator.k = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 24));
+        } else if (key == "k") s.estimator.k = int(checkedInteger(jsonInteger(v, path, key), 1, kMaxK, path, key));
         else if (key == "ray_cache" || key == "sort_queries" || key == "full_recompute" || key == "envelope" ||
                  key == "blocking_grid") {
             if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
@@ -144,21 +187,24 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
             target = v.get<bool>();
         } else if (key == "detp_index") s.estimator.detpIndex = parseDetpIndex(str(), path);
         else if (key == "detp_boundary") s.estimator.boundary = parseDetpBoundary(str(), path);
-        else if (key == "photons") s.photons = positiveInteger(v, path, key);
-        else if (key == "seed") {
-            if (!v.is_number_integer() || v.get<int64_t>() < 0) throw InputError(path, key, "must be a non-negative integer");
-            s.seed = v.get<uint64_t>();
-        } else if (key == "max_bounces") s.maxBounces = uint32_t(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 16));
-        else if (key == "threads") {
-            if (!v.is_number_integer() || v.get<int64_t>() < 0) throw InputError(path, key, "must be a non-negative integer");
-            s.threads = int(std::min<int64_t>(v.get<int64_t>(), 1024));
-        } else if (key == "frames") s.frames = parseFrameRange(str(), path);
+        else if (key == "photons") s.photons = checkedPhotons(jsonInteger(v, path, key), path, key);
+        else if (key == "seed") s.seed = uint64_t(checkedInteger(jsonInteger(v, path, key), 0, kMaxSeed, path, key));
+        else if (key == "max_bounces")
+            s.maxBounces = uint32_t(checkedInteger(jsonInteger(v, path, key), 1, kMaxBounces, path, key,
+                                                   " (the bounce field of a segment is 16 bits)"));
+        else if (key == "threads")
+            s.threads = int(checkedInteger(jsonInteger(v, path, key), 0, kMaxThreads, path, key, " (0: all cores)"));
+        else if (key == "frames") {
+            s.frames = parseFrameRange(str(), path);
+            s.framesSource = path;
+        }
         else if (key == "lights") {
             if (!v.is_array()) throw InputError(path, key, "must be an array of lights");
             for (size_t i = 0; i < v.size(); ++i) s.extraLights.push_back(parseLight(v[i], path, "lights[" + std::to_string(i) + "]"));
-        } else if (key == "width") s.width = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 20));
-        else if (key == "height") s.height = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 20));
-        else if (key == "spp") s.samplesPerPixel = int(std::min<uint64_t>(positiveInteger(v, path, key), 1u << 16));
+        } else if (key == "width") s.width = int(checkedInteger(jsonInteger(v, path, key), 1, kMaxImageSide, path, key));
+        else if (key == "height") s.height = int(checkedInteger(jsonInteger(v, path, key), 1, kMaxImageSide, path, key));
+        else if (key == "spp")
+            s.samplesPerPixel = int(checkedInteger(jsonInteger(v, path, key), 1, kMaxSamplesPerPixel, path, key));
         else if (key == "exr") {
             if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
             s.writeExr = v.get<bool>();
@@ -173,11 +219,13 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
                 throw InputError(path, key, "must be a positive number");
             s.exposure = v.get<float>();
         } else if (key == "camera") {
-            if (v.is_number_integer()) {
-                s.cameraIndex = int(std::clamp<int64_t>(v.get<int64_t>(), -1, 1 << 20));
+            if (v.is_number()) {
+                s.cameraIndex = int(checkedInteger(jsonInteger(v, path, key), 0, INT32_MAX, path, key));
                 continue;
             }
-            if (!v.is_object() || !v.contains("position") || !v.contains("target"))
+            if (!v.is_object()) throw InputError(path, key, "must be a glTF camera index or {position, target, up, yfov}");
+            refuseUnknownKeys(v, {"position", "target", "up", "yfov"}, path, key);
+            if (!v.contains("position") || !v.contains("target"))
                 throw InputError(path, key, "must be a glTF camera index or {position, target, up, yfov}");
             RenderSettings::LookAt c;
             c.position = vec3(v["position"], path, "camera.position");
@@ -191,7 +239,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
         } else if (key.rfind("_", 0) == 0 || key == "comment") {
             // "_…" and "comment" keys are notes for people
         } else {
-            throw InputError(path, key, "unknown key");
+            throw InputError(path, key, "unknown key" + didYouMean(key, kConfigKeys));
         }
     }
 }
@@ -199,20 +247,22 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
 }  // namespace
 
 void validateSettings(const RenderSettings& s) {
-    if (s.scenePath.empty()) throw InputError("command line", "SCENE", "no scene given");
-    if (s.photons == 0) throw InputError("command line", "--photons", "must be a positive integer");
-    if (s.photons > (uint64_t(1) << 32)) throw InputError("command line", "--photons", "at most 2^32 photons are supported");
-    if (s.maxBounces == 0) throw InputError("command line", "max_bounces", "must be positive");
+    // Values from a config were checked against the config's name as they were read; these
+    // checks catch the command line's (and any program that fills RenderSettings itself).
+    const std::string cli = "command line";
+    if (s.scenePath.empty()) throw InputError(cli, "SCENE", "no scene given");
+    checkedPhotons(int64_t(std::min<uint64_t>(s.photons, INT64_MAX)), cli, "--photons");
+    checkedInteger(s.maxBounces, 1, kMaxBounces, cli, "max_bounces", " (the bounce field of a segment is 16 bits)");
     if (s.radiusGiven && !(s.estimator.radius > 0 && std::isfinite(s.estimator.radius)))
-        throw InputError("command line", "--radius", "must be a positive number (scene units)");
-    if (s.estimator.k <= 0) throw InputError("command line", "--k", "must be a positive integer");
-    constexpr int kMaxImageSide = 16384;
+        throw InputError(cli, "--radius", "must be a positive number (scene units)");
+    checkedInteger(s.estimator.k, 1, kMaxK, cli, "--k");
+    checkedInteger(s.threads, 0, kMaxThreads, cli, "--threads", " (0: all cores)");
     if (s.width <= 0 || s.height <= 0 || s.width > kMaxImageSide || s.height > kMaxImageSide)
-        throw InputError("command line", "--width/--height",
+        throw InputError(cli, "--width/--height",
                          std::to_string(s.width) + "x" + std::to_string(s.height) + " is outside 1..16384 per side");
-    if (s.samplesPerPixel <= 0 || s.samplesPerPixel > 4096) throw InputError("command line", "--spp", "must lie in 1..4096");
+    checkedInteger(s.samplesPerPixel, 1, kMaxSamplesPerPixel, cli, "--spp");
     if (s.exposure && !(*s.exposure > 0 && std::isfinite(*s.exposure)))
-        throw InputError("command line", "--exposure", "must be a positive number");
+        throw InputError(cli, "--exposure", "must be a positive number");
 }
 
 }  // namespace qsgi

@@ -32,6 +32,7 @@ struct RenderSettings {
     bool useEnvelope = true;     // fold paths that never meet the moving geometry's envelope
     bool blockingGrid = true;    // find blocked segments through the grid (false: test every tracked one)
     std::optional<FrameRange> frames;
+    std::string framesSource;  // where frames came from (the config or "command line"), for messages
     std::vector<PunctualLight> extraLights;  // world space, from the config
 
     // Images (DESIGN §7)
@@ -45,6 +46,23 @@ struct RenderSettings {
     bool progress = false;
     bool quiet = false;
 };
+
+// Limits of qsgi's own formats and of sane runs. Values beyond them are refused with a message,
+// never clamped or wrapped.
+constexpr int64_t kMaxPhotons = int64_t(1) << 32;  // a segment's path index is 32 bits
+constexpr int64_t kMaxBounces = int64_t(1) << 16;  // a segment's bounce field is 16 bits
+constexpr int64_t kMaxK = int64_t(1) << 24;
+constexpr int64_t kMaxThreads = 1024;
+constexpr int64_t kMaxImageSide = 16384;
+constexpr int64_t kMaxSamplesPerPixel = 4096;
+constexpr int64_t kMaxSeed = INT64_MAX;
+
+// `value` if it lies in [lo, hi], else InputError(source, place, "must lie in lo..hi" + why).
+int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string& source, const std::string& place,
+                       const std::string& why = "");
+// A photon count: within 1..kMaxPhotons and within the machine's memory (each photon stores at
+// least one segment and its path's start).
+uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place);
 
 // Reads a config file into `settings` (only the keys present change). Relative scene and
 // animation paths are resolved against the config's folder. Throws InputError.

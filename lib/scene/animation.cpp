@@ -2,10 +2,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <set>
 
 #include "util/error.h"
 #include "util/json_file.h"
+#include "util/nearest_name.h"
 
 namespace qsgi {
 
@@ -46,11 +48,20 @@ std::vector<double> numbers(const json& j, size_t count, const std::string& file
     return out;
 }
 
+// Keys starting with "_" and "comment" are notes for people, as in configs.
+void refuseUnknownKeys(const json& j, const std::vector<std::string>& known, const std::string& file,
+                       const std::string& place) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& key = it.key();
+        if (std::find(known.begin(), known.end(), key) != known.end() || key.rfind("_", 0) == 0 || key == "comment")
+            continue;
+        throw InputError(file, place.empty() ? key : place + "." + key, "unknown key" + didYouMean(key, known));
+    }
+}
+
 Transform parseNodeTransform(const json& j, const std::string& file, const std::string& place) {
     if (!j.is_object()) throw InputError(file, place, "must be an object with matrix or translation/rotation/scale");
-    for (auto it = j.begin(); it != j.end(); ++it)
-        if (it.key() != "matrix" && it.key() != "translation" && it.key() != "rotation" && it.key() != "scale")
-            throw InputError(file, place + "." + it.key(), "unknown field (expected matrix, translation, rotation, scale)");
+    refuseUnknownKeys(j, {"matrix", "translation", "rotation", "scale"}, file, place);
     Transform t;
     if (j.contains("matrix")) {
         if (j.size() != 1) throw InputError(file, place, "matrix cannot be combined with translation/rotation/scale");
@@ -92,6 +103,7 @@ Animation Animation::fromTransformFile(const std::string& path, const Scene& sce
 
 Animation Animation::parseTransformFile(const std::string& path, const nlohmann::json& doc, const Scene& scene) {
     if (!doc.is_object()) throw InputError(path, "", "must be a JSON object");
+    refuseUnknownKeys(doc, {"format", "version", "fps", "frames"}, path, "");
     if (doc.value("format", "") != "qsgi-animation")
         throw InputError(path, "format", "must be \"qsgi-animation\"");
     if (!doc.contains("version") || !doc["version"].is_number_integer() || doc["version"].get<int>() != 1)
@@ -112,6 +124,7 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
         std::string place = "frames[" + std::to_string(i) + "]";
         if (!f.is_object() || !f.contains("frame") || !f["frame"].is_number_integer())
             throw InputError(path, place, "must be an object with an integer \"frame\"");
+        refuseUnknownKeys(f, {"frame", "nodes"}, path, place);
         const int64_t frame = f["frame"].get<int64_t>();
         if (frame < 0 || frame > 10000000) throw InputError(path, place + ".frame", "must lie in [0, 10^7]");
         if (frame <= previousFrame)
@@ -124,7 +137,12 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
             if (!f["nodes"].is_object()) throw InputError(path, place + ".nodes", "must be an object keyed by node name");
             for (auto it = f["nodes"].begin(); it != f["nodes"].end(); ++it) {
                 const int node = findNode(scene, it.key());
-                if (node < 0) throw InputError(path, place + ", node '" + it.key() + "'", "no such node in " + scene.sourcePath);
+                if (node < 0) {
+                    std::vector<std::string> names;
+                    for (const SceneNode& n : scene.nodes) names.push_back(n.name);
+                    throw InputError(path, place + ", node '" + it.key() + "'",
+                                     "no such node in " + scene.sourcePath + didYouMean(it.key(), names));
+                }
                 const Transform t = parseNodeTransform(it.value(), path, place + ", node '" + it.key() + "'");
                 key.nodes.emplace_back(node, t);
                 if (!(t == a.rest_[node])) moved.insert(node);

@@ -2,11 +2,16 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
+
+#include "scene/gltf_document.h"
+#include "util/memory.h"
 
 namespace qsgi {
 namespace {
@@ -20,9 +25,48 @@ const std::set<std::string> kSupportedExtensions = {
 
 std::string at(const std::string& what, int index) { return what + "[" + std::to_string(index) + "]"; }
 
+// Accessor Formats
+// What the glTF 2.0 specification (§3.7.2.1, and KHR_mesh_quantization when the file requires it)
+// allows for the accessors qsgi reads: their element type, component types and normalisation.
+struct AccessorFormat {
+    int type;  // TINYGLTF_TYPE_*
+    std::vector<std::pair<int, bool>> allowed;           // (componentType, normalized)
+    std::vector<std::pair<int, bool>> allowedQuantized;  // more, with KHR_mesh_quantization
+};
+
+const AccessorFormat kPositionFormat{
+    TINYGLTF_TYPE_VEC3,
+    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}},
+    {{TINYGLTF_COMPONENT_TYPE_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_BYTE, true},
+     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
+     {TINYGLTF_COMPONENT_TYPE_SHORT, false}, {TINYGLTF_COMPONENT_TYPE_SHORT, true},
+     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}}};
+const AccessorFormat kNormalFormat{
+    TINYGLTF_TYPE_VEC3,
+    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}},
+    {{TINYGLTF_COMPONENT_TYPE_BYTE, true}, {TINYGLTF_COMPONENT_TYPE_SHORT, true}}};
+const AccessorFormat kIndexFormat{
+    TINYGLTF_TYPE_SCALAR,
+    {{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false},
+     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false}},
+    {}};
+
+std::string componentTypeName(int type) {
+    switch (type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
+        default: return "componentType " + std::to_string(type);
+    }
+}
+
 // Accessor Decoding
 // An accessor's elements as doubles, `components` per element, normalised integers mapped to
-// [0,1] or [-1,1] as the glTF spec says. Every offset is bounds-checked against its buffer.
+// [0,1] or [-1,1] as the glTF spec says. Every offset is bounds-checked against its buffer, and
+// sizes against the machine's memory, before anything is allocated.
 struct AccessorData {
     size_t count = 0;
     int components = 0;
@@ -32,26 +76,30 @@ struct AccessorData {
 
 class AccessorReader {
 public:
-    AccessorReader(const tinygltf::Model& model, const std::string& file) : model_(model), file_(file) {}
+    AccessorReader(const GltfDocument& document, const std::string& file)
+        : model_(document.model), absentBuffers_(document.absentBuffers), file_(file) {
+        for (const auto& ext : model_.extensionsRequired) quantized_ = quantized_ || ext == "KHR_mesh_quantization";
+    }
 
-    AccessorData read(int accessorIndex, const std::string& usedBy) const {
+    AccessorData read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const {
         const std::string place = usedBy + " -> " + at("accessors", accessorIndex);
         if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
             throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) +
                                                 ", which does not exist");
         const tinygltf::Accessor& acc = model_.accessors[accessorIndex];
+        checkFormat(acc, format, place);
         AccessorData out;
         out.count = acc.count;
         out.components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-        const int componentSize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
-        if (out.components <= 0 || componentSize <= 0)
-            throw InputError(file_, place, "unknown accessor type or componentType");
-        if (acc.count > (size_t(1) << 31))
-            throw InputError(file_, place, "count " + std::to_string(acc.count) + " is implausibly large");
-        out.values.assign(acc.count * size_t(out.components), 0.0);
+        refuseBeyondMemory(saturatingMultiply(acc.count, uint64_t(out.components) * sizeof(double)), file_, place,
+                           "its " + std::to_string(acc.count) + " elements");
         if (acc.bufferView >= 0)
-            decode(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, acc.normalized,
-                   out.components, place, out.values.data(), nullptr);
+            checkRange(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, out.components, place);
+        out.values.assign(acc.count * size_t(out.components), 0.0);
+        // Without a bufferView the elements are zeros, typically overridden by sparse values.
+        if (acc.bufferView >= 0)
+            decode(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, acc.normalized, out.components,
+                   out.values.data(), nullptr);
         if (acc.sparse.isSparse) applySparse(acc, out, place);
         for (double v : out.values)
             if (!std::isfinite(v)) throw InputError(file_, place, "holds a non-finite number (NaN or Inf)");
@@ -59,25 +107,68 @@ public:
     }
 
 private:
-    // Decodes `count` elements from a buffer view into `doubles` (or, for sparse indices, into
-    // `indices`), checking that every byte read lies inside the view and the buffer.
-    void decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized,
-                int components, const std::string& place, double* doubles, std::vector<size_t>* indices) const {
+    void checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const {
+        const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+        if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
+            throw InputError(file_, place, "unknown accessor type or componentType");
+        if (acc.type != format.type)
+            throw InputError(file_, place, std::string("must be of type ") +
+                                               (format.type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR"));
+        const std::pair<int, bool> used{acc.componentType, acc.normalized};
+        auto allows = [&](const std::vector<std::pair<int, bool>>& list) {
+            return std::find(list.begin(), list.end(), used) != list.end();
+        };
+        if (allows(format.allowed) || (quantized_ && allows(format.allowedQuantized))) return;
+        const std::string what = (acc.normalized ? "normalized " : "") + componentTypeName(acc.componentType);
+        if (allows(format.allowedQuantized))
+            throw InputError(file_, place, what + " components need the KHR_mesh_quantization extension, which the "
+                                                  "file does not list in extensionsRequired");
+        throw InputError(file_, place, what + " components are not allowed here by the glTF 2.0 specification");
+    }
+
+    // Checks that `count` elements from a buffer view lie inside the view and its buffer, with
+    // the alignment and stride the specification requires.
+    void checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
+                    const std::string& place) const {
         if (viewIndex < 0 || viewIndex >= int(model_.bufferViews.size()))
             throw InputError(file_, place, "refers to bufferView " + std::to_string(viewIndex) + ", which does not exist");
+        const std::string viewPlace = at("bufferViews", viewIndex);
         const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
         if (view.buffer < 0 || view.buffer >= int(model_.buffers.size()))
-            throw InputError(file_, at("bufferViews", viewIndex), "refers to a buffer that does not exist");
+            throw InputError(file_, viewPlace, "refers to a buffer that does not exist");
+        if (absentBuffers_.count(view.buffer))
+            throw InputError(file_, viewPlace, "reads buffer " + std::to_string(view.buffer) +
+                                                   ", which has no uri and so no data");
         const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
-        if (view.byteOffset + view.byteLength > buffer.data.size())
-            throw InputError(file_, at("bufferViews", viewIndex),
-                             "reaches byte " + std::to_string(view.byteOffset + view.byteLength) + " of buffer " +
+        if (uint64_t(view.byteOffset) + uint64_t(view.byteLength) > buffer.data.size())
+            throw InputError(file_, viewPlace,
+                             "reaches byte " + std::to_string(uint64_t(view.byteOffset) + view.byteLength) + " of buffer " +
                                  std::to_string(view.buffer) + ", which holds only " + std::to_string(buffer.data.size()));
+        const uint64_t componentSize = uint64_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
+        const uint64_t elementSize = componentSize * uint64_t(components);
+        if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
+            throw InputError(file_, viewPlace + ".byteStride",
+                             std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
+        if (view.byteStride != 0 && view.byteStride < elementSize)
+            throw InputError(file_, viewPlace + ".byteStride", std::to_string(view.byteStride) + " is smaller than the " +
+                                                                   std::to_string(elementSize) + "-byte elements of " + place);
+        if (byteOffset % componentSize != 0 || (view.byteOffset + byteOffset) % componentSize != 0)
+            throw InputError(file_, place, "byteOffset is not a multiple of its " + std::to_string(componentSize) +
+                                               "-byte component size");
+        const uint64_t stride = view.byteStride ? view.byteStride : elementSize;
+        if (count > 0 && uint64_t(byteOffset) + saturatingMultiply(stride, count - 1) + elementSize > view.byteLength)
+            throw InputError(file_, place, "reads past the end of bufferView " + std::to_string(viewIndex));
+    }
+
+    // Decodes `count` elements (checked by checkRange) into `doubles` or, for sparse indices,
+    // into `indices`.
+    void decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized,
+                int components, double* doubles, std::vector<size_t>* indices) const {
+        const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
+        const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
         const size_t componentSize = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
         const size_t elementSize = componentSize * size_t(components);
         const size_t stride = view.byteStride ? view.byteStride : elementSize;
-        if (count > 0 && byteOffset + stride * (count - 1) + elementSize > view.byteLength)
-            throw InputError(file_, place, "reads past the end of bufferView " + std::to_string(viewIndex));
         const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
         for (size_t e = 0; e < count; ++e) {
             const unsigned char* element = base + e * stride;
@@ -102,23 +193,40 @@ private:
     }
 
     void applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const {
-        const size_t n = size_t(std::max(acc.sparse.count, 0));
+        if (acc.sparse.count < 1 || size_t(acc.sparse.count) > out.count)
+            throw InputError(file_, place + ".sparse.count", std::to_string(acc.sparse.count) +
+                                                                 " is outside 1..count of the accessor");
+        const size_t n = size_t(acc.sparse.count);
+        const int indexType = acc.sparse.indices.componentType;
+        if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            throw InputError(file_, place + ".sparse.indices.componentType", "must be an unsigned integer type");
+        checkRange(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, 1,
+                   place + ".sparse.indices");
+        checkRange(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
+                   out.components, place + ".sparse.values");
         std::vector<size_t> targets(n);
-        decode(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n,
-               acc.sparse.indices.componentType, false, 1, place + ".sparse.indices", nullptr, &targets);
+        decode(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, false, 1, nullptr,
+               &targets);
         std::vector<double> values(n * size_t(out.components));
         decode(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
-               acc.normalized, out.components, place + ".sparse.values", values.data(), nullptr);
+               acc.normalized, out.components, values.data(), nullptr);
         for (size_t i = 0; i < n; ++i) {
             if (targets[i] >= out.count)
                 throw InputError(file_, place + ".sparse.indices", "index " + std::to_string(targets[i]) +
                                                                        " is beyond the accessor's count");
+            if (i > 0 && targets[i] <= targets[i - 1])
+                throw InputError(file_, place + ".sparse.indices", "must strictly increase (index " +
+                                                                       std::to_string(targets[i]) + " follows " +
+                                                                       std::to_string(targets[i - 1]) + ")");
             for (int c = 0; c < out.components; ++c) out.values[targets[i] * out.components + c] = values[i * out.components + c];
         }
     }
 
     const tinygltf::Model& model_;
+    const std::set<int>& absentBuffers_;
     const std::string& file_;
+    bool quantized_ = false;
 };
 
 // Textures and Materials
@@ -218,6 +326,8 @@ std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::s
             if (c < 0 || c >= int(nodes.size()))
                 throw InputError(file, at("nodes", int(i)) + ".children", "refers to node " + std::to_string(c) + ", which does not exist");
             if (c == int(i)) throw InputError(file, at("nodes", int(i)), "is its own child (the hierarchy has a cycle)");
+            if (std::count(nodes[i].children.begin(), nodes[i].children.end(), c))
+                throw InputError(file, at("nodes", int(i)) + ".children", "lists node " + std::to_string(c) + " twice");
             if (nodes[c].parent >= 0 && nodes[c].parent != int(i))
                 throw InputError(file, at("nodes", c), "has two parents (nodes " + std::to_string(nodes[c].parent) +
                                                            " and " + std::to_string(i) + "); glTF nodes form a tree");
@@ -258,8 +368,8 @@ std::vector<uint32_t> triangleIndices(int mode, const std::vector<uint32_t>& idx
 
 class SceneBuilder {
 public:
-    SceneBuilder(const tinygltf::Model& model, const std::string& file, Warnings& warnings)
-        : model_(model), file_(file), warnings_(warnings), reader_(model, file) {}
+    SceneBuilder(const GltfDocument& document, const std::string& file, Warnings& warnings)
+        : model_(document.model), file_(file), warnings_(warnings), reader_(document, file) {}
 
     Scene build() {
         Scene scene;
@@ -329,15 +439,13 @@ private:
         if (!prim.targets.empty()) warnings_.add(file_ + ": morph targets are not applied; the base mesh is used");
         auto pos = prim.attributes.find("POSITION");
         if (pos == prim.attributes.end()) throw InputError(file_, place, "has no POSITION attribute");
-        const AccessorData positions = reader_.read(pos->second, place + ".attributes.POSITION");
-        if (positions.components != 3) throw InputError(file_, place + ".attributes.POSITION", "must be VEC3");
-        const size_t vertexCount = positions.count;
+        const AccessorData positions = reader_.read(pos->second, place + ".attributes.POSITION", kPositionFormat);
+                const size_t vertexCount = positions.count;
 
         std::optional<AccessorData> normals;
         auto nrm = prim.attributes.find("NORMAL");
         if (nrm != prim.attributes.end()) {
-            normals = reader_.read(nrm->second, place + ".attributes.NORMAL");
-            if (normals->components != 3) throw InputError(file_, place + ".attributes.NORMAL", "must be VEC3");
+            normals = reader_.read(nrm->second, place + ".attributes.NORMAL", kNormalFormat);
             if (normals->count != vertexCount)
                 throw InputError(file_, place + ".attributes.NORMAL",
                                  "has " + std::to_string(normals->count) + " elements but POSITION has " +
@@ -352,11 +460,16 @@ private:
 
         std::vector<uint32_t> indices;
         if (prim.indices >= 0) {
-            const AccessorData idx = reader_.read(prim.indices, place + ".indices");
-            if (idx.components != 1) throw InputError(file_, place + ".indices", "must be SCALAR");
+            const AccessorData idx = reader_.read(prim.indices, place + ".indices", kIndexFormat);
             indices.resize(idx.count);
+            // The largest value of the index type means "primitive restart", which glTF forbids.
+            const double restart = double((uint64_t(1) << (8 * tinygltf::GetComponentSizeInBytes(
+                                                              uint32_t(model_.accessors[prim.indices].componentType)))) - 1);
             for (size_t i = 0; i < idx.count; ++i) {
                 const double v = idx.values[i];
+                if (v == restart)
+                    throw InputError(file_, place + ".indices", "index " + std::to_string(uint64_t(v)) + " at position " +
+                                                                    std::to_string(i) + " is the primitive-restart value, which glTF forbids");
                 if (v < 0 || v >= double(vertexCount))
                     throw InputError(file_, place + ".indices", "index " + std::to_string(uint64_t(v)) + " at position " +
                                                                     std::to_string(i) + " is beyond the " +
@@ -450,56 +563,18 @@ private:
     uint32_t defaultMaterial_ = 0;
 };
 
-bool isBinaryGltf(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    char magic[4] = {};
-    in.read(magic, 4);
-    return in.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
-}
-
-std::string firstLine(const std::string& s) {
-    std::string out = s.substr(0, s.find('\n'));
-    return out.empty() ? s : out;
-}
-
 }  // namespace
 
 Scene loadGltfScene(const std::string& path, Warnings& warnings) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw InputError(path, "", "no such file");
-    if (fs::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a glTF file");
-    {
-        std::ifstream probe(path, std::ios::binary);
-        if (!probe) throw InputError(path, "", "cannot be opened for reading");
-    }
-
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    std::string err, warn;
-    bool ok = false;
-    try {
-        ok = isBinaryGltf(path) ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                                : loader.LoadASCIIFromFile(&model, &err, &warn, path);
-    } catch (const std::exception& e) {
-        throw InputError(path, "", std::string("not a readable glTF file: ") + e.what());
-    }
-    if (!ok) throw InputError(path, "", "not a valid glTF file: " + firstLine(err.empty() ? warn : err));
-    if (!warn.empty()) {
-        size_t start = 0;
-        while (start < warn.size()) {
-            size_t end = warn.find('\n', start);
-            if (end == std::string::npos) end = warn.size();
-            if (end > start) warnings.add(path + ": " + warn.substr(start, end - start));
-            start = end + 1;
-        }
-    }
+    const GltfDocument document = readGltfDocument(path, warnings);
+    const tinygltf::Model& model = document.model;
     for (const auto& ext : model.extensionsRequired)
         if (!kSupportedExtensions.count(ext))
             throw InputError(path, "extensionsRequired", "requires extension " + ext + ", which qsgi does not implement");
     for (const auto& ext : model.extensionsUsed)
         if (!kSupportedExtensions.count(ext)) warnings.add(path + ": extension " + ext + " is ignored");
 
-    Scene scene = SceneBuilder(model, path, warnings).build();
+    Scene scene = SceneBuilder(document, path, warnings).build();
     return scene;
 }
 

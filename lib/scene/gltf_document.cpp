@@ -1,0 +1,194 @@
+#include "scene/gltf_document.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cctype>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace qsgi {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr uint32_t kGlbJsonChunk = 0x4E4F534A;  // "JSON"
+
+uint32_t readU32(const std::string& bytes, size_t offset) {
+    uint32_t v;
+    std::memcpy(&v, bytes.data() + offset, 4);
+    return v;  // GLB is little-endian, as is every machine qsgi builds on
+}
+
+void appendU32(std::string& bytes, uint32_t v) { bytes.append(reinterpret_cast<const char*>(&v), 4); }
+
+// The container of a .glb: its JSON chunk, and where the chunks after it start.
+struct GlbLayout {
+    std::string jsonText;
+    size_t afterJson = 0;
+};
+
+GlbLayout readGlbLayout(const std::string& path, const std::string& bytes) {
+    if (bytes.size() < 20) throw InputError(path, "GLB header", "the file is too short to be a binary glTF");
+    const uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8);
+    if (version != 2)
+        throw InputError(path, "GLB header", "container version " + std::to_string(version) + " is not 2 (glTF 2.0)");
+    if (length != bytes.size())
+        throw InputError(path, "GLB header", "declares " + std::to_string(length) + " bytes but the file has " +
+                                                 std::to_string(bytes.size()) + " (truncated or padded)");
+    const uint32_t jsonLength = readU32(bytes, 12), jsonType = readU32(bytes, 16);
+    if (jsonType != kGlbJsonChunk) throw InputError(path, "GLB chunk 0", "is not the JSON chunk");
+    if (uint64_t(jsonLength) + 20 > bytes.size())
+        throw InputError(path, "GLB chunk 0", "its length " + std::to_string(jsonLength) + " runs past the end of the file");
+    return {bytes.substr(20, jsonLength), 20 + size_t(jsonLength)};
+}
+
+// "https://host/a.bin" -> "https"; "" for relative paths, data URIs and Windows drive letters.
+std::string remoteScheme(const std::string& uri) {
+    size_t i = 0;
+    while (i < uri.size() && (std::isalnum(static_cast<unsigned char>(uri[i])) || uri[i] == '+' || uri[i] == '-' || uri[i] == '.'))
+        ++i;
+    if (i < 2 || i >= uri.size() || uri[i] != ':' || !std::isalpha(static_cast<unsigned char>(uri[0]))) return "";
+    std::string scheme = uri.substr(0, i);
+    for (char& c : scheme) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return scheme == "data" || scheme == "file" ? "" : scheme;
+}
+
+void checkAsset(const std::string& path, const json& doc) {
+    if (!doc.contains("asset") || !doc["asset"].is_object())
+        throw InputError(path, "asset", "is missing (every glTF file must state asset.version)");
+    const json& asset = doc["asset"];
+    auto versionOf = [&](const char* key) -> std::pair<int, int> {
+        const std::string place = std::string("asset.") + key;
+        if (!asset[key].is_string()) throw InputError(path, place, "must be a string such as \"2.0\"");
+        const std::string v = asset[key].get<std::string>();
+        const size_t dot = v.find('.');
+        auto digits = [](const std::string& s) {
+            return !s.empty() && s.size() < 6 && s.find_first_not_of("0123456789") == std::string::npos;
+        };
+        if (dot == std::string::npos || !digits(v.substr(0, dot)) || !digits(v.substr(dot + 1)))
+            throw InputError(path, place, "'" + v + "' is not of the form major.minor");
+        return {std::stoi(v.substr(0, dot)), std::stoi(v.substr(dot + 1))};
+    };
+    if (!asset.contains("version")) throw InputError(path, "asset.version", "is missing (glTF 2.0 files say \"2.0\")");
+    const auto version = versionOf("version");
+    if (version.first != 2)
+        throw InputError(path, "asset.version", "is " + asset["version"].get<std::string>() +
+                                                    ": qsgi reads glTF 2.x only");
+    if (asset.contains("minVersion")) {
+        const auto minVersion = versionOf("minVersion");
+        if (minVersion.first != 2 || minVersion.second > 0)
+            throw InputError(path, "asset.minVersion", "is " + asset["minVersion"].get<std::string>() +
+                                                           ": the file needs features newer than glTF 2.0, which qsgi implements");
+    }
+}
+
+void refuseRemoteUris(const std::string& path, const json& doc, const char* array) {
+    if (!doc.contains(array) || !doc[array].is_array()) return;
+    for (size_t i = 0; i < doc[array].size(); ++i) {
+        const json& item = doc[array][i];
+        if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+        const std::string uri = item["uri"].get<std::string>();
+        const std::string scheme = remoteScheme(uri);
+        if (!scheme.empty())
+            throw InputError(path, std::string(array) + "[" + std::to_string(i) + "].uri",
+                             "'" + uri.substr(0, 80) + "' is a remote (" + scheme +
+                                 ":) URI; qsgi reads local files only (download it and refer to the file)");
+    }
+}
+
+// Gives every uri-less buffer that is not the GLB's BIN chunk a 1-byte placeholder; returns them.
+std::set<int> replaceAbsentBuffers(json& doc, bool binary) {
+    std::set<int> absent;
+    if (!doc.contains("buffers") || !doc["buffers"].is_array()) return absent;
+    json& buffers = doc["buffers"];
+    for (size_t i = binary ? 1 : 0; i < buffers.size(); ++i) {
+        if (!buffers[i].is_object() || buffers[i].contains("uri")) continue;
+        buffers[i]["uri"] = "data:application/octet-stream;base64,AA==";
+        buffers[i]["byteLength"] = 1;
+        absent.insert(int(i));
+    }
+    return absent;
+}
+
+std::string readBytes(const std::string& path) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw InputError(path, "", "no such file");
+    if (fs::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a glTF file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, "", "cannot be opened for reading");
+    const auto size = fs::file_size(path, ec);
+    if (ec || size >= (uint64_t(1) << 32)) throw InputError(path, "", "is 4 GiB or larger; glTF files are limited to 2^32 bytes");
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string firstLine(const std::string& s) {
+    std::string out = s.substr(0, s.find('\n'));
+    return out.empty() ? s : out;
+}
+
+}  // namespace
+
+GltfDocument readGltfDocument(const std::string& path, Warnings& warnings) {
+    std::string bytes = readBytes(path);
+    const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    GlbLayout glb;
+    if (binary) glb = readGlbLayout(path, bytes);
+    const std::string& jsonText = binary ? glb.jsonText : bytes;
+
+    json doc;
+    try {
+        doc = json::parse(jsonText);
+    } catch (const json::parse_error& e) {
+        throw InputError(path, "byte " + std::to_string(e.byte + (binary ? 20 : 0)), "not valid JSON");
+    } catch (const json::exception&) {
+        throw InputError(path, "", "not usable JSON (a number too large for a double?)");
+    }
+    if (!doc.is_object()) throw InputError(path, "", "the glTF JSON must be an object");
+    checkAsset(path, doc);
+    refuseRemoteUris(path, doc, "buffers");
+    refuseRemoteUris(path, doc, "images");
+
+    GltfDocument out;
+    out.absentBuffers = replaceAbsentBuffers(doc, binary);
+    if (!out.absentBuffers.empty()) {
+        std::string rewritten = doc.dump();
+        if (binary) {
+            while (rewritten.size() % 4) rewritten += ' ';
+            std::string container = bytes.substr(0, 12);
+            appendU32(container, uint32_t(rewritten.size()));
+            appendU32(container, kGlbJsonChunk);
+            container += rewritten;
+            container += bytes.substr(glb.afterJson);
+            const uint32_t total = uint32_t(container.size());
+            std::memcpy(container.data() + 8, &total, 4);
+            bytes = std::move(container);
+        } else {
+            bytes = std::move(rewritten);
+        }
+    }
+
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    bool ok = false;
+    const std::string baseDir = fs::absolute(fs::path(path)).parent_path().string();
+    try {
+        ok = binary ? loader.LoadBinaryFromMemory(&out.model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                                  unsigned(bytes.size()), baseDir)
+                    : loader.LoadASCIIFromString(&out.model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir);
+    } catch (const std::exception& e) {
+        throw InputError(path, "", std::string("not a readable glTF file: ") + e.what());
+    }
+    if (!ok) throw InputError(path, "", "not a valid glTF file: " + firstLine(err.empty() ? warn : err));
+    for (size_t start = 0; start < warn.size();) {
+        size_t end = warn.find('\n', start);
+        if (end == std::string::npos) end = warn.size();
+        if (end > start) warnings.add(path + ": " + warn.substr(start, end - start));
+        start = end + 1;
+    }
+    return out;
+}
+
+}  // namespace qsgi

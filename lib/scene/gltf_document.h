@@ -1,0 +1,29 @@
+// Reading a .gltf or .glb file into tinygltf's model, with the document-level rules of the glTF 2.0
+// specification that tinygltf does not enforce, and the valid constructs it refuses:
+//   - asset.version must be 2.x and asset.minVersion at most 2.0;
+//   - buffers and images are local files or data URIs: a remote URI (http:, https:, …) is refused;
+//   - a buffer without a uri (other than a GLB's BIN chunk) is valid as long as nothing reads it;
+//     tinygltf refuses the whole file, so such buffers are handed to it as a 1-byte placeholder and
+//     listed in absentBuffers, and any read through them is refused by the accessor reader.
+// Everything beyond the document level (accessors, hierarchy, materials) is checked where the
+// model is turned into a Scene (gltf_loader.cpp).
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <set>
+#include <string>
+
+#include "util/error.h"
+
+namespace qsgi {
+
+struct GltfDocument {
+    tinygltf::Model model;
+    std::set<int> absentBuffers;  // buffers that have no data (no uri, not the BIN chunk)
+};
+
+// Throws InputError naming the file and the place in it; tinygltf's own warnings go to warnings.
+GltfDocument readGltfDocument(const std::string& path, Warnings& warnings);
+
+}  // namespace qsgi

@@ -1,0 +1,26 @@
+// How much memory this machine has, so that a request that cannot fit (a huge accessor, billions of
+// photons) is refused with the numbers before anything is allocated, instead of dying in the
+// allocator or the OOM killer hours later.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace qsgi {
+
+// Physical memory of the machine, in bytes (sysconf); a large fallback if it cannot be read.
+uint64_t physicalMemoryBytes();
+
+// "48.0 GiB", "512 MiB", "12 KiB", "100 B".
+std::string formatBytes(uint64_t bytes);
+
+// Throws InputError(file, place, "<what> would need X, more than the Y of memory this machine
+// has") when bytes exceeds the machine's physical memory.
+void refuseBeyondMemory(uint64_t bytes, const std::string& file, const std::string& place, const std::string& what);
+
+// a*b, saturating at UINT64_MAX instead of wrapping.
+inline uint64_t saturatingMultiply(uint64_t a, uint64_t b) {
+    return (a != 0 && b > UINT64_MAX / a) ? UINT64_MAX : a * b;
+}
+
+}  // namespace qsgi

@@ -1,0 +1,324 @@
+#!/usr/bin/env python3
+"""Writes the hand-made test inputs of tests/data: hostile files that qsgi must refuse
+(bad/gltf, bad/animation, bad/config) and valid edge cases that it must load (good/).
+
+Each bad file breaks one rule; bad/generated.tsv lists it with the words its error message must
+contain. Files found by fuzzing are added by hand to bad/<kind>/ and listed in bad/found.tsv.
+Run from anywhere: python3 tests/data/make_inputs.py (the output is deterministic)."""
+import base64
+import copy
+import json
+import os
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+rows = []  # (kind, relative path, expected words, the file the message names)
+
+
+def b64(data):
+    return "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+
+
+# A 2 m floor quad (4 vertices, 2 triangles) and a point light 1 m above it.
+POS = struct.pack("<12f", -1, 0, 1, 1, 0, 1, 1, 0, -1, -1, 0, -1)
+NRM = struct.pack("<12f", *([0, 1, 0] * 4))
+IDX = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+
+
+def scene(positions=POS, indices=IDX, normals=None):
+    data = positions + indices
+    views = [{"buffer": 0, "byteOffset": 0, "byteLength": len(positions)},
+             {"buffer": 0, "byteOffset": len(positions), "byteLength": len(indices)}]
+    attributes = {"POSITION": 0}
+    accessors = [{"bufferView": 0, "componentType": 5126, "count": len(positions) // 12, "type": "VEC3",
+                  "min": [-1, 0, -1], "max": [1, 0, 1]},
+                 {"bufferView": 1, "componentType": 5123, "count": len(indices) // 2, "type": "SCALAR"}]
+    if normals is not None:
+        while len(data) % 4:
+            data += b"\0"
+        views.append({"buffer": 0, "byteOffset": len(data), "byteLength": len(normals)})
+        data += normals
+        accessors.append({"bufferView": 2, "componentType": 5126, "count": len(normals) // 12, "type": "VEC3"})
+        attributes["NORMAL"] = 2
+    return {
+        "asset": {"version": "2.0", "generator": "qsgi tests/data/make_inputs.py"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"name": "Bulb", "type": "point", "intensity": 10}]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"name": "Floor", "mesh": 0},
+                  {"name": "Lamp", "translation": [0, 1, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+        "meshes": [{"primitives": [{"attributes": attributes, "indices": 1}]}],
+        "buffers": [{"byteLength": len(data), "uri": b64(data)}],
+        "bufferViews": views,
+        "accessors": accessors,
+    }
+
+
+def write(rel, content):
+    path = os.path.join(HERE, rel)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    mode = "wb" if isinstance(content, bytes) else "w"
+    with open(path, mode) as f:
+        f.write(content)
+
+
+def bad(kind, name, content, words, names=None):
+    rel = f"bad/{kind}/{name}"
+    if isinstance(content, dict) or isinstance(content, list):
+        content = json.dumps(content, indent=1)
+    write(rel, content)
+    rows.append((kind, rel, words, names or name))
+
+
+def edited(edit, base=None):
+    m = copy.deepcopy(base or scene())
+    edit(m)
+    return m
+
+
+def glb(doc, binary):
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    binary += b"\0" * (-len(binary) % 4)
+    chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
+    return b"glTF" + struct.pack("<II", 2, 12 + len(chunks)) + chunks
+
+
+# ---- valid edge cases (good/) ----
+write("good/base.gltf", json.dumps(scene(normals=NRM), indent=1))
+
+# An accessor without a bufferView is all zeros, here overridden by sparse values: the floor.
+m = scene()
+sparse_idx = struct.pack("<4B", 0, 1, 2, 3)
+m["buffers"][0] = {"byteLength": len(IDX) + 4 + len(POS), "uri": b64(IDX + sparse_idx + POS)}
+m["bufferViews"] = [{"buffer": 0, "byteOffset": 0, "byteLength": len(IDX)},
+                    {"buffer": 0, "byteOffset": 12, "byteLength": 4},
+                    {"buffer": 0, "byteOffset": 16, "byteLength": len(POS)}]
+m["accessors"] = [{"componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, 0, -1], "max": [1, 0, 1],
+                   "sparse": {"count": 4, "indices": {"bufferView": 1, "componentType": 5121},
+                              "values": {"bufferView": 2}}},
+                  {"bufferView": 0, "componentType": 5123, "count": 6, "type": "SCALAR"}]
+write("good/accessor_without_bufferview.gltf", json.dumps(m, indent=1))
+
+m = scene()
+m["buffers"][0]["uri"] = m["buffers"][0]["uri"].replace("application/octet-stream", "application/gltf-buffer")
+write("good/buffer_gltf_buffer_data_uri.gltf", json.dumps(m, indent=1))
+
+m = scene()
+m["buffers"].append({"byteLength": 1024, "name": "nothing reads this"})
+write("good/buffer_without_uri_unused.gltf", json.dumps(m, indent=1))
+
+# KHR_mesh_quantization: positions as normalized shorts scaled back by the node, normals as bytes.
+qpos = struct.pack("<16h", -32767, 0, 32767, 0, 32767, 0, 32767, 0, 32767, 0, -32767, 0, -32767, 0, -32767, 0)
+qnrm = struct.pack("<16b", *([0, 127, 0, 0] * 4))
+m = scene(positions=qpos + qnrm)
+m["extensionsUsed"].append("KHR_mesh_quantization")
+m["extensionsRequired"] = ["KHR_mesh_quantization"]
+m["bufferViews"][0] = {"buffer": 0, "byteOffset": 0, "byteLength": 32, "byteStride": 8}
+m["bufferViews"].append({"buffer": 0, "byteOffset": 32, "byteLength": 16, "byteStride": 4})
+m["accessors"][0].update({"componentType": 5122, "normalized": True, "count": 4})
+m["accessors"].append({"bufferView": 2, "componentType": 5120, "normalized": True, "count": 4, "type": "VEC3"})
+m["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 2
+m["nodes"][0]["scale"] = [1, 1, 1]
+write("good/quantized.gltf", json.dumps(m, indent=1))
+
+# A GLB whose second buffer has no uri (only buffer 0 may be the BIN chunk) and is never read.
+m = scene()
+m["buffers"] = [{"byteLength": len(POS + IDX)}, {"byteLength": 64}]
+write("good/glb_with_unused_second_buffer.glb", glb(m, POS + IDX))
+
+# ---- glTF files that break the specification (bad/gltf) ----
+def accessor(i, **kw):
+    return lambda m: m["accessors"][i].update(kw)
+
+
+bad("gltf", "asset_version_3.gltf", edited(lambda m: m["asset"].update(version="3.0")), "asset.version")
+bad("gltf", "asset_missing.gltf", edited(lambda m: m.pop("asset")), "asset")
+bad("gltf", "asset_version_missing.gltf", edited(lambda m: m["asset"].pop("version")), "asset.version")
+bad("gltf", "asset_version_words.gltf", edited(lambda m: m["asset"].update(version="two")), "major.minor")
+bad("gltf", "asset_min_version_2_1.gltf", edited(lambda m: m["asset"].update(minVersion="2.1")), "minVersion")
+short_pos = struct.pack("<12h", -1, 0, 1, 1, 0, 1, 1, 0, -1, -1, 0, -1)
+bad("gltf", "position_short_without_quantization.gltf",
+    edited(accessor(0, componentType=5122), scene(positions=short_pos + b"\0" * 24)), "KHR_mesh_quantization")
+bad("gltf", "position_unsigned_int.gltf", edited(accessor(0, componentType=5125)), "not allowed")
+bad("gltf", "position_vec2.gltf", edited(accessor(0, type="VEC2")), "VEC3")
+bad("gltf", "position_float_normalized.gltf", edited(accessor(0, normalized=True)), "not allowed")
+bad("gltf", "quantization_used_but_not_required.gltf",
+    edited(lambda m: (m["extensionsUsed"].append("KHR_mesh_quantization"), accessor(0, componentType=5122)(m)),
+           scene(positions=short_pos + b"\0" * 24)), "extensionsRequired")
+def ubyte_normals(m):
+    m["extensionsUsed"].append("KHR_mesh_quantization")
+    m["extensionsRequired"] = ["KHR_mesh_quantization"]
+    m["accessors"][2].update(componentType=5121, normalized=True)
+bad("gltf", "normal_unsigned_byte_quantized.gltf", edited(ubyte_normals, scene(normals=NRM)), "not allowed")
+bad("gltf", "indices_float.gltf", edited(accessor(1, componentType=5126, count=3)), "not allowed")
+bad("gltf", "indices_normalized.gltf", edited(accessor(1, normalized=True)), "not allowed")
+bad("gltf", "indices_vec3.gltf", edited(accessor(1, type="VEC3", count=2)), "SCALAR")
+bad("gltf", "index_beyond_vertices.gltf", scene(indices=struct.pack("<6H", 0, 1, 2, 0, 2, 4)), "beyond")
+bad("gltf", "index_primitive_restart.gltf", scene(indices=struct.pack("<6H", 0, 1, 2, 0, 2, 65535)), "primitive-restart")
+bad("gltf", "view_past_buffer.gltf", edited(lambda m: m["bufferViews"][1].update(byteLength=40)), "reaches byte")
+bad("gltf", "view_missing_buffer.gltf", edited(lambda m: m["bufferViews"][1].update(buffer=7)), "buffer")
+bad("gltf", "stride_smaller_than_element.gltf", edited(lambda m: m["bufferViews"][0].update(byteStride=8)), "smaller than")
+bad("gltf", "stride_not_multiple_of_4.gltf", edited(lambda m: m["bufferViews"][0].update(byteStride=14)), "multiple of 4")
+bad("gltf", "stride_over_252.gltf", edited(lambda m: m["bufferViews"][0].update(byteStride=256)), "byteStride")
+bad("gltf", "accessor_misaligned.gltf", edited(accessor(0, byteOffset=2, count=3)), "byteOffset")
+bad("gltf", "accessor_past_view.gltf", edited(accessor(0, count=5)), "past the end")
+bad("gltf", "accessor_missing.gltf",
+    edited(lambda m: m["meshes"][0]["primitives"][0]["attributes"].update(POSITION=9)), "does not exist")
+bad("gltf", "accessor_huge_without_view.gltf",
+    edited(lambda m: m["accessors"].append({"componentType": 5126, "count": 2**40, "type": "VEC3"})
+           or m["meshes"][0]["primitives"][0]["attributes"].update(POSITION=2)), "would need")
+nan_pos = struct.pack("<12f", -1, 0, 1, 1, float("nan"), 1, 1, 0, -1, -1, 0, -1)
+bad("gltf", "positions_nan.gltf", scene(positions=nan_pos), "non-finite")
+inf_pos = struct.pack("<12f", -1, 0, 1, 1, 0, float("inf"), 1, 0, -1, -1, 0, -1)
+bad("gltf", "positions_inf.gltf", scene(positions=inf_pos), "non-finite")
+bad("gltf", "matrix_overflow.gltf",
+    json.dumps(scene()).replace('"name": "Floor"', '"name": "Floor", "matrix": [1e999,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]'),
+    "JSON")
+def sparse(edit):
+    def f(m):
+        m["buffers"][0] = {"byteLength": len(POS + IDX) + 4, "uri": b64(POS + IDX + struct.pack("<4B", *edit))}
+        m["bufferViews"].append({"buffer": 0, "byteOffset": 60, "byteLength": 4})
+        m["accessors"][0]["sparse"] = {"count": 2, "indices": {"bufferView": 2, "componentType": 5121},
+                                       "values": {"bufferView": 0}}
+    return f
+bad("gltf", "sparse_index_beyond_count.gltf", edited(sparse([0, 9, 0, 0])), "beyond the accessor")
+bad("gltf", "sparse_indices_not_increasing.gltf", edited(sparse([2, 1, 0, 0])), "strictly increase")
+bad("gltf", "attribute_lengths_differ.gltf", edited(accessor(2, count=3), scene(normals=NRM)), "equal lengths")
+bad("gltf", "node_two_parents.gltf",
+    edited(lambda m: m["nodes"].extend([{"children": [0]}, {"children": [0]}]) or m["scenes"][0].update(nodes=[1, 2, 3])),
+    "two parents")
+bad("gltf", "node_cycle.gltf",
+    edited(lambda m: m["nodes"].extend([{"children": [3]}, {"children": [2]}]) or m["scenes"][0].update(nodes=[0, 1])),
+    "cycle")
+bad("gltf", "node_own_child.gltf", edited(lambda m: m["nodes"][0].update(children=[0])), "cycle")
+bad("gltf", "node_duplicate_child.gltf",
+    edited(lambda m: m["nodes"].append({"children": [0, 0]}) or m["scenes"][0].update(nodes=[2, 1])), "twice")
+bad("gltf", "node_root_is_a_child.gltf",
+    edited(lambda m: m["nodes"].append({"children": [0]}) or m["scenes"][0].update(nodes=[0, 1, 2])), "not a root")
+bad("gltf", "node_missing_child.gltf", edited(lambda m: m["nodes"][0].update(children=[12])), "does not exist")
+bad("gltf", "node_missing_mesh.gltf", edited(lambda m: m["nodes"][0].update(mesh=3)), "does not exist")
+bad("gltf", "material_missing.gltf", edited(lambda m: m["meshes"][0]["primitives"][0].update(material=4)), "does not exist")
+bad("gltf", "scene_missing.gltf", edited(lambda m: m.update(scene=4)), "does not exist")
+bad("gltf", "scenes_absent.gltf", edited(lambda m: m.pop("scenes") and m.pop("scene")), "no scene")
+bad("gltf", "points_only.gltf", edited(lambda m: m["meshes"][0]["primitives"][0].update(mode=0)), "no triangles")
+bad("gltf", "extension_required_draco.gltf",
+    edited(lambda m: m.update(extensionsUsed=["KHR_lights_punctual", "KHR_draco_mesh_compression"],
+                              extensionsRequired=["KHR_draco_mesh_compression"])), "KHR_draco_mesh_compression")
+bad("gltf", "remote_buffer.gltf", edited(lambda m: m["buffers"][0].update(uri="https://example.com/floor.bin")),
+    "local files only")
+bad("gltf", "remote_image.gltf",
+    edited(lambda m: m.update(images=[{"uri": "http://example.com/wood.png"}], textures=[{"source": 0}],
+                              materials=[{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])),
+    "local files only")
+bad("gltf", "buffer_without_uri_read.gltf",
+    edited(lambda m: m["buffers"].append({"byteLength": 48}) or m["bufferViews"][0].update(buffer=1)), "no uri")
+bad("gltf", "buffer_data_uri_wrong_length.gltf", edited(lambda m: m["buffers"][0].update(byteLength=100)), "uri")
+bad("gltf", "light_negative_intensity.gltf",
+    edited(lambda m: m["extensions"]["KHR_lights_punctual"]["lights"][0].update(intensity=-5)), "non-negative")
+bad("gltf", "light_unknown_type.gltf",
+    edited(lambda m: m["extensions"]["KHR_lights_punctual"]["lights"][0].update(type="area")), "unknown light type")
+bad("gltf", "light_missing.gltf",
+    edited(lambda m: m["nodes"][1]["extensions"]["KHR_lights_punctual"].update(light=3)), "does not exist")
+bad("gltf", "spot_cone_too_wide.gltf",
+    edited(lambda m: m["extensions"]["KHR_lights_punctual"]["lights"][0].update(
+        type="spot", spot={"innerConeAngle": 0.1, "outerConeAngle": 2.0})), "outerConeAngle")
+bad("gltf", "camera_zero_yfov.gltf",
+    edited(lambda m: m.update(cameras=[{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}])
+           or m["nodes"].append({"camera": 0}) or m["scenes"][0]["nodes"].append(2)), "yfov")
+bad("gltf", "emissive_strength_negative.gltf",
+    edited(lambda m: m.update(materials=[{"emissiveFactor": [1, 1, 1], "extensions": {
+        "KHR_materials_emissive_strength": {"emissiveStrength": -2}}}]) or
+        m["meshes"][0]["primitives"][0].update(material=0)), "emissiveStrength")
+bad("gltf", "no_lights.gltf", edited(lambda m: m["nodes"][1].pop("extensions")), "no lights")
+bad("gltf", "empty.gltf", "", "not valid JSON")
+bad("gltf", "json_array.gltf", "[]", "object")
+bad("gltf", "binary_noise.gltf", bytes((i * 73 + 41) % 256 for i in range(512)), "not valid JSON")
+good_glb = glb(scene(), POS + IDX)
+bad("gltf", "glb_truncated.glb", good_glb[:-8], "declares")
+bad("gltf", "glb_container_version_1.glb", good_glb[:4] + struct.pack("<I", 1) + good_glb[8:], "container version")
+bad("gltf", "glb_too_short.glb", good_glb[:14], "too short")
+bad("gltf", "glb_json_chunk_overrun.glb", good_glb[:12] + struct.pack("<I", 1 << 20) + good_glb[16:], "runs past")
+glb_doc = scene()
+glb_doc["buffers"] = [{"byteLength": 4096}]
+bad("gltf", "glb_buffer_longer_than_bin.glb", glb(glb_doc, POS + IDX), "byteLength")
+
+# ---- transform files (bad/animation), rendered with good/base.gltf ----
+def anim(frames, **top):
+    doc = {"format": "qsgi-animation", "version": 1, "frames": frames}
+    doc.update(top)
+    return doc
+
+move = {"Floor": {"translation": [0, 0.5, 0]}}
+bad("animation", "frame_string.json", anim([{"frame": "3", "nodes": move}]), "integer")
+bad("animation", "frame_float.json", anim([{"frame": 1.5, "nodes": move}]), "integer")
+bad("animation", "frame_negative.json", anim([{"frame": -1, "nodes": move}]), "[0, 10^7]")
+bad("animation", "frame_huge.json", anim([{"frame": 10**15, "nodes": move}]), "[0, 10^7]")
+bad("animation", "frames_out_of_order.json", anim([{"frame": 4}, {"frame": 2}]), "out of order")
+bad("animation", "frames_empty.json", anim([]), "non-empty")
+bad("animation", "unknown_top_key.json", {"format": "qsgi-animation", "version": 1, "frams": [{"frame": 0}]},
+    'did you mean "frames"')
+bad("animation", "unknown_frame_key.json", anim([{"frame": 0, "node": move}]), 'did you mean "nodes"')
+bad("animation", "unknown_transform_key.json", anim([{"frame": 0, "nodes": {"Floor": {"translaton": [0, 1, 0]}}}]),
+    'did you mean "translation"')
+bad("animation", "translation_wrong_type.json", anim([{"frame": 0, "nodes": {"Floor": {"translation": "0 1 0"}}}]),
+    "array of 3")
+bad("animation", "rotation_zero.json", anim([{"frame": 0, "nodes": {"Floor": {"rotation": [0, 0, 0, 0]}}}]), "zero quaternion")
+bad("animation", "scale_zero.json", anim([{"frame": 0, "nodes": {"Floor": {"scale": [1, 0, 1]}}}]), "not invertible")
+bad("animation", "fps_zero.json", anim([{"frame": 0}], fps=0), "fps")
+bad("animation", "version_2.json", {"format": "qsgi-animation", "version": 2, "frames": [{"frame": 0}]}, "version")
+bad("animation", "format_missing.json", {"version": 1, "frames": [{"frame": 0}]}, "format")
+bad("animation", "node_unknown.json", anim([{"frame": 0, "nodes": {"Flor": {"translation": [0, 1, 0]}}}]), 'did you mean "Floor"')
+bad("animation", "matrix_and_translation.json",
+    anim([{"frame": 0, "nodes": {"Floor": {"matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1],
+                                           "translation": [0, 1, 0]}}}]), "cannot be combined")
+bad("animation", "moves_the_light.json", anim([{"frame": 0}, {"frame": 1, "nodes": {"Lamp": {"translation": [0, 2, 0]}}}]),
+    "lights must be static")
+bad("animation", "not_json.json", "frames: [0, 1, 2]", "not valid JSON")
+bad("animation", "top_level_array.json", [anim([{"frame": 0}])], "JSON object")
+bad("animation", "number_overflow.json", '{"format":"qsgi-animation","version":1,"frames":[{"frame":0,'
+    '"nodes":{"Floor":{"translation":[0,1e999,0]}}}]}', "JSON")
+
+# ---- configs (bad/config), given with --config; they name good/base.gltf unless they say otherwise ----
+def config(name, doc, words, names=None):
+    if isinstance(doc, dict):
+        doc = {"scene": "../../good/base.gltf", **doc}
+    bad("config", name, doc, words, names)
+
+
+config("unknown_key.json", {"photon": 1000}, 'did you mean "photons"')
+config("photons_string.json", {"photons": "1000"}, "must be an integer")
+config("photons_negative.json", {"photons": -1000}, "outside 1..4294967296")
+config("photons_fraction.json", {"photons": 1000.5}, "must be an integer")
+config("photons_beyond_path_index.json", {"photons": 2**33}, "2^32")
+config("photons_beyond_memory.json", {"photons": 2**32}, "would need")
+config("max_bounces_beyond_field.json", {"max_bounces": 70000}, "65536")
+config("k_beyond.json", {"estimator": "photon-map", "k": 2**40}, "k")
+config("radius_zero.json", {"radius": 0}, "positive number")
+config("radius_string.json", {"radius": "1cm"}, "positive number")
+config("threads_negative.json", {"threads": -2}, "outside 0..1024")
+config("threads_beyond.json", {"threads": 100000}, "threads")
+config("seed_fraction.json", {"seed": 0.5}, "must be an integer")
+config("frames_words.json", {"frames": "first:last"}, "A:B")
+config("frames_beyond_animation.json", {"frames": "0:99999"}, "last frame")
+config("frames_huge_number.json", {"frames": "0:99999999999999999999"}, "A:B")
+config("estimator_unknown.json", {"estimator": "dept"}, 'did you mean "detp"')
+config("light_unknown_key.json", {"lights": [{"type": "point", "position": [0, 1, 0], "intensty": [1, 1, 1]}]},
+    'did you mean "intensity"')
+config("light_missing_intensity.json", {"lights": [{"type": "point", "position": [0, 1, 0]}]}, "intensity")
+config("light_nan_position.json", '{"lights":[{"type":"point","position":[0,1e999,0],"intensity":[1,1,1]}]}', "JSON")
+config("camera_unknown_key.json", {"camera": {"positon": [0, 1, 3], "target": [0, 0, 0]}}, 'did you mean "position"')
+config("camera_target_at_eye.json", {"camera": {"position": [0, 1, 3], "target": [0, 1, 3]}}, "camera")
+config("width_zero.json", {"width": 0}, "outside 1..16384")
+config("spp_huge.json", {"spp": 10**6}, "spp")
+config("scene_missing.json", {"scene": "no-such-scene.gltf"}, "no such file", "no-such-scene.gltf")
+config("not_an_object.json", [1, 2, 3], "JSON object")
+config("boolean_as_string.json", {"png": "yes"}, "true or false")
+
+with open(os.path.join(HERE, "bad", "generated.tsv"), "w") as f:
+    f.write("# kind\tfile (relative to tests/data)\twords the error message must contain\tfile it names\n")
+    f.write("# Written by tests/data/make_inputs.py; files found by fuzzing go to found.tsv.\n")
+    for kind, rel, words, names in rows:
+        f.write(f"{kind}\t{rel}\t{words}\t{names}\n")
+print(f"{len(rows)} hostile files, 6 valid edge cases")

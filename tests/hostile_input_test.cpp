@@ -1,0 +1,114 @@
+// Every hostile file in tests/data/bad/ (made by tests/data/make_inputs.py, or found by fuzzing)
+// is refused by the qsgi executable with one line naming the file and the problem, exit code 2
+// and nothing written; every valid edge case in tests/data/good/ loads with the geometry it holds.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "scene/gltf_loader.h"
+#include "test_support.h"
+
+using namespace qsgi;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct HostileFile {
+    std::string kind;   // gltf, animation or config
+    std::string file;   // relative to tests/data
+    std::string words;  // the message must contain these
+    std::string names;  // and name this file
+};
+
+fs::path dataDir() { return sourceDir() / "tests" / "data"; }
+
+std::vector<HostileFile> readTable(const fs::path& tsv) {
+    std::vector<HostileFile> rows;
+    std::ifstream in(tsv);
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        std::vector<std::string> cells;
+        std::stringstream fields(line);
+        for (std::string cell; std::getline(fields, cell, '\t');) cells.push_back(cell);
+        if (cells.size() != 4) ADD_FAILURE() << tsv << ": a row needs 4 tab-separated cells: " << line;
+        else rows.push_back({cells[0], cells[1], cells[2], cells[3]});
+    }
+    return rows;
+}
+
+std::vector<HostileFile> allHostileFiles() {
+    std::vector<HostileFile> rows = readTable(dataDir() / "bad" / "generated.tsv");
+    const std::vector<HostileFile> found = readTable(dataDir() / "bad" / "found.tsv");
+    rows.insert(rows.end(), found.begin(), found.end());
+    return rows;
+}
+
+}  // namespace
+
+TEST(HostileInput, EveryFileInTheBadFolderIsListedWithItsExpectedMessage) {
+    std::set<std::string> listed;
+    for (const HostileFile& row : allHostileFiles()) {
+        EXPECT_TRUE(fs::exists(dataDir() / row.file)) << row.file << " is listed but absent";
+        EXPECT_TRUE(listed.insert(row.file).second) << row.file << " is listed twice";
+    }
+    size_t files = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(dataDir() / "bad")) {
+        if (!entry.is_regular_file() || entry.path().extension() == ".tsv") continue;
+        ++files;
+        const std::string rel = fs::relative(entry.path(), dataDir()).generic_string();
+        EXPECT_TRUE(listed.count(rel)) << rel << " is in tests/data/bad but in neither generated.tsv nor found.tsv";
+    }
+    EXPECT_GE(files, 100u);
+}
+
+TEST(HostileInput, EveryBadFileIsRefusedWithOneLineNamingItExitTwoAndNothingWritten) {
+    const fs::path out = fs::path(testScratchDir("hostile")) / "out";
+    const std::string base = (dataDir() / "good" / "base.gltf").string();
+    for (const HostileFile& row : allHostileFiles()) {
+        const std::string file = (dataDir() / row.file).string();
+        std::string args;
+        if (row.kind == "gltf") args = "render " + file + " --photons 1000";
+        else if (row.kind == "animation") args = "render " + base + " --animation " + file + " --photons 1000";
+        else if (row.kind == "config") args = "render --config " + file;  // the config's own photon count
+        else {
+            ADD_FAILURE() << row.file << ": unknown kind " << row.kind;
+            continue;
+        }
+        fs::remove_all(out);
+        const CommandResult r = runQsgi(args + " --out " + out.string());
+        SCOPED_TRACE(row.file + "\n" + r.output);
+        EXPECT_EQ(r.exitCode, 2);
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line expected";
+        EXPECT_EQ(r.output.rfind("qsgi: error: ", 0), 0u);
+        EXPECT_NE(r.output.find(row.words), std::string::npos) << "the message should say '" << row.words << "'";
+        EXPECT_NE(r.output.find(row.names), std::string::npos) << "the message should name " << row.names;
+        EXPECT_FALSE(fs::exists(out)) << "a refused input must write nothing";
+    }
+}
+
+// Valid files that tinygltf alone refuses or misreads.
+TEST(HostileInput, ValidEdgeCasesLoadWithTheGeometryTheyHold) {
+    const std::vector<Vec3f> floor = {{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}};
+    for (const char* name : {"base.gltf", "accessor_without_bufferview.gltf", "buffer_gltf_buffer_data_uri.gltf",
+                             "buffer_without_uri_unused.gltf", "quantized.gltf", "glb_with_unused_second_buffer.glb"}) {
+        SCOPED_TRACE(name);
+        Warnings warnings;
+        Scene scene;
+        ASSERT_NO_THROW(scene = loadGltfScene((dataDir() / "good" / name).string(), warnings));
+        ASSERT_EQ(scene.triangleCount(), 2u);
+        ASSERT_EQ(scene.positions.size(), 4u);
+        ASSERT_EQ(scene.lights.size(), 1u);
+        // Positions are re-centred on the scene's origin (worldOrigin) for precision.
+        for (size_t v = 0; v < 4; ++v) {
+            const Vec3d world = Vec3d(scene.positions[v]) + scene.worldOrigin;
+            // Quantized: -32767/32767 is exactly -1; floats are exact.
+            EXPECT_NEAR(world.x, floor[v].x, 1e-6) << "vertex " << v;
+            EXPECT_NEAR(world.y, floor[v].y, 1e-6) << "vertex " << v;
+            EXPECT_NEAR(world.z, floor[v].z, 1e-6) << "vertex " << v;
+            EXPECT_NEAR(scene.normals[v].y, 1.0f, 1e-6f) << "vertex " << v;
+        }
+    }
+}
