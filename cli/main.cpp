@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <csignal>
 
 #include "estimate/accuracy.h"
 #include "output/ply_reader.h"
@@ -18,6 +19,23 @@
 #include "util/progress.h"
 
 namespace {
+
+// The one piece of global state: a signal handler can reach nothing else. Set by the first
+// SIGINT/SIGTERM; the render stops after the frame in progress. The handler resets itself, so a
+// second signal stops the process at once (every file on disk is still complete: they are
+// written atomically, and --resume removes the temporary ones).
+volatile std::sig_atomic_t gStopSignal = 0;
+
+extern "C" void requestStop(int signal) { gStopSignal = signal; }
+
+void installStopHandlers() {
+    struct sigaction action {};
+    action.sa_handler = requestStop;
+    action.sa_flags = SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+}
 
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 1;
@@ -28,7 +46,7 @@ struct CliOptions {
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
     std::optional<double> exposure, radius;
     std::optional<int64_t> k;
-    bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false;
+    bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false, resume = false;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false;
 };
 
@@ -51,6 +69,7 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.noSortQueries) s.estimator.sortQueries = false;
     if (o.fullRecompute) s.fullRecompute = true;
     if (o.noEnvelope) s.useEnvelope = false;
+    if (o.resume) s.resume = true;
     if (!o.frames.empty()) {
         s.frames = qsgi::parseFrameRange(o.frames, cli);
         s.framesSource = cli;
@@ -137,6 +156,9 @@ int main(int argc, char** argv) {
     render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");
     render->add_option("--frames", o.frames, "frames A:B, inclusive at both ends (default: all)");
     render->add_option("--out", o.out, "output folder (default out)");
+    render->add_flag("--resume", o.resume,
+                     "continue the output folder after its last complete frame (same inputs and settings only; "
+                     "threads and --full-recompute may differ)");
     render->add_option("--width", o.width, "image width in pixels (default 640)");
     render->add_option("--height", o.height, "image height in pixels (default 480)");
     render->add_option("--spp", o.spp, "jittered primary rays per pixel (default 1: the pixel centre)");
@@ -175,17 +197,28 @@ int main(int argc, char** argv) {
     }
 
     try {
+        // Before loading, so that a signal at any moment leaves through the same door.
+        installStopHandlers();
         qsgi::Warnings warnings;
         qsgi::RenderJob job(settingsFrom(o, scene), warnings);
         if (!o.quiet)
             for (const auto& w : warnings.messages) std::fprintf(stderr, "qsgi: warning: %s\n", w.c_str());
-        job.run([&](const qsgi::FrameReport& r) {
+        const qsgi::RunOutcome outcome = job.run([&](const qsgi::FrameReport& r) {
             // Lights far from the geometry waste photons; say so once, with the number.
             if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet)
                 std::fprintf(stderr, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate rests on the rest "
                              "(move lights closer or add photons)\n", 100 * r.missedFraction);
             if (o.verbose) std::fprintf(stderr, "qsgi: frame %d (%d/%d) %.3f s\n", r.frame, r.index + 1, r.count, r.seconds);
-        });
+        }, [] { return gStopSignal != 0; });
+        const std::string out = o.out.empty() ? std::string("the output folder") : o.out;
+        if (outcome.interrupted) {
+            std::fprintf(stderr, "qsgi: stopped by %s after frame %d; every frame before %d is complete in %s (add --resume "
+                         "to continue)\n", gStopSignal == SIGINT ? "SIGINT" : "SIGTERM", outcome.nextFrame - 1,
+                         outcome.nextFrame, out.c_str());
+            return 128 + int(gStopSignal);
+        }
+        if (o.resume && !o.quiet && outcome.framesWritten == 0)
+            std::fprintf(stderr, "qsgi: every frame is already complete in %s\n", out.c_str());
         return 0;
     } catch (const qsgi::InputError& e) {
         std::fprintf(stderr, "qsgi: error: %s\n", e.what());

@@ -70,7 +70,7 @@ TEST(Cli, RenderWritesOnePlyPerFrameAndATimingLog) {
     const std::string timing = readAll(dir / "timing.json");
     EXPECT_NE(timing.find("\"photon_simulation\""), std::string::npos);
     EXPECT_NE(timing.find("\"segments\""), std::string::npos);
-    for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos);
+    for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().string().find(".qsgi-tmp"), std::string::npos);
 }
 
 TEST(Cli, HelpAndVersion) {
@@ -161,7 +161,7 @@ TEST(Cli, AnInterruptedRunNeverLeavesATruncatedExr) {
     int complete = 0;
     for (const auto& e : fs::directory_iterator(out)) {
         const std::string name = e.path().filename().string();
-        if (name.rfind("frame_", 0) != 0 || e.path().extension() != ".exr" || name.find(".tmp") != std::string::npos) continue;
+        if (name.rfind("frame_", 0) != 0 || e.path().extension() != ".exr" || name.find(".qsgi-tmp") != std::string::npos) continue;
         const auto self = qsgi::compareImages(e.path(), e.path(), qsgi::ImageTolerance{});
         EXPECT_TRUE(self.readable) << name << ": " << self.problem;
         ++complete;

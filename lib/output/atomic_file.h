@@ -20,7 +20,12 @@ public:
     // the final extension so format detection by name still works.
     const std::filesystem::path& temporaryPath() const { return tempPath_; }
     std::ofstream& stream();  // opened on first use, binary
-    void commit();            // flush, close, rename; throws std::runtime_error on failure
+    // Flush, close, fsync, rename, fsync the folder: after commit() returns, the file survives a
+    // crash or power loss under its final name. Throws std::runtime_error on failure.
+    void commit();
+
+    // Removes the temporary files a killed process left in `folder` (names made by this class).
+    static void removeStaleTemporaries(const std::filesystem::path& folder);
 
 private:
     std::filesystem::path finalPath_, tempPath_;

@@ -5,6 +5,8 @@
 #include <algorithm>
 
 #include "output/atomic_file.h"
+#include "util/error.h"
+#include "util/json_file.h"
 
 namespace qsgi {
 
@@ -31,7 +33,7 @@ void TimingLog::write(const std::filesystem::path& path) const {
                    {"detp_index", estimator == "detp" ? nlohmann::json(detpIndex) : nlohmann::json(nullptr)},
                    {"detp_boundary", hasRadius ? nlohmann::json(boundary) : nlohmann::json(nullptr)},
                    {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute}, {"envelope", envelope},
-                   {"seed", seed}, {"threads", threads}};
+                   {"seed", seed}, {"threads", threads}, {"inputs_fingerprint", inputsFingerprint}};
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
                   {"degenerate_triangles", degenerateTriangles}};
@@ -45,24 +47,31 @@ void TimingLog::write(const std::filesystem::path& path) const {
     j["density_estimation"] = {{"initial_s", frames.empty() ? 0.0 : frames[0].estimationSeconds},
                                {"frame_s", summary(estimates)}};
     json list = json::array();
-    for (const FrameTiming& f : frames)
-        list.push_back({{"frame", f.frame}, {"from_scratch", f.fromScratch}, {"photon_update_s", f.photonSimulationSeconds},
-                        {"find_affected_s", f.findAffectedSeconds}, {"retrace_s", f.retraceSeconds},
-                        {"paths_affected_by_impact", f.pathsAffectedByImpact},
-                        {"paths_affected_by_blocking", f.pathsAffectedByBlocking}, {"tracked_paths", f.trackedPaths},
-                        {"tracked_segments", f.trackedSegments}, {"tracked_bytes", f.trackedBytes},
-                        {"recompute_s", f.recomputeSeconds}, {"vertices_recomputed", f.verticesRecomputed},
-                        {"estimation_s", f.estimationSeconds}, {"render_s", f.renderSeconds},
-                        {"write_s", f.writeSeconds},
-                        {"segments", f.segments}, {"photons_missing_scene", f.photonsMissingScene}, {"paths_retraced", f.pathsRetraced},
-                        {"segments_removed", f.segmentsRemoved}, {"segments_added", f.segmentsAdded},
-                        {"vertices_updated", f.verticesUpdated}, {"disc_regions_s", f.discRegionsSeconds},
-                        {"disc_regions_updated", f.discRegionsUpdated}, {"own_surface_fallbacks", f.ownSurfaceFallbacks},
-                        {"buried_vertices", f.buriedVertices}});
+    for (const FrameTiming& f : frames) {
+        json entry;
+        forEachTimingField(f, [&](const char* name, const auto& value) { entry[name] = value; });
+        list.push_back(entry);
+    }
     j["frames"] = list;
     AtomicFile file(path);
     file.stream() << j.dump(2) << "\n";
     file.commit();
+}
+
+EarlierRun readTimingLog(const std::filesystem::path& path) {
+    const nlohmann::json j = readJsonFile(path.string());
+    EarlierRun run;
+    try {
+        run.inputsFingerprint = j.at("config").at("inputs_fingerprint").get<std::string>();
+        for (const nlohmann::json& entry : j.at("frames")) {
+            FrameTiming f;
+            forEachTimingField(f, [&](const char* name, auto& value) { entry.at(name).get_to(value); });
+            run.frames.push_back(f);
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(path.string(), "", std::string("is not a timing log of this qsgi version (") + e.what() + ")");
+    }
+    return run;
 }
 
 }  // namespace qsgi

@@ -33,6 +33,37 @@ struct FrameTiming {
     uint64_t ownSurfaceFallbacks = 0, buriedVertices = 0;
 };
 
+// Calls visit(name, member) for every field of a FrameTiming, as named in timing.json: the one
+// list that writing and reading (for --resume) share.
+template <class Timing, class Visit>
+void forEachTimingField(Timing& f, Visit&& visit) {
+    visit("frame", f.frame);
+    visit("from_scratch", f.fromScratch);
+    visit("photon_update_s", f.photonSimulationSeconds);
+    visit("find_affected_s", f.findAffectedSeconds);
+    visit("retrace_s", f.retraceSeconds);
+    visit("paths_affected_by_impact", f.pathsAffectedByImpact);
+    visit("paths_affected_by_blocking", f.pathsAffectedByBlocking);
+    visit("tracked_paths", f.trackedPaths);
+    visit("tracked_segments", f.trackedSegments);
+    visit("tracked_bytes", f.trackedBytes);
+    visit("recompute_s", f.recomputeSeconds);
+    visit("vertices_recomputed", f.verticesRecomputed);
+    visit("estimation_s", f.estimationSeconds);
+    visit("render_s", f.renderSeconds);
+    visit("write_s", f.writeSeconds);
+    visit("segments", f.segments);
+    visit("photons_missing_scene", f.photonsMissingScene);
+    visit("paths_retraced", f.pathsRetraced);
+    visit("segments_removed", f.segmentsRemoved);
+    visit("segments_added", f.segmentsAdded);
+    visit("vertices_updated", f.verticesUpdated);
+    visit("disc_regions_s", f.discRegionsSeconds);
+    visit("disc_regions_updated", f.discRegionsUpdated);
+    visit("own_surface_fallbacks", f.ownSurfaceFallbacks);
+    visit("buried_vertices", f.buriedVertices);
+}
+
 struct TimingLog {
     // config
     std::string estimator;
@@ -50,10 +81,20 @@ struct TimingLog {
     std::string scene;
     uint64_t vertices = 0, triangles = 0, dynamicVertices = 0, lights = 0;
     uint64_t degenerateTriangles = 0;
+    // runFingerprint of the inputs and settings; --resume continues only a folder whose log has it.
+    std::string inputsFingerprint;
 
-    std::vector<FrameTiming> frames;
+    std::vector<FrameTiming> frames;  // in the order they were written
 
     void write(const std::filesystem::path& path) const;  // atomically
 };
+
+// What --resume needs from an earlier run's timing.json: its fingerprint and its frames. Throws
+// InputError naming the file if it is not a timing log qsgi wrote.
+struct EarlierRun {
+    std::string inputsFingerprint;
+    std::vector<FrameTiming> frames;
+};
+EarlierRun readTimingLog(const std::filesystem::path& path);
 
 }  // namespace qsgi

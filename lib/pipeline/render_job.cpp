@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <climits>
+#include <iterator>
 #include <optional>
 #include <stdexcept>
 
@@ -15,7 +17,9 @@
 #include "output/ply_writer.h"
 #include "output/radiosity_image.h"
 #include "output/timing_log.h"
+#include "output/atomic_file.h"
 #include "pipeline/frame_solver.h"
+#include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
 #include "trace/photon_tracer.h"
 #include "util/progress.h"
@@ -99,9 +103,47 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                              std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the animation's last frame " +
                                  std::to_string(animation_.lastFrame()));
     }
+    std::string animationBytes;
+    if (!settings_.animationPath.empty()) {
+        std::ifstream in(settings_.animationPath, std::ios::binary);
+        animationBytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    fingerprint_ = runFingerprint(settings_, scene_, animationBytes, camera_);
 }
 
-void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
+namespace {
+
+// With --resume: the frames of the earlier run in `outDir` that are complete on disk (listed in
+// its timing.json, which is written after a frame's files, and every file present). Throws
+// InputError if the folder was made from other inputs or settings.
+std::vector<FrameTiming> framesToKeep(const fs::path& outDir, const std::string& fingerprint,
+                                      const std::function<bool(int)>& filesExist) {
+    const fs::path logPath = outDir / "timing.json";
+    std::error_code ec;
+    if (!fs::exists(logPath, ec)) {
+        for (const auto& entry : fs::directory_iterator(outDir, ec))
+            if (entry.path().filename().string().rfind("frame_", 0) == 0)
+                throw InputError(outDir.string(), "--resume",
+                                 "holds frame files but no timing.json, so nothing says how they were made; render into "
+                                 "an empty folder instead");
+        return {};  // killed before its first frame: nothing to keep
+    }
+    const EarlierRun earlier = readTimingLog(logPath);
+    if (earlier.inputsFingerprint != fingerprint)
+        throw InputError(logPath.string(), "config.inputs_fingerprint",
+                         "the folder was rendered from other inputs or settings (scene, animation, photons, seed, "
+                         "estimator, radius or image options differ), so --resume would mix two renders; use the same "
+                         "ones or render into another folder");
+    std::vector<FrameTiming> kept;
+    for (const FrameTiming& f : earlier.frames)
+        if (filesExist(f.frame)) kept.push_back(f);
+    return kept;
+}
+
+}  // namespace
+
+RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame,
+                          const std::function<bool()>& stopRequested) {
     std::optional<tbb::global_control> threadLimit;
     if (settings_.threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(settings_.threads));
 
@@ -119,6 +161,23 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         fs::remove(probe, ec);
         if (!writable) throw InputError(settings_.outDir, "--out", "the output folder is not writable");
     }
+    AtomicFile::removeStaleTemporaries(outDir);
+    auto frameFilesExist = [&](int frame) {
+        std::error_code missing;
+        return fs::exists(outDir / frameFileName(frame, "ply"), missing) &&
+               (!settings_.writeExr || fs::exists(outDir / frameFileName(frame, "exr"), missing)) &&
+               (!settings_.writePng || fs::exists(outDir / frameFileName(frame, "png"), missing));
+    };
+    // The first frame to compute: with --resume, the first of the range an earlier run of the
+    // same inputs has not completed. Its entries for earlier frames stay in the log.
+    std::vector<FrameTiming> earlierFrames;
+    if (settings_.resume) earlierFrames = framesToKeep(outDir, fingerprint_, frameFilesExist);
+    int start = first_;
+    auto done = [&](int frame) {
+        return std::any_of(earlierFrames.begin(), earlierFrames.end(), [&](const FrameTiming& f) { return f.frame == frame; });
+    };
+    while (start <= last_ && done(start)) ++start;
+    RunOutcome outcome;
 
     TimingLog log;
     log.estimator = estimatorName(settings_.estimator.kind);
@@ -140,6 +199,14 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
     log.triangles = scene_.triangleCount();
     for (uint8_t d : scene_.vertexDynamic) log.dynamicVertices += d;
     log.lights = scene_.lights.size();
+    log.inputsFingerprint = fingerprint_;
+    for (const FrameTiming& f : earlierFrames)
+        if (f.frame < start || f.frame > last_) log.frames.push_back(f);
+    outcome.framesResumed = int(log.frames.size());
+    outcome.nextFrame = start;
+    if (start > last_) return outcome;  // resumed with nothing left to do: the folder stays as it is
+    // Written before any frame, so the folder records its inputs' fingerprint from the start.
+    log.write(outDir / "timing.json");
 
     EmbreeDevice device;
     auto imageMetadata = [&](int frame) {
@@ -175,14 +242,14 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         if (settings_.writePng && !exposure)
             exposure = automaticExposure(renderRadiosityImage(scene_, bvh, result, camera_, imageSettings));
     };
-    if (first_ > 0) {
+    if (start > 0) {
         FrameWork work;
         fixPreviews(solver.solve(animation_.localsAt(0), work), solver.bvh());
         solver.reset();
     }
 
-    const int count = last_ - first_ + 1;
-    for (int frame = first_; frame <= last_; ++frame) {
+    const int count = last_ - start + 1;
+    for (int frame = start; frame <= last_; ++frame) {
         Stopwatch frameClock;
         FrameWork work;
         const VertexRadiosity& result = solver.solve(animation_.localsAt(frame), work);
@@ -211,7 +278,7 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         timing.discRegionsUpdated = work.discRegionsUpdated;
         timing.ownSurfaceFallbacks = solver.ownSurfaceFallbacks();
         timing.buriedVertices = solver.buriedVertices();
-        if (frame == first_) log.photonsMissingScene = work.photonsMissingScene;
+        if (frame == start) log.photonsMissingScene = work.photonsMissingScene;
 
         std::optional<RgbImage> image;
         Stopwatch clock;
@@ -228,11 +295,17 @@ void RenderJob::run(const std::function<void(const FrameReport&)>& onFrame) {
         log.frames.push_back(timing);
         // Rewritten after every frame, so it always describes the frames on disk (DESIGN §7).
         log.write(outDir / "timing.json");
+        outcome.nextFrame = frame + 1;
+        ++outcome.framesWritten;
         if (onFrame)
-            onFrame(FrameReport{frame, frame - first_, count, frameClock.seconds(),
+            onFrame(FrameReport{frame, frame - start, count, frameClock.seconds(),
                                 double(log.photonsMissingScene) / double(std::max<uint64_t>(settings_.photons, 1))});
+        if (frame < last_ && stopRequested && stopRequested()) {
+            outcome.interrupted = true;
+            return outcome;
+        }
     }
-    log.write(outDir / "timing.json");
+    return outcome;
 }
 
 }  // namespace qsgi

@@ -20,14 +20,27 @@ struct FrameReport {
     double missedFraction;  // of the photons emitted this frame, those that hit no geometry
 };
 
+// How run() ended: every frame written, or stopped early on request with the frames before
+// `nextFrame` on disk.
+struct RunOutcome {
+    bool interrupted = false;
+    int nextFrame = 0;      // the first frame not written
+    int framesResumed = 0;  // frames an earlier run had written (--resume)
+    int framesWritten = 0;  // by this run
+};
+
 class RenderJob {
 public:
     // Loads the scene, animation and lights and checks them all; throws InputError before
     // anything is written.
     RenderJob(RenderSettings settings, Warnings& warnings);
 
-    // Creates the output folder and renders every frame. onFrame runs after each frame.
-    void run(const std::function<void(const FrameReport&)>& onFrame = {});
+    // Creates the output folder and renders every frame (with --resume, those an earlier run of
+    // the same inputs has not written). onFrame runs after each frame; when stopRequested returns
+    // true after a frame, run() returns with the folder consistent (every file complete, timing.json
+    // describing the frames on disk).
+    RunOutcome run(const std::function<void(const FrameReport&)>& onFrame = {},
+                   const std::function<bool()>& stopRequested = {});
 
     const Scene& scene() const { return scene_; }
     int firstFrame() const { return first_; }
@@ -39,6 +52,7 @@ private:
     PerspectiveCamera camera_;
     Animation animation_;
     int first_ = 0, last_ = 0;
+    std::string fingerprint_;  // runFingerprint of the inputs and settings
 };
 
 // "frame_0012.ply" and the like.

@@ -32,6 +32,7 @@ struct RenderSettings {
     bool useEnvelope = true;     // fold paths that never meet the moving geometry's envelope
     bool blockingGrid = true;    // find blocked segments through the grid (false: test every tracked one)
     std::optional<FrameRange> frames;
+    bool resume = false;  // continue outDir after its last complete frame (same fingerprint only)
     std::string framesSource;  // where frames came from (the config or "command line"), for messages
     std::vector<PunctualLight> extraLights;  // world space, from the config
 
