@@ -15,6 +15,7 @@ packages=(
   libcli11-dev
   libgtest-dev libgmock-dev
   libbenchmark-dev
+  clang libclang-rt-14-dev    # libFuzzer (scripts/fuzz.sh)
 )
 
 missing=()

@@ -89,6 +89,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, settings_.animationPath);
     scene_.markDynamic(animation_.movedNodes());
     sweepAnimationBounds(scene_, animation_);
+    if (!settings_.animationPath.empty())
+        checkSceneExtent(scene_.positions, scene_.animationBounds, settings_.animationPath, "frames");
 
     camera_ = resolveCamera(settings_, scene_, warnings);
     if (!settings_.radiusGiven) settings_.estimator.radius = defaultRadius(scene_);

@@ -145,10 +145,12 @@ const std::vector<std::string> kConfigKeys = {
 void applyConfig(const std::string& path, const json& doc, RenderSettings& s);
 }  // namespace
 
-void applyConfigFile(const std::string& path, RenderSettings& s) {
+void applyConfigFile(const std::string& path, RenderSettings& s) { applyConfigJson(path, readJsonFile(path), s); }
+
+void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderSettings& s) {
     s.configPath = path;
     try {
-        applyConfig(path, readJsonFile(path), s);
+        applyConfig(path, doc, s);
     } catch (const json::exception& e) {
         throw InputError(path, "", std::string("a field has the wrong JSON type (") + e.what() + ")");
     }

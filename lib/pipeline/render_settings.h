@@ -2,6 +2,8 @@
 // command line (DESIGN §8). Parsing lives here; the CLI only maps options onto the fields.
 #pragma once
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -68,6 +70,8 @@ uint64_t checkedPhotons(int64_t value, const std::string& source, const std::str
 // Reads a config file into `settings` (only the keys present change). Relative scene and
 // animation paths are resolved against the config's folder. Throws InputError.
 void applyConfigFile(const std::string& path, RenderSettings& settings);
+// The same for a config already parsed (`path` names it in messages and resolves relative paths).
+void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderSettings& settings);
 
 // Parses "A:B" (inclusive, as in Blender) or "A". Throws InputError naming `source`.
 FrameRange parseFrameRange(const std::string& text, const std::string& source);

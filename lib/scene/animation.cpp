@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <limits>
 #include <set>
 
 #include "util/error.h"
@@ -196,7 +197,17 @@ void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<std::
         moved.clear();
         if (!scene.applyPose(localsAt(frame), &moved)) continue;
         swept.extend(scene.bounds());
-        for (uint32_t i : moved) perInstance[i].extend(scene.instanceBounds(i));
+        for (uint32_t i : moved) {
+            perInstance[i].extend(scene.instanceBounds(i));
+            // A pose that overflows float (NaN escapes min/max) makes the swept bounds endless,
+            // which checkSceneExtent refuses.
+            const MeshInstance& inst = scene.instances[i];
+            for (uint32_t v = 0; v < inst.vertexCount; ++v)
+                if (!isFinite(scene.positions[inst.firstVertex + v])) {
+                    swept.extend(Vec3f(std::numeric_limits<float>::infinity()));
+                    break;
+                }
+        }
     }
     moved.clear();
     scene.applyPose(scene.restLocals(), &moved);

@@ -18,6 +18,9 @@ public:
     static Animation still(const Scene& scene);
     // Throws InputError naming the file, frame and node for anything unusable.
     static Animation fromTransformFile(const std::string& path, const Scene& scene);
+    // The same for a transform file already parsed as JSON (`path` names it in messages; the
+    // fuzzer uses this). Wrong JSON types may also throw nlohmann::json::exception.
+    static Animation parseTransformFile(const std::string& path, const nlohmann::json& doc, const Scene& scene);
 
     int lastFrame() const { return lastFrame_; }
     double fps() const { return fps_; }
@@ -27,8 +30,6 @@ public:
     const std::vector<int>& movedNodes() const { return moved_; }
 
 private:
-    static Animation parseTransformFile(const std::string& path, const nlohmann::json& doc, const Scene& scene);
-
     struct Key {
         int frame;
         std::vector<std::pair<int, Transform>> nodes;

@@ -132,7 +132,12 @@ std::string firstLine(const std::string& s) {
 }  // namespace
 
 GltfDocument readGltfDocument(const std::string& path, Warnings& warnings) {
-    std::string bytes = readBytes(path);
+    return parseGltfDocument(path, readBytes(path), fs::absolute(fs::path(path)).parent_path().string(), warnings);
+}
+
+GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const std::string& baseDir,
+                               Warnings& warnings) {
+    if (bytes.size() >= (uint64_t(1) << 32)) throw InputError(path, "", "is 4 GiB or larger; glTF files are limited to 2^32 bytes");
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     GlbLayout glb;
     if (binary) glb = readGlbLayout(path, bytes);
@@ -173,7 +178,6 @@ GltfDocument readGltfDocument(const std::string& path, Warnings& warnings) {
     tinygltf::TinyGLTF loader;
     std::string err, warn;
     bool ok = false;
-    const std::string baseDir = fs::absolute(fs::path(path)).parent_path().string();
     try {
         ok = binary ? loader.LoadBinaryFromMemory(&out.model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
                                                   unsigned(bytes.size()), baseDir)

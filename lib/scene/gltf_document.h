@@ -25,5 +25,9 @@ struct GltfDocument {
 
 // Throws InputError naming the file and the place in it; tinygltf's own warnings go to warnings.
 GltfDocument readGltfDocument(const std::string& path, Warnings& warnings);
+// The same for a file already in memory: `path` names it in messages, external URIs are read
+// relative to `baseDir` (the fuzzers use this).
+GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const std::string& baseDir,
+                               Warnings& warnings);
 
 }  // namespace qsgi

@@ -410,6 +410,7 @@ public:
         }
         scene.cameras.resize(model_.cameras.size());
         scene.finalize();
+        checkSceneExtent(scene.positions, scene.bounds(), file_, "nodes");
         return scene;
     }
 
@@ -565,8 +566,9 @@ private:
 
 }  // namespace
 
-Scene loadGltfScene(const std::string& path, Warnings& warnings) {
-    const GltfDocument document = readGltfDocument(path, warnings);
+namespace {
+
+Scene buildScene(const GltfDocument& document, const std::string& path, Warnings& warnings) {
     const tinygltf::Model& model = document.model;
     for (const auto& ext : model.extensionsRequired)
         if (!kSupportedExtensions.count(ext))
@@ -574,8 +576,18 @@ Scene loadGltfScene(const std::string& path, Warnings& warnings) {
     for (const auto& ext : model.extensionsUsed)
         if (!kSupportedExtensions.count(ext)) warnings.add(path + ": extension " + ext + " is ignored");
 
-    Scene scene = SceneBuilder(document, path, warnings).build();
-    return scene;
+    return SceneBuilder(document, path, warnings).build();
+}
+
+}  // namespace
+
+Scene loadGltfScene(const std::string& path, Warnings& warnings) {
+    return buildScene(readGltfDocument(path, warnings), path, warnings);
+}
+
+Scene loadGltfSceneFromMemory(const std::string& path, std::string bytes, const std::string& baseDir,
+                              Warnings& warnings) {
+    return buildScene(parseGltfDocument(path, std::move(bytes), baseDir, warnings), path, warnings);
 }
 
 }  // namespace qsgi

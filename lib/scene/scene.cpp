@@ -1,5 +1,8 @@
 #include "scene/scene.h"
 
+#include "util/error.h"
+
+#include <cstdio>
 #include <functional>
 #include <limits>
 
@@ -21,6 +24,20 @@ std::vector<Vec3f> Scene::frontFaceNormals() const {
     std::vector<Vec3f> front(triangleCount());
     for (uint32_t t = 0; t < triangleCount(); ++t) front[t] = frontFaceNormal(positions, normals, triangles[t]);
     return front;
+}
+
+void checkSceneExtent(const std::vector<Vec3f>& positions, const Bounds3f& bounds, const std::string& file,
+                      const std::string& place) {
+    for (const Vec3f& p : positions)
+        if (!isFinite(p))
+            throw InputError(file, place, "places vertices beyond the range of float (a transform or position is too large)");
+    const double extent = length(Vec3d(bounds.diagonal()));
+    if (!(extent <= kMaxSceneExtent)) {
+        char spans[32];
+        std::snprintf(spans, sizeof spans, "%.3g", extent);
+        throw InputError(file, place, std::string("the scene spans ") + spans + " units; qsgi supports up to 1e15 "
+                                      "(beyond that float areas overflow)");
+    }
 }
 
 Vec3f Scene::geometricNormal(uint32_t tri) const {

@@ -61,6 +61,16 @@ struct MeshInstance {
     bool mirrored = false;             // rest transform has a negative determinant
 };
 
+// The largest bounding-box diagonal qsgi accepts, in scene units. Beyond it float areas and
+// densities overflow (a triangle of side 1e19 has an area beyond float range), so a file or an
+// animation that places geometry further out is refused rather than rendered to Inf and NaN.
+constexpr double kMaxSceneExtent = 1e15;
+
+// Throws InputError(file, place, …) if any vertex position is non-finite or `bounds` (the scene's
+// or its animation's) spans more than kMaxSceneExtent.
+void checkSceneExtent(const std::vector<Vec3f>& positions, const Bounds3f& bounds, const std::string& file,
+                      const std::string& place);
+
 struct Scene {
     std::string sourcePath;
 

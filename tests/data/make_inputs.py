@@ -275,6 +275,11 @@ bad("animation", "matrix_and_translation.json",
                                            "translation": [0, 1, 0]}}}]), "cannot be combined")
 bad("animation", "moves_the_light.json", anim([{"frame": 0}, {"frame": 1, "nodes": {"Lamp": {"translation": [0, 2, 0]}}}]),
     "lights must be static")
+bad("animation", "translation_overflows_float.json",
+    anim([{"frame": 0}, {"frame": 1, "nodes": {"Floor": {"translation": [3.3e38, 0, 0], "scale": [1e38, 1, 1]}}}]),
+    "supports up to 1e15")
+bad("animation", "scene_spans_too_far.json",
+    anim([{"frame": 0}, {"frame": 1, "nodes": {"Floor": {"translation": [1e20, 0, 0]}}}]), "supports up to 1e15")
 bad("animation", "not_json.json", "frames: [0, 1, 2]", "not valid JSON")
 bad("animation", "top_level_array.json", [anim([{"frame": 0}])], "JSON object")
 bad("animation", "number_overflow.json", '{"format":"qsgi-animation","version":1,"frames":[{"frame":0,'
