@@ -182,9 +182,12 @@ int main(int argc, char** argv) {
 
     try {
         app.parse(argc, argv);
+    } catch (const CLI::Success& e) {  // --help, --version
+        return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        const int code = app.exit(e);
-        return code == 0 ? 0 : kExitBadInput;
+        // One line, like every other bad input (CLI11's own report takes two).
+        std::fprintf(stderr, "qsgi: error: command line: %s (see qsgi --help)\n", e.what());
+        return kExitBadInput;
     }
 
     if (compare->parsed()) {

@@ -131,6 +131,18 @@ TEST(Cli, BadInputGivesOneClearMessageExitCodeTwoAndWritesNothing) {
     expectBadInput("render " + lit + " --photons 0", "--photons", out);
     expectBadInput("render " + lit + " --photons -5", "--photons", out);
     expectBadInput("render " + lit + " --frames 3:1", "frames", out);
+    // Values out of range or unparsable: refused with one line, never clamped or wrapped.
+    expectBadInput("render " + lit + " --photons abc", "--photons", out);
+    expectBadInput("render " + lit + " --photons 8589934592", "2^32", out);
+    expectBadInput("render " + lit + " --bogus-option", "--bogus-option", out);
+    expectBadInput("render " + lit + " --threads 5000", "0..1024", out);
+    expectBadInput("render " + lit + " --k 0", "--k", out);
+    expectBadInput("render " + lit + " --k 99999999999", "--k", out);
+    expectBadInput("render " + lit + " --seed -1", "--seed", out);
+    expectBadInput("render " + lit + " --radius nan", "--radius", out);
+    expectBadInput("render " + lit + " --radius 1e40", "--radius", out);
+    expectBadInput("render " + lit + " --frames 0:99999999999", "frames", out);
+    expectBadInput("render " + lit + " --camera 99999999999", "--camera", out);
 
     // An output folder that cannot be created: its parent is a regular file.
     writeText(dir / "file", "x");
