@@ -85,17 +85,6 @@ Vec3f vec3(const json& j, const std::string& file, const std::string& place) {
     return v;
 }
 
-// Keys starting with "_" and "comment" are notes for people.
-void refuseUnknownKeys(const json& j, const std::vector<std::string>& known, const std::string& file,
-                       const std::string& place) {
-    for (auto it = j.begin(); it != j.end(); ++it) {
-        const std::string& key = it.key();
-        if (std::find(known.begin(), known.end(), key) != known.end() || key.rfind("_", 0) == 0 || key == "comment")
-            continue;
-        throw InputError(file, place.empty() ? key : place + "." + key, "unknown key" + didYouMean(key, known));
-    }
-}
-
 // An integer, also when written as 1e6 (a float with no fraction); never wrapped.
 int64_t jsonInteger(const json& v, const std::string& file, const std::string& key) {
     if (v.is_number_unsigned()) return v.get<uint64_t>() > uint64_t(INT64_MAX) ? INT64_MAX : int64_t(v.get<uint64_t>());
@@ -159,6 +148,7 @@ void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderS
 namespace {
 void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
     if (!doc.is_object()) throw InputError(path, "", "must be a JSON object");
+    refuseUnknownKeys(doc, kConfigKeys, path, "");
     const std::filesystem::path base = std::filesystem::path(path).parent_path();
     auto resolve = [&](const std::string& p) { return std::filesystem::path(p).is_absolute() ? p : (base / p).string(); };
     for (auto it = doc.begin(); it != doc.end(); ++it) {
@@ -238,11 +228,8 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
                 c.yfov = v["yfov"].get<float>();
             }
             s.camera = c;
-        } else if (key.rfind("_", 0) == 0 || key == "comment") {
-            // "_…" and "comment" keys are notes for people
-        } else {
-            throw InputError(path, key, "unknown key" + didYouMean(key, kConfigKeys));
         }
+        // Any other key is a note for people ("_…", "comment"): refuseUnknownKeys let it through.
     }
 }
 

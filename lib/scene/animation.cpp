@@ -49,17 +49,6 @@ std::vector<double> numbers(const json& j, size_t count, const std::string& file
     return out;
 }
 
-// Keys starting with "_" and "comment" are notes for people, as in configs.
-void refuseUnknownKeys(const json& j, const std::vector<std::string>& known, const std::string& file,
-                       const std::string& place) {
-    for (auto it = j.begin(); it != j.end(); ++it) {
-        const std::string& key = it.key();
-        if (std::find(known.begin(), known.end(), key) != known.end() || key.rfind("_", 0) == 0 || key == "comment")
-            continue;
-        throw InputError(file, place.empty() ? key : place + "." + key, "unknown key" + didYouMean(key, known));
-    }
-}
-
 Transform parseNodeTransform(const json& j, const std::string& file, const std::string& place) {
     if (!j.is_object()) throw InputError(file, place, "must be an object with matrix or translation/rotation/scale");
     refuseUnknownKeys(j, {"matrix", "translation", "rotation", "scale"}, file, place);

@@ -1,8 +1,10 @@
 #include "util/json_file.h"
 
+#include <algorithm>
 #include <fstream>
 
 #include "util/error.h"
+#include "util/nearest_name.h"
 
 namespace qsgi {
 
@@ -18,6 +20,16 @@ nlohmann::json readJsonFile(const std::string& path) {
         std::string what = e.what();
         const auto bracket = what.find("] ");
         throw InputError(path, "", "not usable JSON: " + (bracket == std::string::npos ? what : what.substr(bracket + 2)));
+    }
+}
+
+void refuseUnknownKeys(const nlohmann::json& j, const std::vector<std::string>& known, const std::string& file,
+                       const std::string& place) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& key = it.key();
+        if (std::find(known.begin(), known.end(), key) != known.end() || key.rfind("_", 0) == 0 || key == "comment")
+            continue;
+        throw InputError(file, place.empty() ? key : place + "." + key, "unknown key" + didYouMean(key, known));
     }
 }
 

@@ -5,9 +5,15 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace qsgi {
 
 nlohmann::json readJsonFile(const std::string& path);
+
+// Throws InputError(file, place.key, "unknown key (did you mean …?)") for a key of the object `j`
+// that is not in `known`. Keys starting with "_", and "comment", are notes for people.
+void refuseUnknownKeys(const nlohmann::json& j, const std::vector<std::string>& known, const std::string& file,
+                       const std::string& place);
 
 }  // namespace qsgi
