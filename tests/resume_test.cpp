@@ -37,12 +37,16 @@ struct SignalledRun {
     std::string output;
 };
 
-// Starts `qsgi arguments` and sends it `signal` after `seconds` (if it still runs).
-SignalledRun runAndSignal(const std::string& arguments, const char* signal, double seconds, const fs::path& scratch) {
+// Starts `qsgi arguments` and sends it `signal` after `seconds` (if it still runs). With
+// `afterStart`, the clock starts when that file appears (the run has begun), not at launch.
+SignalledRun runAndSignal(const std::string& arguments, const char* signal, double seconds, const fs::path& scratch,
+                          const fs::path& afterStart = {}) {
     const fs::path log = scratch / "signalled.log", rc = scratch / "signalled.rc";
-    const std::string command = std::string(QSGI_CLI) + " " + arguments + " 2>" + log.string() + " & pid=$!; sleep " +
-                                std::to_string(seconds) + "; kill -" + signal + " $pid 2>/dev/null; wait $pid; echo $? > " +
-                                rc.string();
+    const std::string waitForStart =
+        afterStart.empty() ? "" : "for i in $(seq 600); do [ -e " + afterStart.string() + " ] && break; sleep 0.05; done; ";
+    const std::string command = std::string(QSGI_CLI) + " " + arguments + " 2>" + log.string() + " & pid=$!; " +
+                                waitForStart + "sleep " + std::to_string(seconds) + "; kill -" + signal +
+                                " $pid 2>/dev/null; wait $pid; echo $? > " + rc.string();
     EXPECT_EQ(std::system(command.c_str()), 0);
     return {std::stoi(readAll(rc)), readAll(log)};
 }
@@ -118,7 +122,9 @@ TEST(Resume, SigintAndSigtermStopAfterTheCurrentFrameWithAConsistentFolder) {
     for (const char* signal : {"INT", "TERM"}) {
         SCOPED_TRACE(signal);
         const fs::path out = dir / signal;
-        const SignalledRun stopped = runAndSignal(renderArguments() + " --out " + out.string(), signal, 0.6, dir);
+        // timing.json appears once the handlers are in place and before frame 0 is computed.
+        const SignalledRun stopped =
+            runAndSignal(renderArguments() + " --out " + out.string(), signal, 0.3, dir, out / "timing.json");
         ASSERT_EQ(stopped.exitCode, std::string(signal) == "INT" ? 130 : 143) << stopped.output;
         EXPECT_NE(stopped.output.find("--resume"), std::string::npos) << stopped.output;
         EXPECT_NE(stopped.output.find(std::string("SIG") + signal), std::string::npos) << stopped.output;
