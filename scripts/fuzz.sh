@@ -9,8 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-shift || true
-harnesses=("$@")
+harnesses=("${@:2}")
 [ ${#harnesses[@]} -eq 0 ] && harnesses=(transform_file config gltf)
 
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \

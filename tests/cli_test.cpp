@@ -4,7 +4,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "output/image_compare.h"
 #include "test_support.h"
@@ -12,13 +11,6 @@
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string readAll(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 std::string cornell() { return (sourceDir() / "data/cornell/cornell.gltf").string(); }
 std::string cornellAnimation() { return (sourceDir() / "data/cornell/animation.json").string(); }
@@ -48,13 +40,13 @@ TEST(Cli, OutputBytesAreIdenticalForOneAndTwoThreadsAndRepeatedRuns) {
     for (int f = 0; f <= 2; ++f)
       for (const char* ext : {".ply", ".exr", ".png"}) {
         const std::string name = "frame_000" + std::to_string(f) + ext;
-        const std::string a = readAll(fs::path(dir) / "t1" / name);
+        const std::string a = readFileBytes(fs::path(dir) / "t1" / name);
         ASSERT_GT(a.size(), 1000u) << name;
-        EXPECT_EQ(a, readAll(fs::path(dir) / "t2" / name)) << name << " differs between 1 and 2 threads";
-        EXPECT_EQ(a, readAll(fs::path(dir) / "t2again" / name)) << name << " differs between runs";
+        EXPECT_EQ(a, readFileBytes(fs::path(dir) / "t2" / name)) << name << " differs between 1 and 2 threads";
+        EXPECT_EQ(a, readFileBytes(fs::path(dir) / "t2again" / name)) << name << " differs between runs";
     }
     // The block moves, so frames differ.
-    EXPECT_NE(readAll(fs::path(dir) / "t1/frame_0000.ply"), readAll(fs::path(dir) / "t1/frame_0002.ply"));
+    EXPECT_NE(readFileBytes(fs::path(dir) / "t1/frame_0000.ply"), readFileBytes(fs::path(dir) / "t1/frame_0002.ply"));
     EXPECT_TRUE(fs::exists(fs::path(dir) / "t1/timing.json"));
 }
 
@@ -67,7 +59,7 @@ TEST(Cli, RenderWritesOnePlyPerFrameAndATimingLog) {
     for (int f : {5, 6, 7}) EXPECT_TRUE(fs::exists(dir / ("frame_000" + std::to_string(f) + ".ply")));
     EXPECT_FALSE(fs::exists(dir / "frame_0004.ply"));
     EXPECT_FALSE(fs::exists(dir / "frame_0008.ply"));
-    const std::string timing = readAll(dir / "timing.json");
+    const std::string timing = readFileBytes(dir / "timing.json");
     EXPECT_NE(timing.find("\"photon_simulation\""), std::string::npos);
     EXPECT_NE(timing.find("\"segments\""), std::string::npos);
     for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().string().find(".qsgi-tmp"), std::string::npos);
@@ -190,9 +182,9 @@ TEST(Cli, EveryEstimatorRendersEndToEnd) {
                                         " --radius 0.07 --k 30 --photons 20000 --width 80 --height 60 --out " + out.string());
         ASSERT_EQ(r.exitCode, 0) << estimator << "\n" << r.output;
         EXPECT_TRUE(fs::exists(out / "frame_0000.ply"));
-        const std::string info = readAll(out / "frame_0000.exr");
+        const std::string info = readFileBytes(out / "frame_0000.exr");
         EXPECT_NE(info.find(estimator), std::string::npos) << "EXR metadata should name " << estimator;
-        const std::string timing = readAll(out / "timing.json");
+        const std::string timing = readFileBytes(out / "timing.json");
         EXPECT_NE(timing.find(std::string("\"estimator\": \"") + estimator + "\""), std::string::npos) << timing;
         if (std::string(estimator) != "impact-count") {
             EXPECT_NE(timing.find("\"radius\": 0.07"), std::string::npos) << timing;
@@ -221,12 +213,12 @@ TEST(Cli, IncrementalRunWritesTheBytesOfAFullRecomputation) {
         ASSERT_EQ(r.exitCode, 0) << r.output;
         for (int f = 0; f <= 3; ++f) {
             const std::string name = "frame_000" + std::to_string(f) + ".ply";
-            const std::string a = readAll(inc / name);
+            const std::string a = readFileBytes(inc / name);
             ASSERT_GT(a.size(), 1000u);
-            EXPECT_EQ(a, readAll(full / name)) << name;
+            EXPECT_EQ(a, readFileBytes(full / name)) << name;
         }
-        EXPECT_NE(readAll(inc / "timing.json").find("\"full_recompute\": false"), std::string::npos);
-        EXPECT_NE(readAll(full / "timing.json").find("\"full_recompute\": true"), std::string::npos);
+        EXPECT_NE(readFileBytes(inc / "timing.json").find("\"full_recompute\": false"), std::string::npos);
+        EXPECT_NE(readFileBytes(full / "timing.json").find("\"full_recompute\": true"), std::string::npos);
     }
 }
 
@@ -241,9 +233,9 @@ TEST(Cli, FrameRangeStartingMidAnimationWritesTheSequentialBytes) {
     for (int f = 3; f <= 5; ++f)
         for (const char* ext : {".ply", ".exr", ".png"}) {
             const std::string name = "frame_000" + std::to_string(f) + ext;
-            const std::string a = readAll(dir / "all" / name);
+            const std::string a = readFileBytes(dir / "all" / name);
             ASSERT_GT(a.size(), 500u) << name;
-            EXPECT_EQ(a, readAll(dir / "late" / name)) << name;
+            EXPECT_EQ(a, readFileBytes(dir / "late" / name)) << name;
         }
     EXPECT_FALSE(fs::exists(dir / "late/frame_0002.ply"));
 }

@@ -20,12 +20,7 @@ RayCache trace(const Scene& scene, uint64_t photons) { return traceScene(scene, 
 
 std::vector<Vec3f> estimate(const Scene& scene, const RayCache& cache, EstimatorKind kind, DetpBoundary rule,
                             float radius, int k = 50) {
-    EstimatorSettings s;
-    s.kind = kind;
-    s.boundary = rule;
-    s.radius = radius;
-    s.k = k;
-    return estimateWith(scene, cache, s).irradiance;
+    return estimateWith(scene, cache, NamedEstimator{"", kind, rule}.settings(radius, k)).irradiance;
 }
 
 Vec3d worldPosition(const Scene& s, size_t v) { return Vec3d(s.positions[v]) + s.worldOrigin; }
@@ -37,19 +32,14 @@ double pointIrradiance(const Vec3d& light, const Vec3d& p, const Vec3d& n) {
     return std::max(0.0, dot(d, n)) / (len * len * len);
 }
 
-struct Named {
-    const char* name;
-    EstimatorKind kind;
-    DetpBoundary rule;
-};
-const Named kLeakFree[] = {{"DETP clip", EstimatorKind::Detp, DetpBoundary::Clip},
+const NamedEstimator kLeakFree[] = {{"DETP clip", EstimatorKind::Detp, DetpBoundary::Clip},
                            {"DETP linear", EstimatorKind::Detp, DetpBoundary::Linear},
                            {"photon map", EstimatorKind::PhotonMap, DetpBoundary::Clip},
                            {"impact count", EstimatorKind::ImpactCount, DetpBoundary::Clip}};
 
 // Every leak-free estimator gives exactly zero at `dark`; returns the paper rule's mean there.
 double expectNoLightAt(const Scene& scene, const RayCache& cache, const std::vector<size_t>& dark, float r) {
-    for (const Named& e : kLeakFree) {
+    for (const NamedEstimator& e : kLeakFree) {
         const auto E = estimate(scene, cache, e.kind, e.rule, r);
         size_t lit = 0;
         for (size_t v : dark) lit += E[v] != Vec3f(0.0f);
@@ -134,7 +124,7 @@ TEST(DetpBoundary, CeilingAboveALightPanelSeesOnlyTheGap) {
         return m;
     };
     const double reference = regionMean(estimate(scene, cache, EstimatorKind::ImpactCount, DetpBoundary::Clip, r));
-    for (const Named& e : kLeakFree) {
+    for (const NamedEstimator& e : kLeakFree) {
         if (e.kind == EstimatorKind::ImpactCount) continue;
         const double m = regionMean(estimate(scene, cache, e.kind, e.rule, r));
         std::printf("ceiling above the panel: %s %.4f, impact count %.4f (relative σ %.3f)\n", e.name, m, reference, relativeSigma);
@@ -346,7 +336,7 @@ TEST(DetpBoundary, CreaseVerticesFallBackAndLeaveTheirNeighboursAlone) {
     }
     EXPECT_EQ(fallbacks, size_t(cells - 1)) << "every crease vertex but the two ends";
     EXPECT_EQ(regions.fallbackVertices(), fallbacks);
-    for (const Named& e : kLeakFree) {
+    for (const NamedEstimator& e : kLeakFree) {
         if (e.kind == EstimatorKind::ImpactCount) continue;
         const auto Ew = estimate(welded, cw, e.kind, e.rule, r), Es = estimate(split, cs, e.kind, e.rule, r);
         size_t compared = 0;
@@ -390,7 +380,7 @@ TEST(DetpBoundary, OutsideOfASphereIsUnbiasedWithinOnePercent) {
     const Vec3d light(0, 2.5, 0);
     testscenes::addPointLight(scene, Vec3f(light), Vec3f(1.0f));
     const RayCache cache = trace(scene, 4000000);
-    for (const Named& e : kLeakFree) {
+    for (const NamedEstimator& e : kLeakFree) {
         if (e.kind == EstimatorKind::ImpactCount) continue;
         const auto E = estimate(scene, cache, e.kind, e.rule, e.kind == EstimatorKind::PhotonMap ? 0.2f : 0.05f);
         double bias = 0;

@@ -19,24 +19,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Rule {
-    const char* name;
-    EstimatorKind kind;
-    DetpBoundary boundary;
-};
-const Rule kRules[] = {{"impact count", EstimatorKind::ImpactCount, DetpBoundary::Clip},
+const NamedEstimator kRules[] = {{"impact count", EstimatorKind::ImpactCount, DetpBoundary::Clip},
                        {"photon map", EstimatorKind::PhotonMap, DetpBoundary::Clip},
                        {"DETP clip", EstimatorKind::Detp, DetpBoundary::Clip},
                        {"DETP linear", EstimatorKind::Detp, DetpBoundary::Linear},
                        {"DETP paper", EstimatorKind::Detp, DetpBoundary::Paper}};
-
-EstimatorSettings settingsFor(const Rule& rule, float radius) {
-    EstimatorSettings s;
-    s.kind = rule.kind;
-    s.boundary = rule.boundary;
-    s.radius = radius;
-    return s;
-}
 
 // Every irradiance and radiosity component finite and non-negative.
 void expectFiniteAndNonNegative(const VertexRadiosity& r, const std::string& what) {
@@ -86,11 +73,11 @@ TEST(NumericalExtremes, SceneScaledByAThousandthOrAThousandGivesTheSameIrradianc
     constexpr uint64_t kPhotons = 40000;
     std::vector<RayCache> caches;
     for (const Scene& s : scenes) caches.push_back(traceScene(s, kPhotons, 5));
-    for (const Rule& rule : kRules) {
+    for (const NamedEstimator& rule : kRules) {
         SCOPED_TRACE(rule.name);
         std::vector<VertexRadiosity> results;
         for (size_t i = 0; i < scenes.size(); ++i) {
-            results.push_back(estimateWith(scenes[i], caches[i], settingsFor(rule, defaultRadius(scenes[i]))));
+            results.push_back(estimateWith(scenes[i], caches[i], rule.settings(defaultRadius(scenes[i]))));
             expectFiniteAndNonNegative(results.back(), rule.name);
         }
         const double reference = totalLuminance(results[0].irradiance);
@@ -116,8 +103,8 @@ TEST(NumericalExtremes, GrazingDirectionalLightGivesFiniteIrradiance) {
         sun.intensity = Vec3f(100.0f);
         scene.lights.push_back(sun);
         const RayCache cache = traceScene(scene, 20000, 3);
-        for (const Rule& rule : kRules) {
-            const VertexRadiosity r = estimateWith(scene, cache, settingsFor(rule, defaultRadius(scene)));
+        for (const NamedEstimator& rule : kRules) {
+            const VertexRadiosity r = estimateWith(scene, cache, rule.settings(defaultRadius(scene)));
             expectFiniteAndNonNegative(r, rule.name);
             if (elevation == 0.0) {
                 EXPECT_EQ(totalLuminance(r.irradiance), 0.0) << rule.name;
@@ -144,9 +131,9 @@ TEST(NumericalExtremes, CoplanarOverlappingTrianglesShareTheLightWithoutLosingOr
     const size_t n = single.vertexCount();
     ASSERT_EQ(doubled.vertexCount(), 2 * n);
     const RayCache a = traceScene(single, 30000, 9), b = traceScene(doubled, 30000, 9);
-    const Rule impactCount = kRules[0];
-    const VertexRadiosity one = estimateWith(single, a, settingsFor(impactCount, 0.05f));
-    const VertexRadiosity two = estimateWith(doubled, b, settingsFor(impactCount, 0.05f));
+    const NamedEstimator impactCount = kRules[0];
+    const VertexRadiosity one = estimateWith(single, a, impactCount.settings(0.05f));
+    const VertexRadiosity two = estimateWith(doubled, b, impactCount.settings(0.05f));
     expectFiniteAndNonNegative(two, "doubled");
     double sumOne = 0, sumTwo = 0;
     for (size_t v = 0; v < n; ++v) {
@@ -155,7 +142,7 @@ TEST(NumericalExtremes, CoplanarOverlappingTrianglesShareTheLightWithoutLosingOr
     }
     // Albedo 0: one bounce, the same photons in both scenes, each counted on one copy.
     EXPECT_NEAR(sumTwo, sumOne, 1e-4 * sumOne);
-    for (const Rule& rule : kRules) expectFiniteAndNonNegative(estimateWith(doubled, b, settingsFor(rule, 0.05f)), rule.name);
+    for (const NamedEstimator& rule : kRules) expectFiniteAndNonNegative(estimateWith(doubled, b, rule.settings(0.05f)), rule.name);
 }
 
 // A vertex no triangle uses, one photon, and radii from 10^-9 of the scene to twice its size.
@@ -175,10 +162,10 @@ TEST(NumericalExtremes, LoneVertexOnePhotonAndExtremeRadiiGiveFiniteIrradiance) 
     for (uint64_t photons : {uint64_t(1), uint64_t(3000)}) {
         const RayCache cache = traceScene(scene, photons, 2);
         for (float radius : {1e-9f * diagonal, 0.015f * diagonal, 2.0f * diagonal}) {
-            for (const Rule& rule : kRules) {
+            for (const NamedEstimator& rule : kRules) {
                 const std::string what = std::string(rule.name) + ", " + std::to_string(photons) + " photons, radius " +
                                          std::to_string(radius / diagonal) + " of the diagonal";
-                const VertexRadiosity r = estimateWith(scene, cache, settingsFor(rule, radius));
+                const VertexRadiosity r = estimateWith(scene, cache, rule.settings(radius));
                 expectFiniteAndNonNegative(r, what);
                 if (rule.kind == EstimatorKind::ImpactCount) {
                     EXPECT_EQ(luminance(r.irradiance[lone]), 0.0f) << what;

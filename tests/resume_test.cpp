@@ -7,23 +7,14 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <random>
 #include <set>
-#include <sstream>
 
 #include "test_support.h"
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string readAll(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 // 30 frames of data/cornell with PLY, EXR and PNG: about 1.5 s on 2 cores.
 std::string renderArguments() {
@@ -48,7 +39,7 @@ SignalledRun runAndSignal(const std::string& arguments, const char* signal, doub
                                 waitForStart + "sleep " + std::to_string(seconds) + "; kill -" + signal +
                                 " $pid 2>/dev/null; wait $pid; echo $? > " + rc.string();
     EXPECT_EQ(std::system(command.c_str()), 0);
-    return {std::stoi(readAll(rc)), readAll(log)};
+    return {std::stoi(readFileBytes(rc)), readFileBytes(log)};
 }
 
 std::set<std::string> frameFiles(const fs::path& dir) {
@@ -62,13 +53,13 @@ void expectSameFrameFiles(const fs::path& reference, const fs::path& resumed) {
     const std::set<std::string> names = frameFiles(reference);
     ASSERT_EQ(names.size(), 90u);
     EXPECT_EQ(frameFiles(resumed), names);
-    for (const std::string& name : names) EXPECT_EQ(readAll(reference / name), readAll(resumed / name)) << name;
+    for (const std::string& name : names) EXPECT_EQ(readFileBytes(reference / name), readFileBytes(resumed / name)) << name;
 }
 
 // The frames timing.json lists, in order.
 std::vector<int> loggedFrames(const fs::path& dir) {
     std::vector<int> frames;
-    const nlohmann::json log = nlohmann::json::parse(readAll(dir / "timing.json"));
+    const nlohmann::json log = nlohmann::json::parse(readFileBytes(dir / "timing.json"));
     for (const auto& f : log["frames"]) frames.push_back(f["frame"]);
     return frames;
 }
@@ -145,19 +136,19 @@ TEST(Resume, FolderFromOtherInputsIsRefusedAndLeftUntouched) {
     const fs::path cornell = sourceDir() / "data" / "cornell";
     const std::string scene = (cornell / "cornell.gltf").string() + " --animation " + (cornell / "animation.json").string();
     ASSERT_EQ(runQsgi("render " + scene + few + " --out " + out.string()).exitCode, 0);
-    const std::string before = readAll(out / "frame_0001.ply") + readAll(out / "timing.json");
+    const std::string before = readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json");
     for (const char* change : {" --seed 7", " --estimator photon-map", " --radius 0.02", " --spp 2", " --png"}) {
         SCOPED_TRACE(change);
         const CommandResult r = runQsgi("render " + scene + few + change + " --resume --out " + out.string());
         EXPECT_EQ(r.exitCode, 2) << r.output;
         EXPECT_NE(r.output.find("other inputs or settings"), std::string::npos) << r.output;
         EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
-        EXPECT_EQ(readAll(out / "frame_0001.ply") + readAll(out / "timing.json"), before);
+        EXPECT_EQ(readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json"), before);
     }
     // The same inputs with another update strategy: nothing left to do, nothing rewritten.
     const CommandResult same = runQsgi("render " + scene + few + " --full-recompute --resume --out " + out.string());
     EXPECT_EQ(same.exitCode, 0) << same.output;
-    EXPECT_EQ(readAll(out / "frame_0001.ply") + readAll(out / "timing.json"), before);
+    EXPECT_EQ(readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json"), before);
     // Frame files without a log are not ours to continue.
     fs::remove(out / "timing.json");
     const CommandResult orphan = runQsgi("render " + scene + few + " --resume --out " + out.string());

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <sstream>
 
 #include "trace/photon_tracer.h"
 
@@ -34,6 +35,22 @@ CommandResult runQsgi(const std::string& arguments) {
     const int status = pclose(pipe);
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return r;
+}
+
+std::string readFileBytes(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
+
+EstimatorSettings NamedEstimator::settings(float radius, int k) const {
+    EstimatorSettings s;
+    s.kind = kind;
+    s.boundary = rule;
+    s.radius = radius;
+    s.k = k;
+    return s;
 }
 
 RayCache traceScene(const Scene& scene, uint64_t photons, uint64_t seed) {

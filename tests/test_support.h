@@ -17,6 +17,15 @@ struct CommandResult {
     std::string output;  // stdout and stderr together
 };
 CommandResult runQsgi(const std::string& arguments);
+std::string readFileBytes(const std::filesystem::path& path);  // "" if unreadable
+
+// An estimator and its boundary rule, named for test messages.
+struct NamedEstimator {
+    const char* name;
+    qsgi::EstimatorKind kind;
+    qsgi::DetpBoundary rule;
+    qsgi::EstimatorSettings settings(float radius, int k = 50) const;
+};
 
 // Every photon of the scene traced once (max 32 bounces), as a render's first frame does.
 qsgi::RayCache traceScene(const qsgi::Scene& scene, uint64_t photons, uint64_t seed);

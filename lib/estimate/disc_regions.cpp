@@ -61,43 +61,7 @@ bool pointReachable(Reach reach, const VertexDisc& disc, const Vec3f& centre, co
 
 namespace {
 
-// The cells of v's disc that light can reach from `start` (DESIGN §5).
-VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
-                    const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage, const OwnSurface& own);
-
-VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
-                             const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
-                             OwnSurfaceScratch& scratch) {
-    VertexDisc disc;
-    const Vec3f& normal = scene.normals[v];
-    discFrame(normal, disc.tangent, disc.bitangent);
-    const OwnSurface own = findOwnSurface(v, scene, topology, frontNormals, radius, scratch);
-    if (own.empty) {
-        disc.fallback = true;
-        return disc;
-    }
-    disc.epsAbove = own.epsAbove;
-    disc.epsBelow = own.epsBelow;
-    // Double precision for the points, so the float rays start exactly where the rule says.
-    const double sideStep = std::min(1e-3 * double(radius), double(scene.sceneEpsilon()));
-    const Vec3d lifted = Vec3d(scene.positions[v]) + Vec3d(normal) * double(own.epsAbove);
-    VertexDisc best = discFrom(Vec3f(lifted + Vec3d(own.towardSurface) * sideStep), disc, v, scene, bvh, frontNormals,
-                               radius, withCoverage, own);
-    if (best.reachableArea > 0) return best;
-    // Nothing reachable from the start point: either v is buried, or the start lies exactly on a
-    // surface through v (a floor vertex at the foot of a wall, where the own surface runs on under
-    // the wall and gives no side to step to), and which side of it float rounding puts the start
-    // on decides everything — the answer would change with the scene's unit. Light reaching v
-    // comes from the open side, so try a step to each side and keep the one that sees most.
-    const Vec3d sides[4] = {Vec3d(disc.tangent), -Vec3d(disc.tangent), Vec3d(disc.bitangent), -Vec3d(disc.bitangent)};
-    for (const Vec3d& side : sides) {
-        VertexDisc candidate = discFrom(Vec3f(lifted + side * sideStep), disc, v, scene, bvh, frontNormals, radius,
-                                        withCoverage, own);
-        if (candidate.reachableArea > best.reachableArea) best = std::move(candidate);
-    }
-    return best;
-}
-
+// The cells of v's disc that light can reach from `startPoint` (DESIGN §5).
 VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
                     const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage, const OwnSurface& own) {
     const Vec3f& normal = scene.normals[v];
@@ -149,6 +113,39 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
     }
     disc.reachableArea = float(share / kDiscCells);
     return disc;
+}
+
+VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
+                             const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
+                             OwnSurfaceScratch& scratch) {
+    VertexDisc disc;
+    const Vec3f& normal = scene.normals[v];
+    discFrame(normal, disc.tangent, disc.bitangent);
+    const OwnSurface own = findOwnSurface(v, scene, topology, frontNormals, radius, scratch);
+    if (own.empty) {
+        disc.fallback = true;
+        return disc;
+    }
+    disc.epsAbove = own.epsAbove;
+    disc.epsBelow = own.epsBelow;
+    // Double precision for the points, so the float rays start exactly where the rule says.
+    const double sideStep = std::min(1e-3 * double(radius), double(scene.sceneEpsilon()));
+    const Vec3d lifted = Vec3d(scene.positions[v]) + Vec3d(normal) * double(own.epsAbove);
+    VertexDisc best = discFrom(Vec3f(lifted + Vec3d(own.towardSurface) * sideStep), disc, v, scene, bvh, frontNormals,
+                               radius, withCoverage, own);
+    if (best.reachableArea > 0) return best;
+    // Nothing reachable from the start point: either v is buried, or the start lies exactly on a
+    // surface through v (a floor vertex at the foot of a wall, where the own surface runs on under
+    // the wall and gives no side to step to), and which side of it float rounding puts the start
+    // on decides everything — the answer would change with the scene's unit. Light reaching v
+    // comes from the open side, so try a step to each side and keep the one that sees most.
+    const Vec3d sides[4] = {Vec3d(disc.tangent), -Vec3d(disc.tangent), Vec3d(disc.bitangent), -Vec3d(disc.bitangent)};
+    for (const Vec3d& side : sides) {
+        VertexDisc candidate = discFrom(Vec3f(lifted + side * sideStep), disc, v, scene, bvh, frontNormals, radius,
+                                        withCoverage, own);
+        if (candidate.reachableArea > best.reachableArea) best = std::move(candidate);
+    }
+    return best;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <climits>
 #include <iterator>
 #include <optional>
+#include <set>
 #include <stdexcept>
 
 #include "estimate/estimator.h"
@@ -174,11 +175,10 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     // same inputs has not completed. Its entries for earlier frames stay in the log.
     std::vector<FrameTiming> earlierFrames;
     if (settings_.resume) earlierFrames = framesToKeep(outDir, fingerprint_, frameFilesExist);
+    std::set<int> done;
+    for (const FrameTiming& f : earlierFrames) done.insert(f.frame);
     int start = first_;
-    auto done = [&](int frame) {
-        return std::any_of(earlierFrames.begin(), earlierFrames.end(), [&](const FrameTiming& f) { return f.frame == frame; });
-    };
-    while (start <= last_ && done(start)) ++start;
+    while (start <= last_ && done.count(start)) ++start;
     RunOutcome outcome;
 
     TimingLog log;

@@ -113,6 +113,11 @@ std::set<int> replaceAbsentBuffers(json& doc, bool binary) {
     return absent;
 }
 
+// GLB lengths are 32-bit, and tinygltf takes sizes as unsigned int.
+void refuseBeyondGltfSize(const std::string& path, uint64_t size) {
+    if (size >= (uint64_t(1) << 32)) throw InputError(path, "", "is 4 GiB or larger; glTF files are limited to 2^32 bytes");
+}
+
 std::string readBytes(const std::string& path) {
     std::error_code ec;
     if (!fs::exists(path, ec)) throw InputError(path, "", "no such file");
@@ -120,7 +125,7 @@ std::string readBytes(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, "", "cannot be opened for reading");
     const auto size = fs::file_size(path, ec);
-    if (ec || size >= (uint64_t(1) << 32)) throw InputError(path, "", "is 4 GiB or larger; glTF files are limited to 2^32 bytes");
+    if (!ec) refuseBeyondGltfSize(path, size);  // before reading it
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
@@ -137,7 +142,7 @@ GltfDocument readGltfDocument(const std::string& path, Warnings& warnings) {
 
 GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const std::string& baseDir,
                                Warnings& warnings) {
-    if (bytes.size() >= (uint64_t(1) << 32)) throw InputError(path, "", "is 4 GiB or larger; glTF files are limited to 2^32 bytes");
+    refuseBeyondGltfSize(path, bytes.size());
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     GlbLayout glb;
     if (binary) glb = readGlbLayout(path, bytes);
