@@ -34,7 +34,7 @@ SignalledRun runAndSignal(const std::string& arguments, const char* signal, doub
                           const fs::path& afterStart = {}) {
     const fs::path log = scratch / "signalled.log", rc = scratch / "signalled.rc";
     const std::string waitForStart =
-        afterStart.empty() ? "" : "for i in $(seq 600); do [ -e " + afterStart.string() + " ] && break; sleep 0.05; done; ";
+        afterStart.empty() ? "" : "for i in $(seq 3000); do [ -e " + afterStart.string() + " ] && break; sleep 0.01; done; ";
     const std::string command = std::string(QSGI_CLI) + " " + arguments + " 2>" + log.string() + " & pid=$!; " +
                                 waitForStart + "sleep " + std::to_string(seconds) + "; kill -" + signal +
                                 " $pid 2>/dev/null; wait $pid; echo $? > " + rc.string();
@@ -78,14 +78,23 @@ TEST(Resume, RunKilledAtRandomMomentsResumesToTheBytesOfAnUninterruptedRun) {
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const double duration = secondsSince(start);
 
+    // The kill moment is drawn inside the frames, not inside the launch: wait until a random frame
+    // (0..24) is on disk, then up to one more frame's time. Timing from launch alone missed every
+    // run on a machine whose first (reference) run was slowed by a cold start.
     std::mt19937 random{std::random_device{}()};
-    std::uniform_real_distribution<double> moment(0.05, 0.95);
+    std::uniform_int_distribution<int> frameOnDisk(0, 24);
+    std::uniform_real_distribution<double> withinFrame(0.0, 1.0);
+    const double frameSeconds = duration / 30;
     int interrupted = 0;
     for (int attempt = 0; attempt < 4; ++attempt) {
-        const double seconds = moment(random) * duration;
-        SCOPED_TRACE("SIGKILL after " + std::to_string(seconds) + " s of a " + std::to_string(duration) + " s run");
+        const int frame = frameOnDisk(random);
+        const double seconds = withinFrame(random) * frameSeconds;
+        SCOPED_TRACE("SIGKILL " + std::to_string(seconds) + " s after frame " + std::to_string(frame) + " was written");
         const fs::path out = dir / ("killed" + std::to_string(attempt));
-        const SignalledRun killed = runAndSignal(renderArguments() + " --out " + out.string(), "9", seconds, dir);
+        char written[32];
+        std::snprintf(written, sizeof written, "frame_%04d.ply", frame);
+        const SignalledRun killed =
+            runAndSignal(renderArguments() + " --out " + out.string(), "9", seconds, dir, out / written);
         if (killed.exitCode != 0) ++interrupted;
         // What a kill leaves: timing.json lists only frames whose every file is complete.
         if (fs::exists(out / "timing.json"))
@@ -113,9 +122,10 @@ TEST(Resume, SigintAndSigtermStopAfterTheCurrentFrameWithAConsistentFolder) {
     for (const char* signal : {"INT", "TERM"}) {
         SCOPED_TRACE(signal);
         const fs::path out = dir / signal;
-        // timing.json appears once the handlers are in place and before frame 0 is computed.
+        // Signalled just after frame 1 is on disk, well before the last of 30 frames, so the stop
+        // lands inside the run on any machine speed.
         const SignalledRun stopped =
-            runAndSignal(renderArguments() + " --out " + out.string(), signal, 0.3, dir, out / "timing.json");
+            runAndSignal(renderArguments() + " --out " + out.string(), signal, 0.0, dir, out / "frame_0001.ply");
         ASSERT_EQ(stopped.exitCode, std::string(signal) == "INT" ? 130 : 143) << stopped.output;
         EXPECT_NE(stopped.output.find("--resume"), std::string::npos) << stopped.output;
         EXPECT_NE(stopped.output.find(std::string("SIG") + signal), std::string::npos) << stopped.output;
