@@ -16,6 +16,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   clang libclang-rt-14-dev    # libFuzzer (scripts/fuzz.sh)
+  python3-numpy python3-matplotlib   # scripts/sweep.py: error figures and plots
 )
 
 missing=()

@@ -35,6 +35,31 @@ TEST(Accuracy, BorderVerticesAreThoseNearTheCrease) {
     }
 }
 
+// Near-edge vertices are those whose exact distance to an open edge is within the radius, at any
+// radius: from 1e-6 of the plane (where sampling edges every radius/8 once made 10^8 samples and
+// took minutes) to larger than the whole plane.
+TEST(Accuracy, NearEdgeRegionsEqualExactDistancesAtEveryRadius) {
+    const Scene plane = testscenes::plane(1.0f, 10, Vec3f(0.5f));  // 2 m square, 0.2 m spacing, open border
+    Bounds3f bounds;
+    for (const Vec3f& p : plane.positions) bounds.extend(p);
+    const int flat = bounds.upper.y - bounds.lower.y < 1e-6f ? 1 : bounds.upper.z - bounds.lower.z < 1e-6f ? 2 : 0;
+    for (float radius : {2e-6f, 0.25f, 0.5f, 0.9f, 10.0f}) {
+        SCOPED_TRACE("radius " + std::to_string(radius));
+        const std::vector<EdgeRegion> region = edgeRegions(plane.positions, plane.normals, plane.triangles, radius);
+        for (size_t v = 0; v < plane.vertexCount(); ++v) {
+            float toBorder = 1e30f;
+            for (int axis = 0; axis < 3; ++axis)
+                if (axis != flat)
+                    toBorder = std::min({toBorder, plane.positions[v][axis] - bounds.lower[axis],
+                                         bounds.upper[axis] - plane.positions[v][axis]});
+            const EdgeRegion expected = toBorder < 1e-5f           ? EdgeRegion::OnEdge
+                                        : toBorder <= radius + 1e-5f ? EdgeRegion::NearEdge
+                                                                     : EdgeRegion::Interior;
+            EXPECT_EQ(int(region[v]), int(expected)) << "vertex " << v << " at " << toBorder << " m from the border";
+        }
+    }
+}
+
 TEST(Accuracy, CompareCommandReadsPlysAndRejectsMismatches) {
     const fs::path dir = testScratchDir("compare");
     Scene scene = testscenes::plane(1.0f, 10, Vec3f(0.5f));

@@ -63,30 +63,61 @@ std::vector<EdgeRegion> edgeRegions(const std::vector<Vec3f>& positions, const s
             users[std::minmax(a, b)].push_back(t);
         }
     std::vector<uint8_t> onEdge(positions.size(), 0);
-    std::vector<Vec3f> edgeSamples;
+    std::vector<std::pair<Vec3f, Vec3f>> edges;
+    double edgeLength = 0;
     for (const auto& [edge, tris] : users) {
         bool isEdge = tris.size() != 2;
         // A crease turns by more than the own surface's 45° limit.
         if (!isEdge) isEdge = dot(front(tris[0]), front(tris[1])) < kOwnSurfaceCos;
         if (!isEdge) continue;
         onEdge[edge.first] = onEdge[edge.second] = 1;
-        // Points along the segment every radius/8: distances to it are then exact to radius/16.
-        const Vec3f a = positions[edge.first], b = positions[edge.second];
-        const int steps = std::max(1, int(std::ceil(length(b - a) / (radius / 8))));
-        for (int i = 0; i <= steps; ++i) edgeSamples.push_back(a + (b - a) * (float(i) / float(steps)));
+        edges.emplace_back(positions[edge.first], positions[edge.second]);
+        edgeLength += length(edges.back().second - edges.back().first);
     }
+    // Edges cut into pieces no longer than `piece`, indexed by their midpoints; a vertex is near an
+    // edge when its exact distance to a piece is within the radius, and only pieces whose midpoint
+    // lies within radius + piece/2 can be. The piece is at least the radius (few candidates per
+    // vertex) and at least 2^-16 of all edges' length, so a radius of 1e-6 of the scene cannot
+    // make hundreds of millions of pieces.
+    const float piece = std::max(radius, float(edgeLength / double(1 << 16)));
+    std::vector<std::pair<Vec3f, Vec3f>> pieces;
+    std::vector<Vec3f> midpoints;
+    for (const auto& [a, b] : edges) {
+        const int count = piece > 0 ? std::max(1, int(std::ceil(length(b - a) / piece))) : 1;
+        for (int i = 0; i < count; ++i) {
+            const Vec3f p0 = a + (b - a) * (float(i) / float(count)), p1 = a + (b - a) * (float(i + 1) / float(count));
+            pieces.emplace_back(p0, p1);
+            midpoints.push_back((p0 + p1) * 0.5f);
+        }
+    }
+    auto distanceSquaredToPiece = [&](const Vec3f& p, size_t i) {
+        const auto& [a, b] = pieces[i];
+        const Vec3f ab = b - a;
+        const float t = std::clamp(dot(p - a, ab) / std::max(dot(ab, ab), 1e-30f), 0.0f, 1.0f);
+        const Vec3f d = p - (a + ab * t);
+        return dot(d, d);
+    };
     std::vector<EdgeRegion> region(positions.size(), EdgeRegion::Interior);
-    const PointIndex index(edgeSamples);
+    const PointIndex index(midpoints);
     std::vector<size_t> found;
     std::vector<float> d2;
+    const float reach = radius + 0.5f * piece;
     for (size_t v = 0; v < positions.size(); ++v) {
         if (onEdge[topology.weldedId(uint32_t(v))]) {
             region[v] = EdgeRegion::OnEdge;
             continue;
         }
-        if (!(radius > 0) || edgeSamples.empty()) continue;
+        if (!(radius > 0) || pieces.empty()) continue;
+        // The nearest midpoint settles most vertices at once (a piece is never farther than its
+        // midpoint); the others are decided by every piece that could reach.
         index.nearest(positions[v], 1, found, d2);
-        if (!found.empty() && d2[0] <= radius * radius) region[v] = EdgeRegion::NearEdge;
+        bool near = distanceSquaredToPiece(positions[v], found[0]) <= radius * radius;
+        if (!near) {
+            index.withinRadius(positions[v], reach * reach, found, d2);
+            for (size_t i : found)
+                if ((near = distanceSquaredToPiece(positions[v], i) <= radius * radius)) break;
+        }
+        if (near) region[v] = EdgeRegion::NearEdge;
     }
     return region;
 }

@@ -36,7 +36,7 @@ void TimingLog::write(const std::filesystem::path& path) const {
                    {"seed", seed}, {"threads", threads}, {"inputs_fingerprint", inputsFingerprint}};
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
-                  {"degenerate_triangles", degenerateTriangles}};
+                  {"degenerate_triangles", degenerateTriangles}, {"animation_diagonal", animationDiagonal}};
     std::vector<double> updates, estimates;
     for (size_t i = 1; i < frames.size(); ++i) {
         updates.push_back(frames[i].photonSimulationSeconds);

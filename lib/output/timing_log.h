@@ -81,6 +81,7 @@ struct TimingLog {
     std::string scene;
     uint64_t vertices = 0, triangles = 0, dynamicVertices = 0, lights = 0;
     uint64_t degenerateTriangles = 0;
+    double animationDiagonal = 0;  // the diagonal of the whole animation's bounds (default radius = 1.5 % of it)
     // runFingerprint of the inputs and settings; --resume continues only a folder whose log has it.
     std::string inputsFingerprint;
 

@@ -201,6 +201,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     log.triangles = scene_.triangleCount();
     for (uint8_t d : scene_.vertexDynamic) log.dynamicVertices += d;
     log.lights = scene_.lights.size();
+    log.animationDiagonal = scene_.animationBounds.extent();
     log.inputsFingerprint = fingerprint_;
     for (const FrameTiming& f : earlierFrames)
         if (f.frame < start || f.frame > last_) log.frames.push_back(f);

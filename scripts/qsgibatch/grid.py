@@ -1,0 +1,226 @@
+"""The sweep config (configs/sweep-*.json) and the grid points it names.
+
+A point is one qsgi render: estimator, boundary rule, photons, radius (as a fraction of the
+animation's bounding-box diagonal, so one config fits any scale), k, update strategy and frames.
+Three families: `accuracy` (the grid the plots of the trade are drawn from), `full` (the same
+renders with --full-recompute at one radius: the second line style of the Pareto plot) and
+`extreme` (radius from 1e-6 of the diagonal to all of it, photons from 1 up: stability)."""
+import dataclasses
+import json
+import math
+import os
+
+ESTIMATORS = ("impact-count", "photon-map", "photon-map:paper", "detp:clip", "detp:linear", "detp:paper")
+DEFAULT_K = 50
+DEFAULT_RADIUS_FRACTION = 0.015  # qsgi's default radius (render_settings.cpp: defaultRadius)
+KNOWN_KEYS = {"scene", "animation", "reference", "frames", "seeds", "grid", "extremes", "quick",
+              "reference_build", "jobs"}
+GRID_KEYS = {"photons", "radius_fraction", "k", "estimators", "full_recompute_radius_fraction"}
+EXTREME_KEYS = {"radius_fraction", "radius_photons", "photons", "estimators"}
+REFERENCE_KEYS = {"photons", "seeds", "radius_fraction"}
+
+
+class ConfigError(Exception):
+    """A sweep config that cannot be run: the message names the file, the key and the problem."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Point:
+    family: str           # accuracy | full | extreme
+    estimator: str        # impact-count | photon-map | detp
+    boundary: str         # clip | linear | paper ("" for impact-count)
+    photons: int
+    radius_fraction: float  # of the animation's diagonal (0 for impact-count: it has no radius)
+    k: int                # photon map only (0 otherwise)
+    full_recompute: bool
+    frames: str           # "A:B"
+
+    @property
+    def label(self) -> str:
+        """Estimator and rule as users write them: `detp:clip`, `photon-map:paper`."""
+        if not self.boundary or self.estimator == "photon-map" and self.boundary == "clip":
+            return self.estimator
+        return f"{self.estimator}:{self.boundary}"
+
+    @property
+    def name(self) -> str:
+        """A folder name that spells the parameters (resumption finds a point's results by it)."""
+        parts = [self.label.replace(":", "-"), f"n{self.photons}"]
+        if self.radius_fraction:
+            parts.append(f"r{self.radius_fraction:g}")
+        if self.k:
+            parts.append(f"k{self.k}")
+        parts.append("f" + self.frames.replace(":", "-"))
+        if self.full_recompute:
+            parts.append("full")
+        return "_".join(parts)
+
+    def qsgi_options(self, diagonal: float) -> list:
+        options = ["--estimator", self.estimator, "--photons", str(self.photons), "--frames", self.frames]
+        if self.boundary:
+            options += ["--detp-boundary", self.boundary]
+        if self.radius_fraction:
+            options += ["--radius", repr(self.radius_fraction * diagonal)]
+        if self.k:
+            options += ["--k", str(self.k)]
+        if self.full_recompute:
+            options.append("--full-recompute")
+        return options
+
+
+@dataclasses.dataclass
+class SweepConfig:
+    path: str
+    scene: str
+    animation: str
+    reference: str          # a committed reference PLY (frame 0), or "" to build one
+    frames: str
+    seeds: tuple            # (the rendered seed, the second seed for the noise figure)
+    reference_build: dict   # photons, seeds, radius_fraction of the built reference
+    points: list
+    jobs: int
+
+
+def _fail(path, where, problem):
+    raise ConfigError(f"{path}: {where}: {problem}")
+
+
+def _check_keys(path, where, table, known):
+    if not isinstance(table, dict):
+        _fail(path, where, "must be an object")
+    for key in table:
+        if key not in known and not key.startswith("_"):
+            _fail(path, where or key, f"unknown key '{key}' (known: {', '.join(sorted(known))})")
+
+
+def _count(path, where, value, low=1, high=2 ** 32):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != math.floor(value) \
+            or not low <= value <= high:
+        _fail(path, where, f"must be an integer in {low}..{high}, not {json.dumps(value)}")
+    return int(value)
+
+
+def _fraction(path, where, value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value <= 1:
+        _fail(path, where, f"must be a fraction of the scene diagonal in (0, 1], not {json.dumps(value)}")
+    return float(value)
+
+
+def _list(path, where, value, item):
+    if not isinstance(value, list) or not value:
+        _fail(path, where, "must be a non-empty list")
+    return [item(path, f"{where}[{i}]", v) for i, v in enumerate(value)]
+
+
+def _estimator(path, where, value):
+    if value not in ESTIMATORS:
+        _fail(path, where, f"unknown estimator {json.dumps(value)} (known: {', '.join(ESTIMATORS)})")
+    name, _, rule = value.partition(":")
+    return name, ("" if name == "impact-count" else rule or "clip")
+
+
+def _frames(path, where, value):
+    try:
+        a, b = (int(x) for x in str(value).split(":"))
+    except ValueError:
+        _fail(path, where, f"must be \"A:B\", not {json.dumps(value)}")
+    if not 0 <= a <= b:
+        _fail(path, where, f"must be \"A:B\" with 0 <= A <= B, not {json.dumps(value)}")
+    return f"{a}:{b}"
+
+
+def _merge(base: dict, override: dict) -> dict:
+    merged = dict(base)
+    for key, value in override.items():
+        merged[key] = _merge(base.get(key, {}), value) if isinstance(value, dict) else value
+    return merged
+
+
+def _grid_points(path, grid, frames):
+    _check_keys(path, "grid", grid, GRID_KEYS)
+    photons = _list(path, "grid.photons", grid.get("photons"), _count)
+    radii = _list(path, "grid.radius_fraction", grid.get("radius_fraction"), _fraction)
+    ks = _list(path, "grid.k", grid.get("k", [DEFAULT_K]), lambda p, w, v: _count(p, w, v, 1, 2 ** 24))
+    estimators = _list(path, "grid.estimators", grid.get("estimators"), _estimator)
+    full_radius = _fraction(path, "grid.full_recompute_radius_fraction",
+                            grid.get("full_recompute_radius_fraction", DEFAULT_RADIUS_FRACTION))
+    points = []
+    for name, rule in estimators:
+        for n in photons:
+            if name == "impact-count":
+                points.append(Point("accuracy", name, rule, n, 0.0, 0, False, frames))
+                points.append(Point("full", name, rule, n, 0.0, 0, True, frames))
+                continue
+            for r in radii:
+                for k in (ks if name == "photon-map" else [0]):
+                    points.append(Point("accuracy", name, rule, n, r, k, False, frames))
+            k = DEFAULT_K if name == "photon-map" else 0
+            points.append(Point("full", name, rule, n, full_radius, k, True, frames))
+    return points
+
+
+def _extreme_points(path, extremes):
+    _check_keys(path, "extremes", extremes, EXTREME_KEYS)
+    radii = _list(path, "extremes.radius_fraction", extremes.get("radius_fraction"), _fraction)
+    radius_photons = _count(path, "extremes.radius_photons", extremes.get("radius_photons", 100000))
+    if radius_photons > 100000:
+        _fail(path, "extremes.radius_photons", "at most 1e5: a disc the size of the scene costs hours at 1e7")
+    photons = _list(path, "extremes.photons", extremes.get("photons"), _count)
+    estimators = _list(path, "extremes.estimators", extremes.get("estimators"), _estimator)
+    points = []
+    for name, rule in estimators:
+        k = DEFAULT_K if name == "photon-map" else 0
+        if name != "impact-count":
+            points += [Point("extreme", name, rule, radius_photons, r, k, False, "0:0") for r in radii]
+        points += [Point("extreme", name, rule, n, DEFAULT_RADIUS_FRACTION if name != "impact-count" else 0.0,
+                         k, False, "0:0") for n in photons]
+    return points
+
+
+def load(path: str, quick: bool) -> SweepConfig:
+    try:
+        with open(path) as f:
+            raw = json.load(f)
+    except OSError as e:
+        raise ConfigError(f"{path}: cannot read ({e.strerror})")
+    except json.JSONDecodeError as e:
+        raise ConfigError(f"{path}: line {e.lineno}: {e.msg}")
+    _check_keys(path, "", raw, KNOWN_KEYS)
+    if quick:
+        if "quick" not in raw:
+            _fail(path, "quick", "--quick needs a \"quick\" section (overrides of grid, extremes, frames)")
+        raw = _merge(raw, raw["quick"])
+    here = os.path.dirname(os.path.abspath(path))
+
+    def input_file(key, required):
+        if key not in raw:
+            if required:
+                _fail(path, key, "missing")
+            return ""
+        resolved = os.path.normpath(os.path.join(here, raw[key]))
+        if not os.path.isfile(resolved):
+            _fail(path, key, f"no such file: {resolved}")
+        return resolved
+
+    frames = _frames(path, "frames", raw.get("frames", "0:5"))
+    seeds = _list(path, "seeds", raw.get("seeds", [1, 2]), lambda p, w, v: _count(p, w, v, 0, 2 ** 63))
+    if len(seeds) != 2 or seeds[0] == seeds[1]:
+        _fail(path, "seeds", "must be two different seeds: the render's, and the second one for the noise figure")
+    reference_build = raw.get("reference_build", {})
+    _check_keys(path, "reference_build", reference_build, REFERENCE_KEYS)
+    grid = raw.get("grid") or _fail(path, "grid", "missing")
+    points = _grid_points(path, grid, frames)
+    if "extremes" in raw:
+        points += _extreme_points(path, raw["extremes"])
+    unique = list(dict.fromkeys(points))
+    smallest = min(p.radius_fraction for p in points if p.family == "accuracy" and p.radius_fraction) \
+        if any(p.radius_fraction for p in points if p.family == "accuracy") else DEFAULT_RADIUS_FRACTION
+    build = {"photons": _count(path, "reference_build.photons", reference_build.get("photons", 4000000)),
+             "seeds": _list(path, "reference_build.seeds", reference_build.get("seeds", [1001, 1002, 1003, 1004]),
+                            lambda p, w, v: _count(p, w, v, 0, 2 ** 63)),
+             "radius_fraction": _fraction(path, "reference_build.radius_fraction",
+                                          reference_build.get("radius_fraction", smallest))}
+    return SweepConfig(path=os.path.abspath(path), scene=input_file("scene", True),
+                       animation=input_file("animation", False), reference=input_file("reference", False),
+                       frames=frames, seeds=tuple(seeds), reference_build=build, points=unique,
+                       jobs=_count(path, "jobs", raw.get("jobs", 1), 1, 256))

@@ -1,0 +1,209 @@
+"""The sweep's plots, drawn from sweep.csv alone (so a merge job can draw them from rows that other
+machines computed). Every axis names its quantity and unit; errors are relative to the
+reference's mean radiosity at frame 0, times are per frame on this machine."""
+import math
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")  # headless: files only
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+ERROR_AXIS = "relative RMS error at frame 0"
+MIN_PHOTONS_FOR_SLOPE = 1e4  # below, the fixed cost per frame (regions, setup) hides the growth
+
+
+def _estimators(rows):
+    return list(dict.fromkeys(r["estimator"] for r in rows))
+
+
+def _finite(values):
+    return [v for v in values if not math.isnan(v)]
+
+
+def _save(figure, out, name, title_note):
+    figure.suptitle(title_note, fontsize=9)
+    figure.tight_layout()
+    path = os.path.join(out, name)
+    figure.savefig(path + ".tmp.png", dpi=110)
+    plt.close(figure)
+    os.replace(path + ".tmp.png", path)
+    return name
+
+
+def _colours(names):
+    cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    return {n: cycle[i % len(cycle)] for i, n in enumerate(names)}
+
+
+def error_vs_photons(rows, out, note):
+    accuracy = [r for r in rows if r["family"] == "accuracy"]
+    estimators = _estimators(accuracy)
+    figure, axes = plt.subplots(1, len(estimators), figsize=(4.2 * len(estimators), 3.8), squeeze=False, sharey=True)
+    for axis, name in zip(axes[0], estimators):
+        mine = [r for r in accuracy if r["estimator"] == name]
+        ks = sorted({r["k"] for r in mine if not math.isnan(r["k"])})
+        default_k = 50.0 if 50.0 in ks else (ks[0] if ks else math.nan)
+        curves = {}
+        for r in mine:
+            if not math.isnan(r["k"]) and r["k"] != default_k:
+                continue
+            curves.setdefault(r["radius_fraction"], []).append(r)
+        for fraction, points in sorted(curves.items()):
+            points.sort(key=lambda r: r["photons"])
+            label = f"r = {100 * fraction:g} % of diagonal" if fraction else "no radius"
+            axis.plot([r["photons"] for r in points], [r["rms_all"] for r in points], "o-", label=label, ms=3)
+        if len(ks) > 1:  # photon map: k at the middle radius, dashed
+            radii = sorted({r["radius_fraction"] for r in mine})
+            middle = radii[len(radii) // 2]
+            for k in ks:
+                if k == default_k:
+                    continue
+                points = sorted((r for r in mine if r["k"] == k and r["radius_fraction"] == middle),
+                                key=lambda r: r["photons"])
+                axis.plot([r["photons"] for r in points], [r["rms_all"] for r in points], "x--", ms=4,
+                          label=f"k = {k:g}, r = {100 * middle:g} %")
+        axis.set(xscale="log", yscale="log", title=name + (f" (k = {default_k:g})" if ks else ""),
+                 xlabel="photons per frame")
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend(fontsize=7)
+    axes[0][0].set_ylabel(ERROR_AXIS)
+    return _save(figure, out, "error_vs_photons.png", note)
+
+
+def _pareto_front(points):
+    """The points no other point beats in both time and error, by increasing time."""
+    front, best = [], math.inf
+    for r in sorted(points, key=lambda r: (r["median_frame_s"], r["rms_all"])):
+        if r["rms_all"] < best:
+            front.append(r)
+            best = r["rms_all"]
+    return front
+
+
+def pareto(rows, out, note):
+    timed = [r for r in rows if r["family"] in ("accuracy", "full") and not math.isnan(r["median_frame_s"])]
+    estimators = _estimators(timed)
+    colours = _colours(estimators)
+    figure, axis = plt.subplots(figsize=(7.5, 5))
+    for name in estimators:
+        incremental = [r for r in timed if r["estimator"] == name and r["family"] == "accuracy"]
+        full = [r for r in timed if r["estimator"] == name and r["family"] == "full"]
+        axis.scatter([r["median_frame_s"] for r in incremental], [r["rms_all"] for r in incremental], s=8,
+                     color=colours[name], alpha=0.35)
+        front = _pareto_front(incremental)
+        axis.plot([r["median_frame_s"] for r in front], [r["rms_all"] for r in front], "-", color=colours[name],
+                  label=f"{name}, incremental (front)")
+        full.sort(key=lambda r: r["median_frame_s"])
+        if full:
+            axis.plot([r["median_frame_s"] for r in full], [r["rms_all"] for r in full], "--", marker="s", ms=3,
+                      color=colours[name], label=f"{name}, --full-recompute")
+    axis.set(xscale="log", yscale="log", xlabel="median time per frame after the first (s)", ylabel=ERROR_AXIS,
+             title="The trade: error against time per frame (lower left is better)")
+    axis.grid(True, which="both", alpha=0.3)
+    axis.legend(fontsize=7)
+    return _save(figure, out, "pareto.png", note)
+
+
+def fitted_slope(photons, seconds):
+    """Least-squares slope of log(time) against log(photons) over the counts where it is growth
+    that shows, not the fixed cost; NaN with fewer than two such points."""
+    pairs = [(n, t) for n, t in zip(photons, seconds) if n >= MIN_PHOTONS_FOR_SLOPE and t > 0]
+    if len(pairs) < 2:
+        return math.nan
+    x, y = np.log10([p[0] for p in pairs]), np.log10([p[1] for p in pairs])
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def time_vs_photons(rows, out, note):
+    full_rows = [r for r in rows if r["family"] == "full"]
+    estimators = _estimators(full_rows)
+    colours = _colours(estimators)
+    figure, axis = plt.subplots(figsize=(7.5, 5))
+    slopes = {}
+    for name in estimators:
+        full = sorted((r for r in full_rows if r["estimator"] == name), key=lambda r: r["photons"])
+        fraction = full[0]["radius_fraction"] if full else math.nan
+        incremental = sorted((r for r in rows if r["family"] == "accuracy" and r["estimator"] == name and
+                              (r["radius_fraction"] == fraction or (math.isnan(fraction) or not fraction))
+                              and (math.isnan(r["k"]) or r["k"] == 50)), key=lambda r: r["photons"])
+        for points, style, kind in ((full, "--s", "full"), (incremental, "-o", "incremental")):
+            if not points:
+                continue
+            n, t = [r["photons"] for r in points], [r["median_frame_s"] for r in points]
+            slope = fitted_slope(n, t)
+            slopes[(name, kind)] = slope
+            axis.plot(n, t, style, ms=3, color=colours[name],
+                      label=f"{name}, {kind}: slope {slope:.2f}" if not math.isnan(slope) else f"{name}, {kind}")
+    axis.set(xscale="log", yscale="log", xlabel="photons per frame", ylabel="median time per frame (s)",
+             title=f"Frame time against photons (slope fitted from {MIN_PHOTONS_FOR_SLOPE:.0e} photons up)")
+    axis.grid(True, which="both", alpha=0.3)
+    axis.legend(fontsize=7)
+    return _save(figure, out, "time_vs_photons.png", note), slopes
+
+
+def bias_vs_radius(rows, out, note):
+    accuracy = [r for r in rows if r["family"] == "accuracy" and r["radius_fraction"]
+                and (math.isnan(r["k"]) or r["k"] == 50)]
+    if not accuracy:
+        return None
+    most = max(r["photons"] for r in accuracy)
+    estimators = _estimators(accuracy)
+    colours = _colours(estimators)
+    figure, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
+    for axis, region, title in ((axes[0], "near_edge", "within one radius of an edge"),
+                                (axes[1], "interior", "interior")):
+        for name in estimators:
+            points = sorted((r for r in accuracy if r["estimator"] == name and r["photons"] == most),
+                            key=lambda r: r["radius_fraction"])
+            axis.plot([100 * r["radius_fraction"] for r in points], [r[f"bias_{region}"] for r in points], "o-",
+                      ms=3, color=colours[name], label=name)
+        axis.axhline(0, color="black", lw=0.6)
+        axis.set(xscale="log", xlabel="radius (% of the scene diagonal)", title=f"{title}, {most:.0e} photons")
+        axis.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("relative bias at frame 0 (signed)")
+    axes[0].legend(fontsize=7)
+    return _save(figure, out, "bias_vs_radius.png", note)
+
+
+def extremes(rows, out, note):
+    extreme = [r for r in rows if r["family"] == "extreme"]
+    if not extreme:
+        return None
+    bad = int(sum(r["nan_count"] + r["inf_count"] for r in extreme))
+    estimators = _estimators(extreme)
+    colours = _colours(estimators)
+    figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    radius_photons = min((r["photons"] for r in extreme if r["radius_fraction"] != 0.015 and r["radius_fraction"]),
+                         default=math.nan)
+    for name in estimators:
+        mine = [r for r in extreme if r["estimator"] == name]
+        by_radius = sorted((r for r in mine if r["photons"] == radius_photons and r["radius_fraction"]),
+                           key=lambda r: r["radius_fraction"])
+        x = [r["radius_fraction"] for r in by_radius]
+        axes[0].plot(x, [r["noise"] for r in by_radius], "o-", ms=3, color=colours[name], label=f"{name}: noise")
+        axes[0].plot(x, [abs(r["bias_all"]) for r in by_radius], "s--", ms=3, color=colours[name],
+                     label=f"{name}: |bias|")
+        by_photons = sorted((r for r in mine if r["radius_fraction"] in (0.015, 0.0)), key=lambda r: r["photons"])
+        axes[1].plot([r["photons"] for r in by_photons], [r["rms_all"] for r in by_photons], "o-", ms=3,
+                     color=colours[name], label=f"{name}: RMS error")
+        axes[1].plot([r["photons"] for r in by_photons], [r["noise"] for r in by_photons], "x:", ms=4,
+                     color=colours[name], label=f"{name}: noise")
+    axes[0].set(xscale="log", yscale="log", xlabel="radius (fraction of the scene diagonal)",
+                ylabel="relative error at frame 0",
+                title=f"Radius extremes at {radius_photons:.0e} photons: noise grows as r shrinks, bias as r grows")
+    axes[1].set(xscale="log", yscale="log", xlabel="photons per frame", ylabel=ERROR_AXIS,
+                title="Photon extremes at the default radius (1.5 %)")
+    for axis in axes:
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend(fontsize=6)
+    return _save(figure, out, "extremes.png", f"{note}   NaN/Inf values in every PLY: {bad}")
+
+
+def draw_all(rows, out, note):
+    """Draws every plot the rows allow; returns (file names, fitted slopes)."""
+    names = [error_vs_photons(rows, out, note), pareto(rows, out, note)]
+    name, slopes = time_vs_photons(rows, out, note)
+    names += [name, bias_vs_radius(rows, out, note), extremes(rows, out, note)]
+    return [n for n in names if n], slopes

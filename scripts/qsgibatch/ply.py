@@ -1,0 +1,75 @@
+"""Reads and writes the vertex-radiosity PLY files qsgi writes (binary little-endian; DESIGN §7).
+
+Only what sweeps need: the vertex table as a numpy record array, and a copy of a file with other
+radiosity values (the averaged reference). The header and the face list are kept as bytes, so a
+written file differs from its template only in the radiosity columns."""
+import os
+
+import numpy as np
+
+_PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "<i2", "ushort": "<u2", "int": "<i4", "uint": "<u4",
+              "float": "<f4", "double": "<f8"}
+
+
+class VertexPly:
+    def __init__(self, header: bytes, vertices: np.ndarray, rest: bytes):
+        self.header, self.vertices, self.rest = header, vertices, rest
+
+    def radiosity(self) -> np.ndarray:
+        """(n, 3) float64 radiosity B in W/m²."""
+        v = self.vertices
+        return np.stack([v["radiosity_r"], v["radiosity_g"], v["radiosity_b"]], axis=1).astype(np.float64)
+
+
+def read(path) -> VertexPly:
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.find(b"end_header\n")
+    if not data.startswith(b"ply\n") or end < 0:
+        raise ValueError(f"{path}: not a PLY file")
+    header = data[:end + len(b"end_header\n")]
+    lines = header.decode("ascii").splitlines()
+    if "format binary_little_endian 1.0" not in lines:
+        raise ValueError(f"{path}: not a binary little-endian PLY")
+    fields, count, in_vertex = [], None, False
+    for line in lines:
+        words = line.split()
+        if words[:2] == ["element", "vertex"]:
+            count, in_vertex = int(words[2]), True
+        elif words[:1] == ["element"]:
+            in_vertex = False
+        elif in_vertex and words[:1] == ["property"]:
+            if words[1] == "list" or words[1] not in _PLY_TYPES:
+                raise ValueError(f"{path}: unsupported vertex property '{line}'")
+            fields.append((words[2], _PLY_TYPES[words[1]]))
+    if count is None or "radiosity_r" not in dict(fields):
+        raise ValueError(f"{path}: no vertex radiosity (not written by qsgi?)")
+    dtype = np.dtype(fields)
+    start = len(header)
+    if len(data) < start + count * dtype.itemsize:
+        raise ValueError(f"{path}: truncated vertex table")
+    vertices = np.frombuffer(data, dtype=dtype, count=count, offset=start).copy()
+    return VertexPly(header, vertices, data[start + count * dtype.itemsize:])
+
+
+def write_with_radiosity(path, template: VertexPly, radiosity: np.ndarray) -> None:
+    """Writes `template` with its radiosity replaced, atomically (temporary file, then rename)."""
+    vertices = template.vertices.copy()
+    for c, name in enumerate(("radiosity_r", "radiosity_g", "radiosity_b")):
+        vertices[name] = radiosity[:, c]
+    temporary = f"{path}.tmp"
+    with open(temporary, "wb") as f:
+        f.write(template.header)
+        f.write(vertices.tobytes())
+        f.write(template.rest)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(temporary, path)
+
+
+def count_non_finite(path) -> tuple:
+    """(NaN count, Inf count) over the radiosity and position columns of one PLY."""
+    v = read(path).vertices
+    columns = [v[name].astype(np.float64) for name in ("x", "y", "z", "radiosity_r", "radiosity_g", "radiosity_b")]
+    values = np.concatenate(columns)
+    return int(np.isnan(values).sum()), int(np.isinf(values).sum())

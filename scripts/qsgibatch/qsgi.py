@@ -1,0 +1,40 @@
+"""Running the qsgi executable: renders (always with --resume, so a killed render continues) and
+`qsgi compare`. A failure raises QsgiError with qsgi's own one-line message."""
+import json
+import os
+import subprocess
+
+
+class QsgiError(Exception):
+    pass
+
+
+class Qsgi:
+    def __init__(self, executable: str, scene: str, animation: str):
+        self.executable, self.scene, self.animation = executable, scene, animation
+
+    def render(self, out: str, options: list, seed: int, threads: int) -> dict:
+        """Renders into `out` (resuming what is there) and returns its timing.json. PLYs only: the
+        sweep judges vertex radiosity, and camera views would only add time."""
+        command = [self.executable, "render", self.scene, "--out", out, "--seed", str(seed),
+                   "--threads", str(threads), "--no-exr", "--quiet", "--resume"] + options
+        if self.animation:
+            command += ["--animation", self.animation]
+        done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if done.returncode != 0:
+            raise QsgiError(f"{' '.join(command)}\nexit {done.returncode}: {done.stdout.strip()}")
+        with open(os.path.join(out, "timing.json")) as f:
+            return json.load(f)
+
+    def compare(self, solution: str, reference: str, radius: float) -> dict:
+        command = [self.executable, "compare", solution, reference, "--radius", repr(radius), "--json"]
+        done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        if done.returncode != 0:
+            raise QsgiError(f"{' '.join(command)}\nexit {done.returncode}: {done.stderr.strip()}")
+        return json.loads(done.stdout)
+
+    def animation_diagonal(self, scratch: str) -> float:
+        """The diagonal of the whole animation's bounds, from a one-photon impact-count probe (the
+        radius grid is in fractions of it, as qsgi's default radius is)."""
+        timing = self.render(scratch, ["--estimator", "impact-count", "--photons", "1", "--frames", "0:0"], 1, 1)
+        return float(timing["scene"]["animation_diagonal"])

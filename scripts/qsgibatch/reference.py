@@ -1,0 +1,46 @@
+"""The reference a sweep's errors are measured against.
+
+Either the committed PLY the config names (an independent renderer's), or one built once and
+cached in OUT/reference/: the per-vertex mean of several seeds of DETP `linear` at the smallest
+radius of the accuracy grid, each at the photon count the config states (reference_build). The
+recipe is written beside it (reference.json) and into every CSV row."""
+import json
+import os
+
+import numpy as np
+
+from . import ply
+
+
+def _describe_build(build: dict) -> str:
+    return (f"built: mean of {len(build['seeds'])} seeds ({', '.join(map(str, build['seeds']))}) of detp:linear "
+            f"at r = {build['radius_fraction']:g} of the diagonal, {build['photons']} photons each")
+
+
+def prepare(config, qsgi, out: str, diagonal: float, threads: int) -> tuple:
+    """Returns (reference PLY path, description). Builds the reference if the config names none."""
+    if config.reference:
+        return config.reference, f"committed: {os.path.relpath(config.reference, os.path.dirname(config.path))}"
+    build = config.reference_build
+    folder = os.path.join(out, "reference")
+    recipe_path, reference_path = os.path.join(folder, "reference.json"), os.path.join(folder, "reference.ply")
+    recipe = dict(build, scene=config.scene, animation=config.animation, diagonal=diagonal)
+    if os.path.exists(reference_path) and os.path.exists(recipe_path):
+        with open(recipe_path) as f:
+            if json.load(f) == recipe:
+                return reference_path, _describe_build(build)
+    os.makedirs(folder, exist_ok=True)
+    options = ["--estimator", "detp", "--detp-boundary", "linear", "--photons", str(build["photons"]),
+               "--radius", repr(build["radius_fraction"] * diagonal), "--frames", "0:0"]
+    runs = []
+    for seed in build["seeds"]:
+        run = os.path.join(folder, f"seed_{seed}")
+        qsgi.render(run, options, seed, threads)
+        runs.append(ply.read(os.path.join(run, "frame_0000.ply")))
+    mean = np.mean([r.radiosity() for r in runs], axis=0)
+    ply.write_with_radiosity(reference_path, runs[0], mean)
+    temporary = recipe_path + ".tmp"
+    with open(temporary, "w") as f:
+        json.dump(recipe, f, indent=1)
+    os.replace(temporary, recipe_path)
+    return reference_path, _describe_build(build)

@@ -1,0 +1,159 @@
+"""Runs grid points: each renders into OUT/points/NAME/ and leaves result.json, the point's row of
+sweep.csv. A point whose result.json exists is not recomputed, and a killed point's renders resume
+where they stopped (qsgi render --resume), so a sweep can be interrupted and run again at will.
+
+Points run `jobs` at a time, each render with cores/jobs threads. A point's timings are marked
+`shared_cores` when another point ran during any part of it: those numbers are not a quiet
+machine's, and the CSV says so."""
+import concurrent.futures
+import glob
+import json
+import math
+import os
+import statistics
+import threading
+import time
+
+import numpy as np
+
+from . import ply
+from .grid import DEFAULT_RADIUS_FRACTION
+
+RESULT_VERSION = 1
+
+
+class Occupancy:
+    """Which points are running when: enough to tell, when a point ends, whether any other point
+    overlapped it (every point that did has started by then)."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._spans = {}  # name -> [start, end or None]
+
+    def start(self, name):
+        with self._lock:
+            self._spans[name] = [time.monotonic(), None]
+
+    def finish(self, name) -> bool:
+        with self._lock:
+            start = self._spans[name][0]
+            end = self._spans[name][1] = time.monotonic()
+            return any(other != name and s < end and (e is None or e > start)
+                       for other, (s, e) in self._spans.items())
+
+
+def _frame_seconds(timing: dict) -> dict:
+    frames = timing["frames"]
+    first, later = frames[0], frames[1:]
+    per_frame = [f["photon_update_s"] + f["estimation_s"] for f in later]
+    return {
+        "initial_s": first["photon_update_s"] + first["estimation_s"],
+        "initial_photon_s": first["photon_update_s"],
+        "initial_estimation_s": first["estimation_s"],
+        "median_frame_s": statistics.median(per_frame) if per_frame else math.nan,
+        "median_photon_update_s": statistics.median(f["photon_update_s"] for f in later) if later else math.nan,
+        "median_estimation_s": statistics.median(f["estimation_s"] for f in later) if later else math.nan,
+        "segments": first["segments"],
+        "photons_missing_scene": first["photons_missing_scene"],
+        "tracked_bytes_per_segment": (later[-1]["tracked_bytes"] / later[-1]["tracked_segments"]
+                                      if later and later[-1]["tracked_segments"] else math.nan),
+    }
+
+
+def _noise(a: str, b: str, reference: np.ndarray) -> float:
+    """The spread between two seeds: RMS of their difference / √2 (one render's standard deviation),
+    over the reference's mean, the normalisation of `qsgi compare`'s relative RMS."""
+    difference = ply.read(a).radiosity() - ply.read(b).radiosity()
+    mean = float(np.mean(reference))
+    rms = float(np.sqrt(np.mean(difference ** 2) / 2))
+    return rms / mean if mean > 0 else rms
+
+
+class Sweep:
+    def __init__(self, config, qsgi, out, diagonal, reference_path, reference_description, jobs, cores):
+        self.config, self.qsgi, self.out, self.diagonal = config, qsgi, out, diagonal
+        self.reference_path, self.reference_description = reference_path, reference_description
+        self.reference_radiosity = ply.read(reference_path).radiosity()
+        self.jobs, self.threads = jobs, max(1, cores // jobs)
+        self.occupancy = Occupancy()
+
+    def folder(self, point):
+        return os.path.join(self.out, "points", point.name)
+
+    def cached(self, point):
+        """The point's result if it was computed with this reference and this qsgi, else None."""
+        path = os.path.join(self.folder(point), "result.json")
+        if not os.path.exists(path):
+            return None
+        with open(path) as f:
+            result = json.load(f)
+        same = result.get("result_version") == RESULT_VERSION and result.get("reference") == self.reference_description
+        return result if same else None
+
+    def run(self, point) -> dict:
+        result = self.cached(point)
+        if result is not None:
+            return result
+        self.occupancy.start(point.name)
+        began = time.monotonic()
+        try:
+            result = self._compute(point)
+        finally:
+            shared = self.occupancy.finish(point.name)
+        result.update(shared_cores=shared, wall_s=time.monotonic() - began)
+        path = os.path.join(self.folder(point), "result.json")
+        with open(path + ".tmp", "w") as f:
+            json.dump(result, f, indent=1, sort_keys=True)
+        os.replace(path + ".tmp", path)
+        return result
+
+    def _compute(self, point) -> dict:
+        folder = self.folder(point)
+        run = os.path.join(folder, "run")
+        seed, second_seed = self.config.seeds
+        timing = self.qsgi.render(run, point.qsgi_options(self.diagonal), seed, self.threads)
+        radius = (point.radius_fraction or DEFAULT_RADIUS_FRACTION) * self.diagonal
+        frame0 = os.path.join(run, "frame_0000.ply")
+        errors = self.qsgi.compare(frame0, self.reference_path, radius)
+        plys = sorted(glob.glob(os.path.join(run, "frame_*.ply")))
+        noise = math.nan
+        if point.family != "full":  # --full-recompute writes the same bytes: its noise is the accuracy row's
+            second = os.path.join(folder, "seed2")
+            options = point.qsgi_options(self.diagonal)
+            options[options.index("--frames") + 1] = "0:0"
+            self.qsgi.render(second, options, second_seed, self.threads)
+            noise = _noise(frame0, os.path.join(second, "frame_0000.ply"), self.reference_radiosity)
+            plys.append(os.path.join(second, "frame_0000.ply"))
+        nan = inf = 0
+        for path in plys:
+            n, i = ply.count_non_finite(path)
+            nan, inf = nan + n, inf + i
+        result = {"result_version": RESULT_VERSION, "family": point.family, "estimator": point.label,
+                  "photons": point.photons, "radius_fraction": point.radius_fraction,
+                  "radius": point.radius_fraction * self.diagonal if point.radius_fraction else math.nan,
+                  "k": point.k or math.nan, "full_recompute": point.full_recompute, "frames": point.frames,
+                  "seed": seed, "noise_seed": second_seed if point.family != "full" else math.nan,
+                  "threads": self.threads, "jobs": self.jobs, "reference": self.reference_description,
+                  "qsgi_version": timing["version"], "noise": noise, "nan_count": nan, "inf_count": inf,
+                  "edge_radius": radius}
+        for region in ("all", "edge", "near_edge", "interior"):
+            result[f"rms_{region}"] = errors[region]["relative_rms"]
+            result[f"bias_{region}"] = errors[region]["relative_bias"]
+            result[f"vertices_{region}"] = errors[region]["vertices"]
+        result.update(_frame_seconds(timing))
+        return result
+
+    def run_all(self, points, progress) -> list:
+        """Runs every point (cached ones return at once), `jobs` at a time, in grid order."""
+        results = [None] * len(points)
+        with concurrent.futures.ThreadPoolExecutor(max_workers=self.jobs) as pool:
+            futures = {pool.submit(self.run, p): i for i, p in enumerate(points)}
+            try:
+                for done, future in enumerate(concurrent.futures.as_completed(futures), 1):
+                    i = futures[future]
+                    results[i] = future.result()
+                    progress(done, len(points), points[i], results[i])
+            except BaseException:
+                pool.shutdown(wait=True, cancel_futures=True)  # finished points keep their result.json
+                raise
+        return results

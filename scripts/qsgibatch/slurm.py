@@ -1,0 +1,75 @@
+"""Slurm submission: sbatch job arrays with a dependent merge job.
+
+Both kinds of work split cleanly. A sweep's points are independent renders. A render's frames
+split into chunks: randomness is counter-based, so a chunk starting at frame A rebuilds frame A's
+state from scratch and writes the bytes one sequential run would (the PNG exposure, fixed at frame
+0, is computed for it). Each submission covers only what is missing, so submitting again after a
+killed or failed task finishes the work without redoing any."""
+import os
+import shlex
+import subprocess
+import sys
+
+
+class SlurmError(Exception):
+    pass
+
+
+def sbatch(name, command, log_folder, options, array=None, dependency=None, cpus=1) -> str:
+    """Submits `command` (a shell command line) and returns the job id."""
+    arguments = ["sbatch", "--parsable", f"--job-name={name}", f"--cpus-per-task={cpus}",
+                 f"--output={os.path.join(log_folder, name + '-%A_%a.out' if array else name + '-%j.out')}"]
+    if array:
+        arguments.append(f"--array={array}")
+    if dependency:
+        arguments.append(f"--dependency={dependency}")
+    arguments += list(options) + ["--wrap", command]
+    done = subprocess.run(arguments, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if done.returncode != 0:
+        raise SlurmError(f"{shlex.join(arguments)}: {done.stderr.strip()}")
+    return done.stdout.strip().split(";")[0]
+
+
+def array_spec(indices) -> str:
+    """Slurm's compact array syntax: [0, 1, 2, 5] -> "0-2,5"."""
+    parts, start = [], None
+    for i, value in enumerate(indices):
+        if start is None:
+            start = value
+        if i + 1 == len(indices) or indices[i + 1] != value + 1:
+            parts.append(str(start) if start == value else f"{start}-{value}")
+            start = None
+    return ",".join(parts)
+
+
+def _python():
+    return sys.executable or "/usr/bin/python3"
+
+
+def submit_sweep(args, config, script) -> int:
+    """A preparation job (scene probe and reference), an array of the points not yet computed, and
+    a merge job that writes sweep.csv and the plots once every point has succeeded."""
+    out = os.path.abspath(args.out)
+    logs = os.path.join(out, "slurm")
+    os.makedirs(logs, exist_ok=True)
+    cpus = args.slurm_cpus
+    command = [_python(), script, os.path.abspath(config.path), "--out", out, "--qsgi", os.path.abspath(args.qsgi),
+               "--cores", str(cpus)] + (["--quick"] if args.quick else [])
+    missing = [i for i, p in enumerate(config.points)
+               if not os.path.exists(os.path.join(out, "points", p.name, "result.json"))]
+    try:
+        prepare = sbatch("qsgi-sweep-prepare", shlex.join(command + ["--prepare"]), logs, args.slurm_option,
+                         cpus=cpus)
+        dependency = f"afterok:{prepare}"
+        if missing:
+            points = sbatch("qsgi-sweep-point", shlex.join(command) + " --point $SLURM_ARRAY_TASK_ID", logs,
+                            args.slurm_option, array=array_spec(missing), dependency=dependency, cpus=cpus)
+            dependency = f"afterok:{points}"
+        merge = sbatch("qsgi-sweep-merge", shlex.join(command + ["--merge"]), logs, args.slurm_option,
+                       dependency=dependency, cpus=cpus)
+    except SlurmError as e:
+        print(f"sweep: {e}", file=sys.stderr)
+        return 2
+    print(f"sweep: submitted {len(missing)} of {len(config.points)} points (jobs {prepare}, "
+          f"{points if missing else '-'}, merge {merge}); logs in {logs}")
+    return 0

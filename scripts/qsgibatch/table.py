@@ -1,0 +1,58 @@
+"""sweep.csv: one row per grid point with every parameter and figure, in a fixed column order."""
+import csv
+import math
+import os
+
+COLUMNS = [
+    # parameters
+    "family", "estimator", "photons", "radius_fraction", "radius", "k", "full_recompute", "frames", "seed",
+    "noise_seed",
+    # error against the reference at frame 0 (relative to the reference's mean; bias signed)
+    "rms_all", "bias_all", "rms_edge", "bias_edge", "rms_near_edge", "bias_near_edge", "rms_interior",
+    "bias_interior", "noise", "edge_radius", "vertices_all", "vertices_edge", "vertices_near_edge",
+    "vertices_interior",
+    # stability
+    "nan_count", "inf_count",
+    # time (seconds; frame = photon update + density estimation, from timing.json)
+    "initial_s", "initial_photon_s", "initial_estimation_s", "median_frame_s", "median_photon_update_s",
+    "median_estimation_s", "wall_s",
+    # work
+    "segments", "photons_missing_scene", "tracked_bytes_per_segment",
+    # how the figures were taken
+    "threads", "jobs", "shared_cores", "reference", "qsgi_version",
+]
+
+
+def _cell(value):
+    if isinstance(value, float):
+        return "" if math.isnan(value) else repr(value)
+    return value
+
+
+def write(path: str, results: list) -> None:
+    """Writes the rows atomically (a reader never sees half a table)."""
+    temporary = path + ".tmp"
+    with open(temporary, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
+        writer.writeheader()
+        for r in results:
+            writer.writerow({c: _cell(r.get(c, math.nan)) for c in COLUMNS})
+    os.replace(temporary, path)
+
+
+def read(path: str) -> list:
+    """Rows with numbers as floats (empty cells as NaN) and booleans as bool."""
+    rows = []
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            parsed = {}
+            for key, value in row.items():
+                if value in ("True", "False"):
+                    parsed[key] = value == "True"
+                else:
+                    try:
+                        parsed[key] = float(value) if value != "" else math.nan
+                    except ValueError:
+                        parsed[key] = value
+            rows.append(parsed)
+    return rows
