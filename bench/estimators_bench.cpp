@@ -7,6 +7,12 @@
 // ratios can be read within one run.
 #include <benchmark/benchmark.h>
 
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 
@@ -125,6 +131,60 @@ void BM_TracePhotons(benchmark::State& state) {
         segments = cache.segments.size();
     }
     state.counters["segments_per_s"] = benchmark::Counter(double(segments), benchmark::Counter::kIsIterationInvariantRate);
+    // What the ray cache holds per segment: the record, and its path's share of the path index.
+    const RayCache& cache = f.cache(photons);
+    state.counters["bytes_per_segment"] =
+        double(sizeof(Segment)) + double(cache.pathBegin.size() * sizeof(uint64_t)) / double(cache.segments.size());
+}
+
+// The ceiling BM_TracePhotons is read against: Embree's own closest-hit rate on the same
+// triangles (one plain BVH, no wrapper), replaying the tracer's segments (their origins and
+// directions, in the tracer's order: incoherent after the first bounce), on all cores as the
+// tracer runs. Tracer segments/s over this rays/s is the share of the hardware's pace we reach.
+void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
+    CornellFixture& f = fixture();
+    const RayCache& cache = f.cache(uint64_t(state.range(0)));
+    RTCScene scene = rtcNewScene(f.device.get());
+    RTCGeometry geometry = rtcNewGeometry(f.device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                 3 * sizeof(float), f.scene.positions.size()));
+    for (size_t v = 0; v < f.scene.positions.size(); ++v)
+        for (int c = 0; c < 3; ++c) vertices[3 * v + c] = f.scene.positions[v][c];
+    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(uint32_t), f.scene.triangles.size()));
+    for (size_t t = 0; t < f.scene.triangles.size(); ++t)
+        for (int c = 0; c < 3; ++c) indices[3 * t + c] = f.scene.triangles[t].v[c];
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(scene);
+    const float epsilon = f.bvh->rayEpsilon();
+    for (auto _ : state) {
+        const size_t hits = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, cache.segments.size(), 4096), size_t(0),
+            [&](const tbb::blocked_range<size_t>& range, size_t count) {
+                for (size_t i = range.begin(); i < range.end(); ++i) {
+                    const Segment& s = cache.segments[i];
+                    RTCRayHit rayHit{};
+                    rayHit.ray.org_x = s.origin.x, rayHit.ray.org_y = s.origin.y, rayHit.ray.org_z = s.origin.z;
+                    rayHit.ray.dir_x = s.direction.x, rayHit.ray.dir_y = s.direction.y, rayHit.ray.dir_z = s.direction.z;
+                    rayHit.ray.tnear = epsilon;
+                    rayHit.ray.tfar = std::numeric_limits<float>::infinity();
+                    rayHit.ray.mask = ~0u;
+                    rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                    RTCIntersectContext context;
+                    rtcInitIntersectContext(&context);
+                    rtcIntersect1(scene, &context, &rayHit);
+                    count += rayHit.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+                }
+                return count;
+            },
+            std::plus<size_t>());
+        benchmark::DoNotOptimize(hits);
+    }
+    rtcReleaseScene(scene);
+    state.counters["rays_per_s"] =
+        benchmark::Counter(double(cache.segments.size()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 void estimatorArguments(benchmark::internal::Benchmark* b) {
@@ -149,6 +209,7 @@ void estimatorArguments(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(BM_TracePhotons)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EmbreeClosestHitCeiling)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DiscRegions)->ArgsProduct({{20, 50, 100}, {0, 1}})->ArgNames({"radius_mm", "coverage"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Estimate)->Apply(estimatorArguments)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);

@@ -106,7 +106,8 @@ def main(argv):
     note = f"{os.path.basename(config.scene)} — reference {description}"
     names, slopes = plots.draw_all(table.read(csv_path), args.out, note)
     bad = sum(r["nan_count"] + r["inf_count"] for r in results)
-    print(f"sweep: {len(results)} points in {csv_path}; plots: {', '.join(names)}; NaN/Inf values: {bad}")
+    print(f"sweep: {len(results)} points in {csv_path} ({sweep.computed} computed now, "
+          f"{len(results) - sweep.computed} finished earlier); plots: {', '.join(names)}; NaN/Inf values: {bad}")
     for (name, kind), slope in slopes.items():
         print(f"  frame time ∝ photons^{slope:.2f}  ({name}, {kind})")
     return 0

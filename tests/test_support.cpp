@@ -24,8 +24,10 @@ std::string testScratchDir(const std::string& name) {
     return p.string();
 }
 
-CommandResult runQsgi(const std::string& arguments) {
-    const std::string command = std::string(QSGI_CLI) + " " + arguments + " 2>&1";
+CommandResult runQsgi(const std::string& arguments) { return runCommand(std::string(QSGI_CLI) + " " + arguments); }
+
+CommandResult runCommand(const std::string& commandLine) {
+    const std::string command = commandLine + " 2>&1";
     FILE* pipe = popen(command.c_str(), "r");
     CommandResult r{-1, ""};
     if (!pipe) return r;

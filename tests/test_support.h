@@ -16,7 +16,8 @@ struct CommandResult {
     int exitCode;
     std::string output;  // stdout and stderr together
 };
-CommandResult runQsgi(const std::string& arguments);
+CommandResult runQsgi(const std::string& arguments);     // the qsgi executable with these arguments
+CommandResult runCommand(const std::string& commandLine);  // any shell command line
 std::string readFileBytes(const std::filesystem::path& path);  // "" if unreadable
 
 // An estimator and its boundary rule, named for test messages.

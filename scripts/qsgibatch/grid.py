@@ -10,7 +10,7 @@ import json
 import math
 import os
 
-ESTIMATORS = ("impact-count", "photon-map", "photon-map:paper", "detp:clip", "detp:linear", "detp:paper")
+ESTIMATORS = ("impact-count", "photon-map", "photon-map:paper", "detp", "detp:clip", "detp:linear", "detp:paper")
 DEFAULT_K = 50
 DEFAULT_RADIUS_FRACTION = 0.015  # qsgi's default radius (render_settings.cpp: defaultRadius)
 KNOWN_KEYS = {"scene", "animation", "reference", "frames", "seeds", "grid", "extremes", "quick",

@@ -182,7 +182,8 @@ def extremes(rows, out, note):
         by_radius = sorted((r for r in mine if r["photons"] == radius_photons and r["radius_fraction"]),
                            key=lambda r: r["radius_fraction"])
         x = [r["radius_fraction"] for r in by_radius]
-        axes[0].plot(x, [r["noise"] for r in by_radius], "o-", ms=3, color=colours[name], label=f"{name}: noise")
+        axes[0].plot(x, [r["rms_all"] for r in by_radius], "o-", ms=3, color=colours[name], label=f"{name}: RMS error")
+        axes[0].plot(x, [r["noise"] for r in by_radius], "x:", ms=4, color=colours[name], label=f"{name}: noise")
         axes[0].plot(x, [abs(r["bias_all"]) for r in by_radius], "s--", ms=3, color=colours[name],
                      label=f"{name}: |bias|")
         by_photons = sorted((r for r in mine if r["radius_fraction"] in (0.015, 0.0)), key=lambda r: r["photons"])
@@ -192,9 +193,9 @@ def extremes(rows, out, note):
                      color=colours[name], label=f"{name}: noise")
     axes[0].set(xscale="log", yscale="log", xlabel="radius (fraction of the scene diagonal)",
                 ylabel="relative error at frame 0",
-                title=f"Radius extremes at {radius_photons:.0e} photons: noise grows as r shrinks, bias as r grows")
+                title=f"Radius extremes, {radius_photons:.0e} photons\n(no photon in a disc: estimate 0, noise 0, bias -100 %)")
     axes[1].set(xscale="log", yscale="log", xlabel="photons per frame", ylabel=ERROR_AXIS,
-                title="Photon extremes at the default radius (1.5 %)")
+                title="Photon extremes, default radius (1.5 % of the diagonal)")
     for axis in axes:
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(fontsize=6)

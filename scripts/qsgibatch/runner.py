@@ -76,6 +76,7 @@ class Sweep:
         self.reference_radiosity = ply.read(reference_path).radiosity()
         self.jobs, self.threads = jobs, max(1, cores // jobs)
         self.occupancy = Occupancy()
+        self.computed = 0  # points computed by this invocation (the others were found finished)
 
     def folder(self, point):
         return os.path.join(self.out, "points", point.name)
@@ -101,6 +102,8 @@ class Sweep:
         finally:
             shared = self.occupancy.finish(point.name)
         result.update(shared_cores=shared, wall_s=time.monotonic() - began)
+        with self.occupancy._lock:
+            self.computed += 1
         path = os.path.join(self.folder(point), "result.json")
         with open(path + ".tmp", "w") as f:
             json.dump(result, f, indent=1, sort_keys=True)
