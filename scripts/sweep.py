@@ -35,6 +35,8 @@ def parse_arguments(argv):
     parser.add_argument("--cores", type=int, default=os.cpu_count(), help="cores shared by the jobs (default: all)")
     parser.add_argument("--qsgi", default=os.path.join(REPOSITORY, "build", "cli", "qsgi"),
                         help="the qsgi executable (default: build/cli/qsgi)")
+    parser.add_argument("--max-photons", type=float, help="only the points with at most this many photons "
+                        "(the cheap part of a grid first; the rest is added by a later run without it)")
     parser.add_argument("--list", action="store_true", help="print the grid points and exit")
     parser.add_argument("--point", type=int, help="compute only point I (0-based; a Slurm array task)")
     parser.add_argument("--prepare", action="store_true", help="only measure the scene and build the reference")
@@ -65,6 +67,8 @@ def main(argv):
     except grid.ConfigError as e:
         print(f"sweep: {e}", file=sys.stderr)
         return 2
+    if args.max_photons is not None:
+        config.points = [p for p in config.points if p.photons <= args.max_photons]
     if args.list:
         for i, p in enumerate(config.points):
             print(i, p.name)

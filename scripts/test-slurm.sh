@@ -23,9 +23,10 @@ trap cleanup EXIT
 
 fail() { echo "test-slurm: FAILED: $*" >&2; exit 1; }
 
-wait_for_queue() {  # until no job of ours is queued or running (at most 10 minutes)
+wait_for_queue() {  # until no job of ours can still run (at most 10 minutes); a merge whose
+  # dependency failed waits forever (DependencyNeverSatisfied) until a resubmission replaces it
   for _ in $(seq 600); do
-    [ -z "$(squeue -h -u "$(id -un)")" ] && return 0
+    [ -z "$(squeue -h -u "$(id -un)" -o '%r' | grep -v DependencyNeverSatisfied)" ] && return 0
     sleep 1
   done
   squeue >&2
@@ -44,7 +45,8 @@ same_frames() {  # every frame file of $1 is in $2 with the same bytes, and noth
 
 logged_frames() { /usr/bin/python3 -c "import json,sys; print(' '.join(str(f['frame']) for f in json.load(open(sys.argv[1]))['frames']))" "$1"; }
 
-scene=(data/cornell/cornell.gltf --animation data/cornell/animation.json --width 64 --height 48 --png --quiet)
+# Absolute paths: the EXR metadata records the scene path as given, and render.py makes it absolute.
+scene=("$root/data/cornell/cornell.gltf" --animation "$root/data/cornell/animation.json" --width 64 --height 48 --png --quiet)
 
 echo "== 1. chunked render == sequential render"
 "$qsgi" render "${scene[@]}" --photons 100000 --frames 0:11 --out "$work/sequential"
@@ -76,6 +78,7 @@ resubmitted=$("${killed[@]}")
 echo "$resubmitted"
 echo "$resubmitted" | grep -q "submitted 1 of 3 chunks" || fail "the resubmission should run chunk 1 alone"
 wait_for_queue
+[ -z "$(squeue -h -u "$(id -un)")" ] || fail "the first merge job was not replaced: $(squeue -h)"
 same_frames "$work/sequential-big" "$work/killed"
 
 echo "== 3. a sweep as a job array"

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The test command (CI runs it through .ci/run): sets up the Debian packages, then
 #   1. builds from scratch (Release) and runs the whole test suite with ctest;
-#   2. builds with AddressSanitizer + UndefinedBehaviorSanitizer and runs the suite again
+#   2. tests the Slurm job arrays on a single-node cluster it starts (scripts/test-slurm.sh);
+#   3. builds with AddressSanitizer + UndefinedBehaviorSanitizer and runs the suite again
 #      (scripts/test-sanitizers.sh);
-#   3. fuzzes the transform-file, config and glTF readers for QSGI_FUZZ_SECONDS each (default 60;
+#   4. fuzzes the transform-file, config and glTF readers for QSGI_FUZZ_SECONDS each (default 60;
 #      scripts/fuzz.sh).
-# QSGI_SKIP_SANITIZERS=1 / QSGI_SKIP_FUZZ=1 leave out 2 / 3 for a quick local run. Extra arguments
+# QSGI_SKIP_SLURM=1 / QSGI_SKIP_SANITIZERS=1 / QSGI_SKIP_FUZZ=1 leave out 2 / 3 / 4 for a quick
+# local run. Extra arguments
 # go to ctest in step 1.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,5 +15,6 @@ scripts/setup.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build
 (cd build && ctest --output-on-failure -j 2 "$@")
+if [ "${QSGI_SKIP_SLURM:-0}" != 1 ]; then scripts/test-slurm.sh; fi
 if [ "${QSGI_SKIP_SANITIZERS:-0}" != 1 ]; then scripts/test-sanitizers.sh; fi
 if [ "${QSGI_SKIP_FUZZ:-0}" != 1 ]; then scripts/fuzz.sh "${QSGI_FUZZ_SECONDS:-60}"; fi

@@ -30,6 +30,20 @@ def sbatch(name, command, log_folder, options, array=None, dependency=None, cpus
     return done.stdout.strip().split(";")[0]
 
 
+def replace_merge_job(record: str, new_job: str) -> None:
+    """Cancels the merge job an earlier submission left (recorded in `record`) and records the new
+    one. A merge whose array had a failed or killed task waits forever on a dependency that can
+    never be met, unless the cluster sets kill_invalid_depend; the resubmission supersedes it."""
+    if os.path.exists(record):
+        with open(record) as f:
+            old = f.read().strip()
+        if old and old != new_job:
+            subprocess.run(["scancel", "--state=PENDING", old], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    with open(record + ".tmp", "w") as f:
+        f.write(new_job + "\n")
+    os.replace(record + ".tmp", record)
+
+
 def array_spec(indices) -> str:
     """Slurm's compact array syntax: [0, 1, 2, 5] -> "0-2,5"."""
     parts, start = [], None
@@ -54,7 +68,8 @@ def submit_sweep(args, config, script) -> int:
     os.makedirs(logs, exist_ok=True)
     cpus = args.slurm_cpus
     command = [_python(), script, os.path.abspath(config.path), "--out", out, "--qsgi", os.path.abspath(args.qsgi),
-               "--cores", str(cpus)] + (["--quick"] if args.quick else [])
+               "--cores", str(cpus)] + (["--quick"] if args.quick else []) + \
+        (["--max-photons", repr(args.max_photons)] if args.max_photons is not None else [])  # the same point indices
     missing = [i for i, p in enumerate(config.points)
                if not os.path.exists(os.path.join(out, "points", p.name, "result.json"))]
     try:
@@ -67,6 +82,7 @@ def submit_sweep(args, config, script) -> int:
             dependency = f"afterok:{points}"
         merge = sbatch("qsgi-sweep-merge", shlex.join(command + ["--merge"]), logs, args.slurm_option,
                        dependency=dependency, cpus=cpus)
+        replace_merge_job(os.path.join(logs, "merge-job"), merge)
     except SlurmError as e:
         print(f"sweep: {e}", file=sys.stderr)
         return 2

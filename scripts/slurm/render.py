@@ -75,6 +75,7 @@ def submit(args) -> int:
         dependency = f"afterok:{array}"
     merge = slurm.sbatch("qsgi-render-merge", shlex.join(me + ["--merge"]), logs, args.slurm_option,
                          dependency=dependency)
+    slurm.replace_merge_job(os.path.join(logs, "merge-job"), merge)
     print(f"render: submitted {len(missing)} of {len(wanted['chunks'])} chunks"
           f"{' (array ' + array + ')' if missing else ''} and the merge (job {merge}); logs in {logs}")
     return 0
