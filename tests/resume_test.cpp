@@ -34,7 +34,7 @@ SignalledRun runAndSignal(const std::string& arguments, const char* signal, doub
                           const fs::path& afterStart = {}) {
     const fs::path log = scratch / "signalled.log", rc = scratch / "signalled.rc";
     const std::string waitForStart =
-        afterStart.empty() ? "" : "for i in $(seq 3000); do [ -e " + afterStart.string() + " ] && break; sleep 0.01; done; ";
+        afterStart.empty() ? "" : "for i in $(seq 12000); do [ -e " + afterStart.string() + " ] && break; sleep 0.01; done; ";
     const std::string command = std::string(QSGI_CLI) + " " + arguments + " 2>" + log.string() + " & pid=$!; " +
                                 waitForStart + "sleep " + std::to_string(seconds) + "; kill -" + signal +
                                 " $pid 2>/dev/null; wait $pid; echo $? > " + rc.string();
