@@ -56,24 +56,24 @@ wait_for_queue
 same_frames "$work/sequential" "$work/chunked"
 
 echo "== 2. a killed array task, resubmitted"
-"$qsgi" render "${scene[@]}" --photons 400000 --frames 0:11 --out "$work/sequential-big"
-killed=(scripts/slurm/render.py --out "$work/killed" --frames 0:11 --chunks 3 --qsgi "$qsgi" -- "${scene[@]}" --photons 400000)
+"$qsgi" render "${scene[@]}" --photons 400000 --frames 0:17 --out "$work/sequential-big"
+killed=(scripts/slurm/render.py --out "$work/killed" --frames 0:17 --chunks 3 --qsgi "$qsgi" -- "${scene[@]}" --photons 400000)
 submitted=$("${killed[@]}")
 echo "$submitted"
 array=$(echo "$submitted" | sed -n 's/.*(array \([0-9]*\)).*/\1/p')
 [ -n "$array" ] || fail "no array job id in: $submitted"
-# Kill task 1 once it has written its first frame (of 4), well before its last.
-for _ in $(seq 600); do
-  [ -e "$work/killed/chunks/001/frame_0004.ply" ] && break
-  sleep 0.2
+# Kill task 1 (frames 6..11) once it has written its first frame, five frames before its last.
+for _ in $(seq 3000); do
+  [ -e "$work/killed/chunks/001/frame_0006.ply" ] && break
+  sleep 0.1
 done
-[ -e "$work/killed/chunks/001/frame_0004.ply" ] || fail "task 1 never wrote its first frame"
+[ -e "$work/killed/chunks/001/frame_0006.ply" ] || fail "task 1 never wrote its first frame"
 scancel --signal=KILL "${array}_1"
 wait_for_queue
 [ ! -e "$work/killed/frame_0000.ply" ] || fail "the merge ran although task 1 was killed"
 done_before=$(logged_frames "$work/killed/chunks/001/timing.json")
-echo "test-slurm: task 1 killed after frames [$done_before] of 4..7"
-[ "$done_before" != "4 5 6 7" ] || fail "task 1 finished before the kill landed; nothing was tested"
+echo "test-slurm: task 1 killed after frames [$done_before] of 6..11"
+[ "$done_before" != "6 7 8 9 10 11" ] || fail "task 1 finished before the kill landed; nothing was tested"
 resubmitted=$("${killed[@]}")
 echo "$resubmitted"
 echo "$resubmitted" | grep -q "submitted 1 of 3 chunks" || fail "the resubmission should run chunk 1 alone"
