@@ -10,6 +10,8 @@ matplotlib.use("Agg")  # headless: files only
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .grid import DEFAULT_RADIUS_FRACTION  # noqa: E402
+
 ERROR_AXIS = "relative RMS error at frame 0"
 MIN_PHOTONS_FOR_SLOPE = 1e4  # below, the fixed cost per frame (regions, setup) hides the growth
 
@@ -175,7 +177,7 @@ def extremes(rows, out, note):
     estimators = _estimators(extreme)
     colours = _colours(estimators)
     figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    radius_photons = min((r["photons"] for r in extreme if r["radius_fraction"] != 0.015 and r["radius_fraction"]),
+    radius_photons = min((r["photons"] for r in extreme if r["radius_fraction"] != DEFAULT_RADIUS_FRACTION and r["radius_fraction"]),
                          default=math.nan)
     for name in estimators:
         mine = [r for r in extreme if r["estimator"] == name]
@@ -186,7 +188,7 @@ def extremes(rows, out, note):
         axes[0].plot(x, [r["noise"] for r in by_radius], "x:", ms=4, color=colours[name], label=f"{name}: noise")
         axes[0].plot(x, [abs(r["bias_all"]) for r in by_radius], "s--", ms=3, color=colours[name],
                      label=f"{name}: |bias|")
-        by_photons = sorted((r for r in mine if r["radius_fraction"] in (0.015, 0.0)), key=lambda r: r["photons"])
+        by_photons = sorted((r for r in mine if r["radius_fraction"] in (DEFAULT_RADIUS_FRACTION, 0.0)), key=lambda r: r["photons"])
         axes[1].plot([r["photons"] for r in by_photons], [r["rms_all"] for r in by_photons], "o-", ms=3,
                      color=colours[name], label=f"{name}: RMS error")
         axes[1].plot([r["photons"] for r in by_photons], [r["noise"] for r in by_photons], "x:", ms=4,

@@ -77,6 +77,7 @@ class Sweep:
         self.jobs, self.threads = jobs, max(1, cores // jobs)
         self.occupancy = Occupancy()
         self.computed = 0  # points computed by this invocation (the others were found finished)
+        self._computed_lock = threading.Lock()
 
     def folder(self, point):
         return os.path.join(self.out, "points", point.name)
@@ -102,7 +103,7 @@ class Sweep:
         finally:
             shared = self.occupancy.finish(point.name)
         result.update(shared_cores=shared, wall_s=time.monotonic() - began)
-        with self.occupancy._lock:
+        with self._computed_lock:
             self.computed += 1
         path = os.path.join(self.folder(point), "result.json")
         with open(path + ".tmp", "w") as f:

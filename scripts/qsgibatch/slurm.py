@@ -56,7 +56,8 @@ def array_spec(indices) -> str:
     return ",".join(parts)
 
 
-def _python():
+def python_executable():
+    """The interpreter running us, for the jobs to run the same one (Debian's, with matplotlib)."""
     return sys.executable or "/usr/bin/python3"
 
 
@@ -67,7 +68,7 @@ def submit_sweep(args, config, script) -> int:
     logs = os.path.join(out, "slurm")
     os.makedirs(logs, exist_ok=True)
     cpus = args.slurm_cpus
-    command = [_python(), script, os.path.abspath(config.path), "--out", out, "--qsgi", os.path.abspath(args.qsgi),
+    command = [python_executable(), script, os.path.abspath(config.path), "--out", out, "--qsgi", os.path.abspath(args.qsgi),
                "--cores", str(cpus)] + (["--quick"] if args.quick else []) + \
         (["--max-photons", repr(args.max_photons)] if args.max_photons is not None else [])  # the same point indices
     missing = [i for i, p in enumerate(config.points)

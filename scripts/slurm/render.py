@@ -67,7 +67,7 @@ def submit(args) -> int:
     missing = [i for i, (a, b) in enumerate(wanted["chunks"]) if not chunks.complete(out, i, a, b)]
     logs = os.path.join(out, "slurm")
     os.makedirs(logs, exist_ok=True)
-    me = [sys.executable or "/usr/bin/python3", os.path.abspath(__file__), "--out", out]
+    me = [slurm.python_executable(), os.path.abspath(__file__), "--out", out]
     dependency = None
     if missing:
         array = slurm.sbatch("qsgi-render-chunk", shlex.join(me) + " --task $SLURM_ARRAY_TASK_ID", logs,
