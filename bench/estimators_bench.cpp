@@ -3,8 +3,9 @@
 // takes minutes), sorted vs unsorted queries, and DETP's FLANN candidates vs the exact index with
 // the approximation's error; DETP's boundary rules (clip, linear, paper) and the cost of the disc
 // regions they need (per radius, with and without the photon map's coverage probes). Photon
-// tracing throughput too. Counters carry the work done, so
-// ratios can be read within one run.
+// tracing and DETP's disc traversal, each next to its ceiling: Embree alone on the same rays
+// (closest hit through the triangles; all hits through the discs). Counters carry the work
+// done, so ratios can be read within one run.
 #include <benchmark/benchmark.h>
 
 #include <embree3/rtcore.h>
@@ -17,6 +18,7 @@
 #include <memory>
 
 #include "estimate/accuracy.h"
+#include "estimate/detp.h"
 #include "estimate/estimator.h"
 #include "scene/gltf_loader.h"
 #include "trace/photon_tracer.h"
@@ -187,6 +189,104 @@ void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
         benchmark::Counter(double(cache.segments.size()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// DETP's own rate: every segment traced through the vertices' discs with the exact test, in the
+// Morton order the estimator uses (DESIGN §5). Its ceiling is BM_EmbreeAllHitsCeiling below.
+void BM_DetpSegments(benchmark::State& state) {
+    CornellFixture& f = fixture();
+    const RayCache& cache = f.cache(uint64_t(state.range(0)));
+    const float radius = float(state.range(1)) / 1000.0f;
+    const DetpDiscs discs(f.device, f.scene, radius, DetpBoundary::Clip, &f.discRegions(int(state.range(1)), false), f.bvh.get());
+    const std::vector<uint32_t> order = segmentMortonOrder(cache);
+    DetpQueryStats stats;
+    for (auto _ : state) {
+        stats = DetpQueryStats();
+        const auto sums = discs.sums(cache, order, &stats);
+        benchmark::DoNotOptimize(sums.data());
+    }
+    state.counters["segments_per_s"] =
+        benchmark::Counter(double(cache.segments.size()), benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["disc_hits_per_segment"] = double(stats.discHits) / double(cache.segments.size());
+}
+
+// What Embree alone does with the same rays through the same discs: one BVH of oriented discs at
+// every vertex (DETP's enlarged search radius), each segment traced over DETP's extent (from just
+// before its origin to r past its impact, or out of the animation's padded bounds if it escapes),
+// in the same Morton order, with a filter that only counts each hit and rejects it so traversal
+// goes on (all hits). No exact test, no regions, no sums: the pace DETP's traversal could reach.
+struct CountingContext {
+    RTCIntersectContext base;  // first member: Embree hands back a pointer to it
+    size_t hits = 0;
+};
+
+void countAndReject(const RTCFilterFunctionNArguments* args) {
+    auto* ctx = reinterpret_cast<CountingContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i] != 0) {
+            ++ctx->hits;
+            args->valid[i] = 0;
+        }
+}
+
+void BM_EmbreeAllHitsCeiling(benchmark::State& state) {
+    CornellFixture& f = fixture();
+    const RayCache& cache = f.cache(uint64_t(state.range(0)));
+    const float radius = float(state.range(1)) / 1000.0f;
+    const float eps = f.scene.sceneEpsilon();
+    const float slack = 1e-4f * radius + eps, searchRadius = radius * (1 + 1e-3f) + eps;  // as DetpDiscs
+    const Bounds3f escapeBounds = f.scene.animationBounds.expanded(radius + 2 * slack);
+    RTCScene scene = rtcNewScene(f.device.get());
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);  // DetpDiscs' flags and quality
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry geometry = rtcNewGeometry(f.device.get(), RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+    const size_t n = f.scene.vertexCount();
+    auto* vertex = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
+    auto* normal = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
+    for (size_t v = 0; v < n; ++v) {
+        for (int c = 0; c < 3; ++c) vertex[4 * v + c] = f.scene.positions[v][c], normal[3 * v + c] = f.scene.normals[v][c];
+        vertex[4 * v + 3] = searchRadius;
+    }
+    rtcSetGeometryIntersectFilterFunction(geometry, countAndReject);
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(scene);
+    const std::vector<uint32_t> order = segmentMortonOrder(cache);
+    std::vector<Segment> ordered(order.size());
+    for (size_t i = 0; i < order.size(); ++i) ordered[i] = cache.segments[order[i]];
+    size_t hits = 0;
+    for (auto _ : state) {
+        hits = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, ordered.size(), 256), size_t(0),
+            [&](const tbb::blocked_range<size_t>& range, size_t count) {
+                CountingContext ctx;
+                rtcInitIntersectContext(&ctx.base);
+                for (size_t i = range.begin(); i < range.end(); ++i) {
+                    const Segment& s = ordered[i];
+                    float end = s.length + radius;
+                    if (!s.hasImpact()) end = std::max(end, escapeBounds.exitDistance(s.origin, s.direction));
+                    const Vec3f o = s.origin - s.direction * slack;
+                    RTCRayHit rh{};
+                    rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
+                    rh.ray.dir_x = s.direction.x, rh.ray.dir_y = s.direction.y, rh.ray.dir_z = s.direction.z;
+                    rh.ray.tnear = 0;
+                    rh.ray.tfar = end + 2 * slack;
+                    rh.ray.mask = ~0u;
+                    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                    rtcIntersect1(scene, &ctx.base, &rh);
+                }
+                return count + ctx.hits;
+            },
+            std::plus<size_t>());
+        benchmark::DoNotOptimize(hits);
+    }
+    rtcReleaseScene(scene);
+    state.counters["rays_per_s"] =
+        benchmark::Counter(double(ordered.size()), benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["disc_hits_per_segment"] = double(hits) / double(ordered.size());
+}
+
 void estimatorArguments(benchmark::internal::Benchmark* b) {
     const int64_t clip = int64_t(DetpBoundary::Clip), linear = int64_t(DetpBoundary::Linear),
                   paper = int64_t(DetpBoundary::Paper);
@@ -210,6 +310,10 @@ void estimatorArguments(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_TracePhotons)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EmbreeClosestHitCeiling)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DetpSegments)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_EmbreeAllHitsCeiling)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DiscRegions)->ArgsProduct({{20, 50, 100}, {0, 1}})->ArgNames({"radius_mm", "coverage"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Estimate)->Apply(estimatorArguments)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
