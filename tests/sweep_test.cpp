@@ -72,7 +72,7 @@ TEST(Sweep, TinyGridTabulatesFallingErrorNoNonFiniteValuesAndResumesWithoutRecom
     for (const char* column :
          {"family", "estimator", "photons", "radius_fraction", "radius", "k", "full_recompute", "frames", "seed",
           "rms_all", "bias_all", "rms_near_edge", "bias_near_edge", "rms_interior", "bias_interior", "noise",
-          "nan_count", "inf_count", "initial_s", "median_frame_s", "threads", "jobs", "shared_cores", "reference"})
+          "nan_count", "inf_count", "initial_s", "median_frame_s", "threads", "jobs", "shared_cores", "other_cores", "reference"})
         EXPECT_NE(std::find(header.begin(), header.end(), column), header.end()) << "no column " << column;
     // 2 photon counts x (impact count, DETP) x (incremental, --full-recompute), and 3 extremes.
     ASSERT_EQ(rows.size(), 11u);
@@ -82,7 +82,11 @@ TEST(Sweep, TinyGridTabulatesFallingErrorNoNonFiniteValuesAndResumesWithoutRecom
         SCOPED_TRACE(r.at("estimator") + " " + r.at("photons") + " r " + r.at("radius_fraction"));
         EXPECT_EQ(r.at("nan_count"), "0");
         EXPECT_EQ(r.at("inf_count"), "0");
-        EXPECT_EQ(r.at("shared_cores"), "False");  // one job at a time
+        // One job at a time, so no point overlaps another: a point is marked shared exactly when
+        // processes outside the sweep (ctest's other tests, here) kept over a quarter core busy.
+        const double other = std::stod(r.at("other_cores"));
+        EXPECT_GE(other, 0.0);
+        EXPECT_EQ(r.at("shared_cores"), other > 0.25 ? "True" : "False");
         EXPECT_EQ(r.at("reference"), "committed: ../reference/cornell_f0000.ply");
         if (r.at("family") == "accuracy") {
             error[r.at("estimator") + "@" + r.at("photons")] = std::stod(r.at("rms_all"));

@@ -3,8 +3,9 @@ sweep.csv. A point whose result.json exists is not recomputed, and a killed poin
 where they stopped (qsgi render --resume), so a sweep can be interrupted and run again at will.
 
 Points run `jobs` at a time, each render with cores/jobs threads. A point's timings are marked
-`shared_cores` when another point ran during any part of it: those numbers are not a quiet
-machine's, and the CSV says so."""
+`shared_cores` when another point ran during any part of it, or when processes outside the sweep
+kept more than a quarter of a core busy on average while it ran (`other_cores`, from /proc/stat):
+those numbers are not a quiet machine's, and the CSV says so."""
 import concurrent.futures
 import glob
 import json
@@ -40,6 +41,44 @@ class Occupancy:
             end = self._spans[name][1] = time.monotonic()
             return any(other != name and s < end and (e is None or e > start)
                        for other, (s, e) in self._spans.items())
+
+
+# Average cores busy outside the sweep above which a point's timings count as shared.
+OTHER_CORES_SHARED = 0.25
+
+
+def _busy_cpu_seconds():
+    """CPU seconds the whole machine has spent busy since boot (Linux /proc/stat), or None."""
+    try:
+        with open("/proc/stat") as f:
+            fields = [int(x) for x in f.readline().split()[1:]]
+    except (OSError, ValueError):
+        return None
+    idle = fields[3] + (fields[4] if len(fields) > 4 else 0)  # idle + iowait
+    return (sum(fields[:8]) - idle) / os.sysconf("SC_CLK_TCK")  # guest time is already in user
+
+
+def _own_cpu_seconds():
+    """CPU seconds of this process and its finished children (the renders)."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+class MachineLoad:
+    """How busy the machine was outside the sweep over a span: (busy CPU time of the machine − this
+    process's and its renders') / wall time, in cores. Other points' renders count as the sweep's
+    own, so with jobs > 1 only outside load shows here (overlap is Occupancy's business)."""
+
+    def __init__(self):
+        self._start = (time.monotonic(), _busy_cpu_seconds(), _own_cpu_seconds())
+
+    def other_cores(self) -> float:
+        wall0, busy0, own0 = self._start
+        busy1 = _busy_cpu_seconds()
+        wall = time.monotonic() - wall0
+        if busy0 is None or busy1 is None or wall <= 0:
+            return math.nan
+        return max(0.0, ((busy1 - busy0) - (_own_cpu_seconds() - own0)) / wall)
 
 
 def _frame_seconds(timing: dict) -> dict:
@@ -97,12 +136,15 @@ class Sweep:
         if result is not None:
             return result
         self.occupancy.start(point.name)
+        load = MachineLoad()
         began = time.monotonic()
         try:
             result = self._compute(point)
         finally:
-            shared = self.occupancy.finish(point.name)
-        result.update(shared_cores=shared, wall_s=time.monotonic() - began)
+            overlapped = self.occupancy.finish(point.name)
+        other = load.other_cores()
+        result.update(shared_cores=overlapped or other > OTHER_CORES_SHARED, other_cores=other,
+                      wall_s=time.monotonic() - began)
         with self._computed_lock:
             self.computed += 1
         path = os.path.join(self.folder(point), "result.json")

@@ -19,7 +19,7 @@ COLUMNS = [
     # work
     "segments", "photons_missing_scene", "tracked_bytes_per_segment",
     # how the figures were taken
-    "threads", "jobs", "shared_cores", "reference", "qsgi_version",
+    "threads", "jobs", "shared_cores", "other_cores", "reference", "qsgi_version",
 ]
 
 
