@@ -44,7 +44,7 @@ struct CliOptions {
     std::string config, animation, estimator, detpIndex, detpBoundary, frames, out;
     // Unset options leave the config's (or the default) value alone.
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
-    std::optional<double> exposure, radius;
+    std::optional<double> exposure, radius, fps;
     std::optional<int64_t> k;
     bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false, resume = false;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false;
@@ -56,6 +56,11 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (!o.config.empty()) qsgi::applyConfigFile(o.config, s);
     if (!scene.empty()) s.scenePath = scene;
     if (!o.animation.empty()) s.animationPath = o.animation;
+    if (o.fps) {
+        if (!(*o.fps > 0) || !(*o.fps <= 1e6))
+            throw qsgi::InputError("command line", "--fps", "must be a positive number of frames per second (at most 10^6)");
+        s.fps = *o.fps;
+    }
     if (!o.estimator.empty()) s.estimator.kind = qsgi::parseEstimator(o.estimator, "command line");
     if (!o.detpIndex.empty()) s.estimator.detpIndex = qsgi::parseDetpIndex(o.detpIndex, "command line");
     if (!o.detpBoundary.empty()) s.estimator.boundary = qsgi::parseDetpBoundary(o.detpBoundary, "command line");
@@ -136,7 +141,10 @@ int main(int argc, char** argv) {
     CLI::App* render = app.add_subcommand("render", "render every frame of a scene's animation to vertex-radiosity PLYs");
     render->add_option("SCENE", scene, "glTF 2.0 scene (.gltf or .glb); may come from --config instead");
     render->add_option("--config", o.config, "JSON config with the same keys (configs/default.json); options override it");
-    render->add_option("--animation", o.animation, "qsgi-animation transform file (JSON)");
+    render->add_option("--animation", o.animation,
+                       "qsgi-animation transform file (JSON), or gltf (every animation in the scene file at once) or "
+                       "gltf:N (its animation N)");
+    render->add_option("--fps", o.fps, "frames per second at which a glTF animation is sampled (default 24)");
     render->add_option("--estimator", o.estimator, "density estimator: detp, photon-map or impact-count (default)");
     render->add_option("--radius", o.radius, "DETP disc / photon-map search radius, scene units (default 1.5 % of the scene diagonal)");
     render->add_option("--k", o.k, "photon map: nearest impacts per vertex (default 50)");

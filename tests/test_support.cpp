@@ -2,7 +2,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -252,38 +254,73 @@ void addPointLight(Scene& s, Vec3f position, Vec3f intensity) {
 }
 
 void writeQuadGltf(const std::string& path, bool lit) {
-    // Two triangles of a 1 m quad facing +y, positions then indices in one base64 buffer.
-    const float pos[12] = {-0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 0.5f, 0, -0.5f, -0.5f, 0, -0.5f};
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    std::string bytes(reinterpret_cast<const char*>(pos), sizeof pos);
-    bytes.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    // Two triangles of a 1 m quad facing +y.
+    GltfWriter w;
+    const int positions = w.accessor({-0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 0.5f, 0, -0.5f, -0.5f, 0, -0.5f}, "VEC3");
+    const int indices = w.indices({0, 1, 2, 0, 2, 3});
+    w.doc["scenes"] = {{{"nodes", {w.node({{"name", "Quad"}, {"mesh", 0}})}}}};
+    using nlohmann::json;
+    const json primitive = {{"attributes", {{"POSITION", positions}}}, {"indices", indices}, {"material", 0}};
+    w.doc["meshes"] = json::array({{{"primitives", json::array({primitive})}}});
+    const json material = {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}},
+                           {"emissiveFactor", lit ? json({1, 1, 1}) : json({0, 0, 0})}};
+    w.doc["materials"] = json::array({material});
+    w.write(path);
+}
+
+namespace {
+int componentsOf(const std::string& type) {
+    return type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : type == "VEC4" ? 4 : type == "MAT4" ? 16 : 0;
+}
+
+int appendView(testscenes::GltfWriter& w, const void* data, size_t bytes) {
+    while (w.bin.size() % 4) w.bin.push_back('\0');
+    const size_t offset = w.bin.size();
+    w.bin.append(static_cast<const char*>(data), bytes);
+    w.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}});
+    return int(w.doc["bufferViews"].size()) - 1;
+}
+}  // namespace
+
+int GltfWriter::accessor(const std::vector<float>& values, const std::string& type) {
+    const int n = componentsOf(type);
+    const int view = appendView(*this, values.data(), values.size() * sizeof(float));
+    std::vector<float> lo(size_t(n), INFINITY), hi(size_t(n), -INFINITY);
+    for (size_t i = 0; i < values.size(); ++i) {
+        lo[i % size_t(n)] = std::min(lo[i % size_t(n)], values[i]);
+        hi[i % size_t(n)] = std::max(hi[i % size_t(n)], values[i]);
+    }
+    doc["accessors"].push_back({{"bufferView", view}, {"componentType", 5126}, {"count", values.size() / size_t(n)},
+                                {"type", type}, {"min", lo}, {"max", hi}});
+    return int(doc["accessors"].size()) - 1;
+}
+
+int GltfWriter::indices(const std::vector<uint16_t>& values) {
+    const int view = appendView(*this, values.data(), values.size() * sizeof(uint16_t));
+    doc["accessors"].push_back({{"bufferView", view}, {"componentType", 5123}, {"count", values.size()}, {"type", "SCALAR"}});
+    return int(doc["accessors"].size()) - 1;
+}
+
+int GltfWriter::node(nlohmann::json n) {
+    doc["nodes"].push_back(std::move(n));
+    return int(doc["nodes"].size()) - 1;
+}
+
+void GltfWriter::write(const std::string& path) const {
     static const char* b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string enc;
-    for (size_t i = 0; i < bytes.size(); i += 3) {
-        uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
-        if (i + 1 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
-        if (i + 2 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 2]));
+    for (size_t i = 0; i < bin.size(); i += 3) {
+        uint32_t v = uint32_t(uint8_t(bin[i])) << 16;
+        if (i + 1 < bin.size()) v |= uint32_t(uint8_t(bin[i + 1])) << 8;
+        if (i + 2 < bin.size()) v |= uint32_t(uint8_t(bin[i + 2]));
         enc += b64[(v >> 18) & 63];
         enc += b64[(v >> 12) & 63];
-        enc += i + 1 < bytes.size() ? b64[(v >> 6) & 63] : '=';
-        enc += i + 2 < bytes.size() ? b64[v & 63] : '=';
+        enc += i + 1 < bin.size() ? b64[(v >> 6) & 63] : '=';
+        enc += i + 2 < bin.size() ? b64[v & 63] : '=';
     }
-    nlohmann::json m = {
-        {"asset", {{"version", "2.0"}}},
-        {"scene", 0},
-        {"scenes", {{{"nodes", {0}}}}},
-        {"nodes", {{{"name", "Quad"}, {"mesh", 0}}}},
-        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}, {"material", 0}}}}}}},
-        {"materials", {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}},
-                        {"emissiveFactor", lit ? nlohmann::json({1, 1, 1}) : nlohmann::json({0, 0, 0})}}}},
-        {"buffers", {{{"byteLength", bytes.size()}, {"uri", "data:application/octet-stream;base64," + enc}}}},
-        {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
-                         {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 12}}}},
-        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"},
-                        {"min", {-0.5, 0, -0.5}}, {"max", {0.5, 0, 0.5}}},
-                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}}},
-    };
-    std::ofstream(path) << m.dump(1);
+    nlohmann::json out = doc;
+    out["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + enc}}};
+    std::ofstream(path) << out.dump(1);
 }
 
 }  // namespace testscenes

@@ -1,6 +1,8 @@
 // Helpers shared by the tests: paths, scratch folders, scenes built in code, and running the CLI.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <string>
 
@@ -58,4 +60,18 @@ qsgi::Scene creasedSheet(int cells, bool welded, qsgi::Vec3f albedo);
 void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
 // Writes a small glTF (a quad; emissive if lit) with an embedded buffer.
 void writeQuadGltf(const std::string& path, bool lit);
+
+// Assembles a glTF document in memory for tests: the JSON is edited directly, binary data goes
+// through accessor(), and write() embeds the buffer as a base64 data URI.
+struct GltfWriter {
+    nlohmann::json doc = {{"asset", {{"version", "2.0"}}}, {"scene", 0}};
+    std::string bin;
+    // An accessor over `values` (float, or unsigned short if indices) of glTF type `type`
+    // ("SCALAR", "VEC3", …); min and max are set (glTF requires them for POSITION and inputs).
+    int accessor(const std::vector<float>& values, const std::string& type);
+    int indices(const std::vector<uint16_t>& values);
+    // Appends a node and returns its index.
+    int node(nlohmann::json node);
+    void write(const std::string& path) const;
+};
 }  // namespace testscenes

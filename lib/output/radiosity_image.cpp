@@ -11,7 +11,7 @@
 namespace qsgi {
 
 RgbImage renderRadiosityImage(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& solution,
-                              const PerspectiveCamera& camera, const ImageSettings& settings) {
+                              const Camera& camera, const ImageSettings& settings) {
     RgbImage image;
     image.width = settings.width;
     image.height = settings.height;
@@ -29,8 +29,8 @@ RgbImage renderRadiosityImage(const Scene& scene, const SceneBvh& bvh, const Ver
                 for (int s = 0; s < spp; ++s) {
                     const float jx = spp == 1 ? 0.5f : jitter.uniform(uint32_t(s), 0);
                     const float jy = spp == 1 ? 0.5f : jitter.uniform(uint32_t(s), 1);
-                    const Vec3f d = cameraRayDirection(camera, float(x) + jx, float(y) + jy, settings.width, settings.height);
-                    const auto hit = bvh.intersect(camera.position, d, tnear, std::numeric_limits<float>::infinity());
+                    const CameraRay ray = cameraRay(camera, float(x) + jx, float(y) + jy, settings.width, settings.height);
+                    const auto hit = bvh.intersect(ray.origin, ray.direction, tnear, std::numeric_limits<float>::infinity());
                     if (!hit) continue;
                     const Triangle& t = scene.triangles[hit->triangle];
                     const Vec3f b = solution.radiosity[t.v[0]] * (1 - hit->u - hit->v) +

@@ -23,6 +23,6 @@ struct ImageSettings {
 };
 
 RgbImage renderRadiosityImage(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& solution,
-                              const PerspectiveCamera& camera, const ImageSettings& settings);
+                              const Camera& camera, const ImageSettings& settings);
 
 }  // namespace qsgi

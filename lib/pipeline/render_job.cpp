@@ -40,7 +40,7 @@ namespace {
 
 // The config's look-at camera, else --camera N, else the scene's first camera, else one that
 // frames the scene (with a warning).
-PerspectiveCamera resolveCamera(const RenderSettings& s, const Scene& scene, Warnings& warnings) {
+Camera resolveCamera(const RenderSettings& s, const Scene& scene, Warnings& warnings) {
     if (s.camera) {
         try {
             return lookAtCamera(Vec3f(Vec3d(s.camera->position) - scene.worldOrigin),
@@ -85,13 +85,21 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                          "the scene has no lights (no emissive material, no KHR_lights_punctual light); add one with "
                          "\"lights\" in a --config file");
 
-    animation_ = settings_.animationPath.empty() ? Animation::still(scene_)
-                                                 : Animation::fromTransformFile(settings_.animationPath, scene_);
-    if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, settings_.animationPath);
+    // Where the animation comes from, as messages name it.
+    std::string animationSource = settings_.animationPath;
+    const std::optional<int> gltfAnimation =
+        gltfAnimationSelector(settings_.animationPath, settings_.configPath.empty() ? "command line" : settings_.configPath);
+    if (settings_.animationPath.empty()) animation_ = Animation::still(scene_);
+    else if (gltfAnimation) {
+        animationSource = settings_.scenePath + " (--animation " + settings_.animationPath + ")";
+        animation_ = Animation::fromGltf(scene_, *gltfAnimation, settings_.fps.value_or(kDefaultGltfFps), animationSource);
+    } else animation_ = Animation::fromTransformFile(settings_.animationPath, scene_);
+    if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, animationSource);
+    scene_.setRestPose(animation_.localsAt(0));
     scene_.markDynamic(animation_.movedNodes());
     sweepAnimationBounds(scene_, animation_);
     if (!settings_.animationPath.empty())
-        checkSceneExtent(scene_.positions, scene_.animationBounds, settings_.animationPath, "frames");
+        checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");
 
     camera_ = resolveCamera(settings_, scene_, warnings);
     if (!settings_.radiusGiven) settings_.estimator.radius = defaultRadius(scene_);
@@ -107,11 +115,25 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                                  std::to_string(animation_.lastFrame()));
     }
     std::string animationBytes;
-    if (!settings_.animationPath.empty()) {
+    if (gltfAnimation) {
+        // What the run shows of it: every moving node's transform at every frame.
+        for (int frame = 0; frame <= animation_.lastFrame(); ++frame) {
+            const std::vector<Transform> locals = animation_.localsAt(frame);
+            for (int node : animation_.movedNodes())
+                animationBytes.append(reinterpret_cast<const char*>(locals[size_t(node)].m.data()), sizeof(double) * 16);
+        }
+    } else if (!settings_.animationPath.empty()) {
         std::ifstream in(settings_.animationPath, std::ios::binary);
         animationBytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     fingerprint_ = runFingerprint(settings_, scene_, animationBytes, camera_);
+}
+
+Camera RenderJob::cameraAt(int frame) const {
+    // A camera hung from a node follows it (channels on camera nodes move the view only).
+    if (camera_.node < 0) return camera_;
+    return placeCamera(camera_, scene_.worldTransforms(animation_.localsAt(frame))[size_t(camera_.node)],
+                       scene_.worldOrigin);
 }
 
 namespace {
@@ -243,7 +265,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     auto fixPreviews = [&](const VertexRadiosity& result, const SceneBvh& bvh) {
         tonemap = PreviewTonemap::fromPercentile(result.radiosity);
         if (settings_.writePng && !exposure)
-            exposure = automaticExposure(renderRadiosityImage(scene_, bvh, result, camera_, imageSettings));
+            exposure = automaticExposure(renderRadiosityImage(scene_, bvh, result, cameraAt(0), imageSettings));
     };
     if (start > 0) {
         FrameWork work;
@@ -286,7 +308,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         std::optional<RgbImage> image;
         Stopwatch clock;
         if (settings_.writeExr || settings_.writePng) {
-            image = renderRadiosityImage(scene_, solver.bvh(), result, camera_, imageSettings);
+            image = renderRadiosityImage(scene_, solver.bvh(), result, cameraAt(frame), imageSettings);
             timing.renderSeconds = clock.seconds();
         }
 

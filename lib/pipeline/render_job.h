@@ -49,7 +49,8 @@ public:
 private:
     RenderSettings settings_;
     Scene scene_;
-    PerspectiveCamera camera_;
+    Camera camera_;  // at frame 0
+    Camera cameraAt(int frame) const;
     Animation animation_;
     int first_ = 0, last_ = 0;
     std::string fingerprint_;  // runFingerprint of the inputs and settings

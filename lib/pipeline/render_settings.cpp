@@ -55,6 +55,15 @@ DetpBoundary parseDetpBoundary(const std::string& name, const std::string& sourc
                      "unknown boundary rule '" + name + "' (clip: default, linear: first-order edge correction, paper: the published rule)");
 }
 
+std::optional<int> gltfAnimationSelector(const std::string& animation, const std::string& source) {
+    if (animation == "gltf") return -1;
+    if (animation.rfind("gltf:", 0) != 0) return std::nullopt;
+    const std::string digits = animation.substr(5);
+    if (digits.empty() || digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos)
+        throw InputError(source, "animation", "'" + animation + "' is not gltf or gltf:N with N a glTF animation index");
+    return std::stoi(digits);
+}
+
 float defaultRadius(const Scene& scene) { return 0.015f * std::max(scene.animationBounds.extent(), 1e-6f); }
 
 FrameRange parseFrameRange(const std::string& text, const std::string& source) {
@@ -127,7 +136,7 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
 }
 
 const std::vector<std::string> kConfigKeys = {
-    "scene", "animation", "out", "estimator", "radius", "k", "ray_cache", "sort_queries", "full_recompute",
+    "scene", "animation", "fps", "out", "estimator", "radius", "k", "ray_cache", "sort_queries", "full_recompute",
     "envelope", "blocking_grid", "detp_index", "detp_boundary", "photons", "seed", "max_bounces", "threads",
     "frames", "lights", "width", "height", "spp", "exr", "exr_half", "png", "exposure", "camera"};
 
@@ -159,7 +168,14 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
             return v.get<std::string>();
         };
         if (key == "scene") s.scenePath = resolve(str());
-        else if (key == "animation") s.animationPath = resolve(str());
+        else if (key == "animation") {
+            s.animationPath = str();
+            if (!gltfAnimationSelector(s.animationPath, path)) s.animationPath = resolve(s.animationPath);
+        } else if (key == "fps") {
+            if (!v.is_number() || !(v.get<double>() > 0) || !(v.get<double>() <= 1e6))
+                throw InputError(path, key, "must be a positive number of frames per second (at most 10^6)");
+            s.fps = v.get<double>();
+        }
         else if (key == "out") s.outDir = str();
         else if (key == "estimator") s.estimator.kind = parseEstimator(str(), path);
         else if (key == "radius") {

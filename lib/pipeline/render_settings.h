@@ -22,7 +22,8 @@ struct FrameRange {
 struct RenderSettings {
     std::string configPath;     // the config file read, if any (for messages)
     std::string scenePath;
-    std::string animationPath;  // empty: no animation (one frame, 0)
+    std::string animationPath;  // empty: no animation (one frame, 0); "gltf" or "gltf:N": the scene's own
+    std::optional<double> fps;  // frames per second at which a glTF animation is sampled (default 24)
     std::string outDir = "out";
     EstimatorSettings estimator;     // radius 0 here: chosen from the scene (defaultRadius)
     bool radiusGiven = false;
@@ -72,6 +73,11 @@ uint64_t checkedPhotons(int64_t value, const std::string& source, const std::str
 void applyConfigFile(const std::string& path, RenderSettings& settings);
 // The same for a config already parsed (`path` names it in messages and resolves relative paths).
 void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderSettings& settings);
+
+// The glTF animation an --animation value names: nullopt for a transform file, -1 for "gltf" (every
+// animation of the scene at once), N for "gltf:N". Throws InputError for "gltf:" without a valid N.
+std::optional<int> gltfAnimationSelector(const std::string& animation, const std::string& source);
+constexpr double kDefaultGltfFps = 24;
 
 // Parses "A:B" (inclusive, as in Blender) or "A". Throws InputError naming `source`.
 FrameRange parseFrameRange(const std::string& text, const std::string& source);

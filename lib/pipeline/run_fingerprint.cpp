@@ -35,7 +35,7 @@ private:
 }  // namespace
 
 std::string runFingerprint(const RenderSettings& s, const Scene& scene, const std::string& animationBytes,
-                           const PerspectiveCamera& camera) {
+                           const Camera& camera) {
     Fingerprinter f;
     f.add(std::string(QSGI_VERSION));
     // The scene as loaded (rest pose), whatever files it came from.
@@ -69,6 +69,9 @@ std::string runFingerprint(const RenderSettings& s, const Scene& scene, const st
     f.addValue(camera.forward);
     f.addValue(camera.up);
     f.addValue(camera.yfov);
+    f.addValue(int(camera.projection));
+    f.addValue(camera.ymag);
+    f.addValue(camera.node);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(f.result()));
     return hex;

@@ -20,6 +20,6 @@ namespace qsgi {
 // 16 hex digits. `animationBytes`: the transform file's contents ("" for a still scene). `scene`
 // must be in its rest pose. `settings` must hold the radius actually used.
 std::string runFingerprint(const RenderSettings& settings, const Scene& scene, const std::string& animationBytes,
-                           const PerspectiveCamera& camera);
+                           const Camera& camera);
 
 }  // namespace qsgi

@@ -3,7 +3,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 
 #include "util/error.h"
@@ -107,7 +109,6 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
     if (!doc.contains("frames") || !doc["frames"].is_array() || doc["frames"].empty())
         throw InputError(path, "frames", "must be a non-empty array");
 
-    std::set<int> moved;
     int previousFrame = -1;
     for (size_t i = 0; i < doc["frames"].size(); ++i) {
         const json& f = doc["frames"][i];
@@ -133,20 +134,96 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
                     throw InputError(path, place + ", node '" + it.key() + "'",
                                      "no such node in " + scene.sourcePath + didYouMean(it.key(), names));
                 }
-                const Transform t = parseNodeTransform(it.value(), path, place + ", node '" + it.key() + "'");
-                key.nodes.emplace_back(node, t);
-                if (!(t == a.rest_[node])) moved.insert(node);
+                key.nodes.emplace_back(node, parseNodeTransform(it.value(), path, place + ", node '" + it.key() + "'"));
             }
         }
         a.keys_.push_back(std::move(key));
     }
     a.lastFrame_ = previousFrame;
-    a.moved_.assign(moved.begin(), moved.end());
+    a.findMovedNodes();
     return a;
+}
+
+Animation Animation::fromGltf(const Scene& scene, int index, double fps, const std::string& source) {
+    if (scene.animations.empty()) throw InputError(source, "", "the scene has no glTF animation");
+    auto listing = [&] {
+        std::string names;
+        for (size_t i = 0; i < scene.animations.size(); ++i)
+            names += (i ? ", " : "") + std::to_string(i) + " '" + scene.animations[i].name + "'";
+        return " (the file has " + names + ")";
+    };
+    if (index < -1 || index >= int(scene.animations.size()))
+        throw InputError(source, "", "there is no glTF animation " + std::to_string(index) + listing());
+    if (!(fps > 0) || !std::isfinite(fps)) throw InputError(source, "fps", "must be a positive number");
+    std::vector<const KeyframeAnimation*> played;
+    for (size_t i = 0; i < scene.animations.size(); ++i)
+        if (index < 0 || int(i) == index) played.push_back(&scene.animations[i]);
+    // Played together, two animations must not drive one property of one node.
+    std::map<std::pair<int, AnimatedProperty>, const KeyframeAnimation*> driver;
+    std::set<int> animated;
+    double end = 0;
+    for (const KeyframeAnimation* anim : played) {
+        end = std::max(end, anim->endTime);
+        for (const AnimationChannel& c : anim->channels) {
+            if (c.property == AnimatedProperty::Weights) continue;
+            auto [it, fresh] = driver.emplace(std::make_pair(c.node, c.property), anim);
+            if (!fresh)
+                throw InputError(source, "", "animations '" + it->second->name + "' and '" + anim->name +
+                                                 "' both drive the " + animatedPropertyName(c.property) + " of node '" +
+                                                 scene.nodes[c.node].name + "'; choose one with --animation gltf:N" +
+                                                 listing());
+            animated.insert(c.node);
+        }
+    }
+    // Frame f shows time f / fps; the last frame is the first at or past the last key. Key times
+    // are float32, so a key meant for frame 41 may lie a few ulps past it: that is frame 41.
+    const double lastFrame = std::ceil(end * fps * (1 - 1e-6));
+    if (!(lastFrame <= 10000000))
+        throw InputError(source, "fps", "the animation's " + std::to_string(end) + " s at " + std::to_string(fps) +
+                                            " frames per second exceed 10^7 frames");
+    Animation a = still(scene);
+    a.fps_ = fps;
+    a.lastFrame_ = int(std::max(0.0, lastFrame));
+    a.everyFrameKeyed_ = true;
+    std::vector<NodeTrs> rest(scene.nodes.size());
+    for (size_t n = 0; n < scene.nodes.size(); ++n)
+        if (scene.nodes[n].trs) rest[n] = *scene.nodes[n].trs;
+    for (int frame = 0; frame <= a.lastFrame_; ++frame) {
+        const double time = frame / fps;
+        std::vector<NodeTrs> trs = rest;
+        for (const KeyframeAnimation* anim : played) anim->apply(time, trs);
+        Key key{frame, {}};
+        for (int node : animated) {
+            const Transform t = trs[node].matrix();
+            if (!t.isFinite() || !(std::fabs(t.determinant3x3()) > 1e-12))
+                throw InputError(source, "frame " + std::to_string(frame) + " (" + std::to_string(time) + " s), node '" +
+                                             scene.nodes[node].name + "'",
+                                 "the animated transform is not invertible (a zero scale?), which qsgi cannot light");
+            key.nodes.emplace_back(node, t);
+        }
+        a.keys_.push_back(std::move(key));
+    }
+    a.findMovedNodes();
+    return a;
+}
+
+void Animation::findMovedNodes() {
+    // Between keys nothing changes, so a node moves iff some key gives it another transform than
+    // it has at frame 0.
+    const std::vector<Transform> first = localsAt(0);
+    std::set<int> moved;
+    for (const Key& k : keys_)
+        for (const auto& [node, t] : k.nodes)
+            if (!(t == first[node])) moved.insert(node);
+    moved_.assign(moved.begin(), moved.end());
 }
 
 std::vector<Transform> Animation::localsAt(int frame) const {
     std::vector<Transform> locals = rest_;
+    if (everyFrameKeyed_) {
+        for (const auto& [node, t] : keys_[size_t(std::clamp(frame, 0, lastFrame_))].nodes) locals[node] = t;
+        return locals;
+    }
     for (const Key& k : keys_) {
         if (k.frame > frame) break;
         for (const auto& [node, t] : k.nodes) locals[node] = t;

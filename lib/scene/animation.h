@@ -1,5 +1,10 @@
-// Per-frame node transforms (DESIGN §3) from a qsgi-animation transform file. A node's entry
-// replaces its local transform; nodes not listed keep their last transform.
+// Per-frame node transforms (DESIGN §3), from a qsgi-animation transform file (a node's entry
+// replaces its local transform; nodes not listed keep their last transform) or from the scene's
+// own glTF animations, sampled at a frame rate (frame f shows time f / fps).
+//
+// A node moves if its local transform at some frame differs from frame 0's: constant channels,
+// which exporters write for every node, move nothing. Frame 0's pose is the scene's rest pose for
+// the run (Scene::setRestPose), so static geometry is placed, and built into the BVH, once.
 #pragma once
 
 #include <nlohmann/json_fwd.hpp>
@@ -21,12 +26,17 @@ public:
     // The same for a transform file already parsed as JSON (`path` names it in messages; the
     // fuzzer uses this). Wrong JSON types may also throw nlohmann::json::exception.
     static Animation parseTransformFile(const std::string& path, const nlohmann::json& doc, const Scene& scene);
+    // The scene's glTF animation `index` (all of them at once if -1), sampled at `fps` from time
+    // 0 through the last key. `source` names the animation in messages (e.g. "scene.gltf,
+    // --animation gltf:1"). Throws InputError if there is no such animation, if animations played
+    // together drive the same node property, or if a frame's transform is not invertible.
+    static Animation fromGltf(const Scene& scene, int index, double fps, const std::string& source);
 
     int lastFrame() const { return lastFrame_; }
     double fps() const { return fps_; }
     // Local transform of every node at the frame (frames past the last keep the last pose).
     std::vector<Transform> localsAt(int frame) const;
-    // Nodes whose local transform differs from the rest pose in some frame.
+    // Nodes whose local transform differs from frame 0's in some frame.
     const std::vector<int>& movedNodes() const { return moved_; }
 
 private:
@@ -34,8 +44,11 @@ private:
         int frame;
         std::vector<std::pair<int, Transform>> nodes;
     };
+    void findMovedNodes();
+
     std::vector<Transform> rest_;
     std::vector<Key> keys_;  // increasing frame
+    bool everyFrameKeyed_ = false;  // keys_[f] is frame f and lists every animated node
     std::vector<int> moved_;
     int lastFrame_ = 0;
     double fps_ = 24;

@@ -5,8 +5,8 @@
 
 namespace qsgi {
 
-PerspectiveCamera lookAtCamera(const Vec3f& position, const Vec3f& target, const Vec3f& up, float yfov) {
-    PerspectiveCamera c;
+Camera lookAtCamera(const Vec3f& position, const Vec3f& target, const Vec3f& up, float yfov) {
+    Camera c;
     c.position = position;
     c.forward = normalize(target - position);
     c.up = normalize(up);
@@ -17,7 +17,7 @@ PerspectiveCamera lookAtCamera(const Vec3f& position, const Vec3f& target, const
     return c;
 }
 
-PerspectiveCamera framingCamera(const Bounds3f& bounds, float aspect) {
+Camera framingCamera(const Bounds3f& bounds, float aspect) {
     const Vec3f centre = bounds.center();
     const float radius = std::max(0.5f * bounds.extent(), 1e-3f);
     const float yfov = 0.8f;
@@ -28,14 +28,23 @@ PerspectiveCamera framingCamera(const Bounds3f& bounds, float aspect) {
     return lookAtCamera(centre + direction * distance, centre, Vec3f(0, 1, 0), yfov);
 }
 
-Vec3f cameraRayDirection(const PerspectiveCamera& c, float x, float y, int width, int height) {
+Camera placeCamera(Camera lens, const Transform& world, const Vec3d& worldOrigin) {
+    lens.position = Vec3f(world.applyPoint(Vec3d(0.0)) - worldOrigin);
+    lens.forward = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
+    lens.up = Vec3f(normalize(world.applyVector(Vec3d(0, 1, 0))));
+    return lens;
+}
+
+CameraRay cameraRay(const Camera& c, float x, float y, int width, int height) {
     const Vec3f right = normalize(cross(c.forward, c.up));
     const Vec3f up = cross(right, c.forward);
-    const float tanHalf = std::tan(c.yfov / 2);
     const float aspect = float(width) / float(height);
-    const float sx = (2 * x / float(width) - 1) * tanHalf * aspect;
-    const float sy = (1 - 2 * y / float(height)) * tanHalf;
-    return normalize(c.forward + right * sx + up * sy);
+    // Image position in [-1, 1]² (y up), scaled to the view's half extents.
+    const float u = (2 * x / float(width) - 1) * aspect, v = 1 - 2 * y / float(height);
+    if (c.projection == Projection::Orthographic)
+        return {c.position + right * (u * c.ymag) + up * (v * c.ymag), c.forward};
+    const float tanHalf = std::tan(c.yfov / 2);
+    return {c.position, normalize(c.forward + right * (u * tanHalf) + up * (v * tanHalf))};
 }
 
 }  // namespace qsgi

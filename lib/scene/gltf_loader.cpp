@@ -10,6 +10,8 @@
 #include <fstream>
 #include <set>
 
+#include "scene/gltf_accessor.h"
+#include "scene/gltf_animation.h"
 #include "scene/gltf_document.h"
 #include "util/memory.h"
 
@@ -23,17 +25,8 @@ const std::set<std::string> kSupportedExtensions = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization",
     "KHR_texture_transform"};
 
-std::string at(const std::string& what, int index) { return what + "[" + std::to_string(index) + "]"; }
-
-// Accessor Formats
 // What the glTF 2.0 specification (§3.7.2.1, and KHR_mesh_quantization when the file requires it)
-// allows for the accessors qsgi reads: their element type, component types and normalisation.
-struct AccessorFormat {
-    int type;  // TINYGLTF_TYPE_*
-    std::vector<std::pair<int, bool>> allowed;           // (componentType, normalized)
-    std::vector<std::pair<int, bool>> allowedQuantized;  // more, with KHR_mesh_quantization
-};
-
+// allows for the mesh accessors qsgi reads.
 const AccessorFormat kPositionFormat{
     TINYGLTF_TYPE_VEC3,
     {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}},
@@ -51,183 +44,6 @@ const AccessorFormat kIndexFormat{
      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, false}},
     {}};
 
-std::string componentTypeName(int type) {
-    switch (type) {
-        case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
-        case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
-        case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
-        default: return "componentType " + std::to_string(type);
-    }
-}
-
-// Accessor Decoding
-// An accessor's elements as doubles, `components` per element, normalised integers mapped to
-// [0,1] or [-1,1] as the glTF spec says. Every offset is bounds-checked against its buffer, and
-// sizes against the machine's memory, before anything is allocated.
-struct AccessorData {
-    size_t count = 0;
-    int components = 0;
-    std::vector<double> values;
-    double operator()(size_t element, int component) const { return values[element * components + component]; }
-};
-
-class AccessorReader {
-public:
-    AccessorReader(const GltfDocument& document, const std::string& file)
-        : model_(document.model), absentBuffers_(document.absentBuffers), file_(file) {
-        for (const auto& ext : model_.extensionsRequired) quantized_ = quantized_ || ext == "KHR_mesh_quantization";
-    }
-
-    AccessorData read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const {
-        const std::string place = usedBy + " -> " + at("accessors", accessorIndex);
-        if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
-            throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) +
-                                                ", which does not exist");
-        const tinygltf::Accessor& acc = model_.accessors[accessorIndex];
-        checkFormat(acc, format, place);
-        AccessorData out;
-        out.count = acc.count;
-        out.components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-        refuseBeyondMemory(saturatingMultiply(acc.count, uint64_t(out.components) * sizeof(double)), file_, place,
-                           "its " + std::to_string(acc.count) + " elements");
-        if (acc.bufferView >= 0)
-            checkRange(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, out.components, place);
-        out.values.assign(acc.count * size_t(out.components), 0.0);
-        // Without a bufferView the elements are zeros, typically overridden by sparse values.
-        if (acc.bufferView >= 0)
-            decode(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, acc.normalized, out.components,
-                   out.values.data(), nullptr);
-        if (acc.sparse.isSparse) applySparse(acc, out, place);
-        for (double v : out.values)
-            if (!std::isfinite(v)) throw InputError(file_, place, "holds a non-finite number (NaN or Inf)");
-        return out;
-    }
-
-private:
-    void checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const {
-        const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-        if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
-            throw InputError(file_, place, "unknown accessor type or componentType");
-        if (acc.type != format.type)
-            throw InputError(file_, place, std::string("must be of type ") +
-                                               (format.type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR"));
-        const std::pair<int, bool> used{acc.componentType, acc.normalized};
-        auto allows = [&](const std::vector<std::pair<int, bool>>& list) {
-            return std::find(list.begin(), list.end(), used) != list.end();
-        };
-        if (allows(format.allowed) || (quantized_ && allows(format.allowedQuantized))) return;
-        const std::string what = (acc.normalized ? "normalized " : "") + componentTypeName(acc.componentType);
-        if (allows(format.allowedQuantized))
-            throw InputError(file_, place, what + " components need the KHR_mesh_quantization extension, which the "
-                                                  "file does not list in extensionsRequired");
-        throw InputError(file_, place, what + " components are not allowed here by the glTF 2.0 specification");
-    }
-
-    // Checks that `count` elements from a buffer view lie inside the view and its buffer, with
-    // the alignment and stride the specification requires.
-    void checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
-                    const std::string& place) const {
-        if (viewIndex < 0 || viewIndex >= int(model_.bufferViews.size()))
-            throw InputError(file_, place, "refers to bufferView " + std::to_string(viewIndex) + ", which does not exist");
-        const std::string viewPlace = at("bufferViews", viewIndex);
-        const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
-        if (view.buffer < 0 || view.buffer >= int(model_.buffers.size()))
-            throw InputError(file_, viewPlace, "refers to a buffer that does not exist");
-        if (absentBuffers_.count(view.buffer))
-            throw InputError(file_, viewPlace, "reads buffer " + std::to_string(view.buffer) +
-                                                   ", which has no uri and so no data");
-        const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
-        if (uint64_t(view.byteOffset) + uint64_t(view.byteLength) > buffer.data.size())
-            throw InputError(file_, viewPlace,
-                             "reaches byte " + std::to_string(uint64_t(view.byteOffset) + view.byteLength) + " of buffer " +
-                                 std::to_string(view.buffer) + ", which holds only " + std::to_string(buffer.data.size()));
-        const uint64_t componentSize = uint64_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
-        const uint64_t elementSize = componentSize * uint64_t(components);
-        if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
-            throw InputError(file_, viewPlace + ".byteStride",
-                             std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
-        if (view.byteStride != 0 && view.byteStride < elementSize)
-            throw InputError(file_, viewPlace + ".byteStride", std::to_string(view.byteStride) + " is smaller than the " +
-                                                                   std::to_string(elementSize) + "-byte elements of " + place);
-        if (byteOffset % componentSize != 0 || (view.byteOffset + byteOffset) % componentSize != 0)
-            throw InputError(file_, place, "byteOffset is not a multiple of its " + std::to_string(componentSize) +
-                                               "-byte component size");
-        const uint64_t stride = view.byteStride ? view.byteStride : elementSize;
-        if (count > 0 && uint64_t(byteOffset) + saturatingMultiply(stride, count - 1) + elementSize > view.byteLength)
-            throw InputError(file_, place, "reads past the end of bufferView " + std::to_string(viewIndex));
-    }
-
-    // Decodes `count` elements (checked by checkRange) into `doubles` or, for sparse indices,
-    // into `indices`.
-    void decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized,
-                int components, double* doubles, std::vector<size_t>* indices) const {
-        const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
-        const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
-        const size_t componentSize = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
-        const size_t elementSize = componentSize * size_t(components);
-        const size_t stride = view.byteStride ? view.byteStride : elementSize;
-        const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
-        for (size_t e = 0; e < count; ++e) {
-            const unsigned char* element = base + e * stride;
-            for (int c = 0; c < components; ++c) {
-                const double v = component(element + c * componentSize, componentType, normalized);
-                if (indices) (*indices)[e] = size_t(v);
-                else doubles[e * components + c] = v;
-            }
-        }
-    }
-
-    static double component(const unsigned char* p, int type, bool normalized) {
-        switch (type) {
-            case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0, -1.0) : v; }
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { uint8_t v; std::memcpy(&v, p, 1); return normalized ? v / 255.0 : v; }
-            case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? v / 4294967295.0 : v; }
-            case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
-            default: return 0;
-        }
-    }
-
-    void applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const {
-        if (acc.sparse.count < 1 || size_t(acc.sparse.count) > out.count)
-            throw InputError(file_, place + ".sparse.count", std::to_string(acc.sparse.count) +
-                                                                 " is outside 1..count of the accessor");
-        const size_t n = size_t(acc.sparse.count);
-        const int indexType = acc.sparse.indices.componentType;
-        if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-            indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-            throw InputError(file_, place + ".sparse.indices.componentType", "must be an unsigned integer type");
-        checkRange(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, 1,
-                   place + ".sparse.indices");
-        checkRange(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
-                   out.components, place + ".sparse.values");
-        std::vector<size_t> targets(n);
-        decode(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, false, 1, nullptr,
-               &targets);
-        std::vector<double> values(n * size_t(out.components));
-        decode(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
-               acc.normalized, out.components, values.data(), nullptr);
-        for (size_t i = 0; i < n; ++i) {
-            if (targets[i] >= out.count)
-                throw InputError(file_, place + ".sparse.indices", "index " + std::to_string(targets[i]) +
-                                                                       " is beyond the accessor's count");
-            if (i > 0 && targets[i] <= targets[i - 1])
-                throw InputError(file_, place + ".sparse.indices", "must strictly increase (index " +
-                                                                       std::to_string(targets[i]) + " follows " +
-                                                                       std::to_string(targets[i - 1]) + ")");
-            for (int c = 0; c < out.components; ++c) out.values[targets[i] * out.components + c] = values[i * out.components + c];
-        }
-    }
-
-    const tinygltf::Model& model_;
-    const std::set<int>& absentBuffers_;
-    const std::string& file_;
-    bool quantized_ = false;
-};
 
 // Textures and Materials
 double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
@@ -264,7 +80,7 @@ Vec3f vec3FromFactor(const std::vector<double>& f, Vec3f fallback) {
 
 Material convertMaterial(const tinygltf::Model& model, int index, const std::string& file, Warnings& warnings) {
     const tinygltf::Material& m = model.materials[index];
-    const std::string place = at("materials", index);
+    const std::string place = gltfPlace("materials", index);
     Material out;
     out.name = m.name;
     const auto& pbr = m.pbrMetallicRoughness;
@@ -300,20 +116,20 @@ Material convertMaterial(const tinygltf::Model& model, int index, const std::str
 }
 
 // Node Hierarchy
-Transform nodeLocalTransform(const tinygltf::Node& n, const std::string& file, int index) {
-    const std::string place = at("nodes", index);
-    Transform t;
-    if (n.matrix.size() == 16) {
-        t = Transform::fromColumnMajor(n.matrix.data());
-    } else {
-        Vec3d tr(0.0), sc(1.0);
-        std::array<double, 4> rot{0, 0, 0, 1};
-        if (n.translation.size() == 3) tr = {n.translation[0], n.translation[1], n.translation[2]};
-        if (n.scale.size() == 3) sc = {n.scale[0], n.scale[1], n.scale[2]};
-        if (n.rotation.size() == 4) rot = {n.rotation[0], n.rotation[1], n.rotation[2], n.rotation[3]};
-        t = Transform::fromTRS(tr, rot, sc);
-    }
-    if (!t.isFinite()) throw InputError(file, place, "transform holds a non-finite number");
+// The node's TRS properties (nullopt if it gives a matrix) and its local transform.
+std::optional<NodeTrs> nodeTrs(const tinygltf::Node& n) {
+    if (n.matrix.size() == 16) return std::nullopt;
+    NodeTrs trs;
+    if (n.translation.size() == 3) trs.translation = {n.translation[0], n.translation[1], n.translation[2]};
+    if (n.scale.size() == 3) trs.scale = {n.scale[0], n.scale[1], n.scale[2]};
+    if (n.rotation.size() == 4) trs.rotation = {n.rotation[0], n.rotation[1], n.rotation[2], n.rotation[3]};
+    return trs;
+}
+
+Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTrs>& trs, const std::string& file,
+                             int index) {
+    const Transform t = trs ? trs->matrix() : Transform::fromColumnMajor(n.matrix.data());
+    if (!t.isFinite()) throw InputError(file, gltfPlace("nodes", index), "transform holds a non-finite number");
     return t;
 }
 
@@ -321,15 +137,16 @@ std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::s
     std::vector<SceneNode> nodes(model.nodes.size());
     for (size_t i = 0; i < model.nodes.size(); ++i) {
         nodes[i].name = model.nodes[i].name;
-        nodes[i].local = nodeLocalTransform(model.nodes[i], file, int(i));
+        nodes[i].trs = nodeTrs(model.nodes[i]);
+        nodes[i].local = nodeLocalTransform(model.nodes[i], nodes[i].trs, file, int(i));
         for (int c : model.nodes[i].children) {
             if (c < 0 || c >= int(nodes.size()))
-                throw InputError(file, at("nodes", int(i)) + ".children", "refers to node " + std::to_string(c) + ", which does not exist");
-            if (c == int(i)) throw InputError(file, at("nodes", int(i)), "is its own child (the hierarchy has a cycle)");
+                throw InputError(file, gltfPlace("nodes", int(i)) + ".children", "refers to node " + std::to_string(c) + ", which does not exist");
+            if (c == int(i)) throw InputError(file, gltfPlace("nodes", int(i)), "is its own child (the hierarchy has a cycle)");
             if (std::count(nodes[i].children.begin(), nodes[i].children.end(), c))
-                throw InputError(file, at("nodes", int(i)) + ".children", "lists node " + std::to_string(c) + " twice");
+                throw InputError(file, gltfPlace("nodes", int(i)) + ".children", "lists node " + std::to_string(c) + " twice");
             if (nodes[c].parent >= 0 && nodes[c].parent != int(i))
-                throw InputError(file, at("nodes", c), "has two parents (nodes " + std::to_string(nodes[c].parent) +
+                throw InputError(file, gltfPlace("nodes", c), "has two parents (nodes " + std::to_string(nodes[c].parent) +
                                                            " and " + std::to_string(i) + "); glTF nodes form a tree");
             nodes[c].parent = int(i);
             nodes[i].children.push_back(c);
@@ -341,7 +158,7 @@ std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::s
         size_t steps = 0;
         while (p >= 0) {
             if (++steps > nodes.size())
-                throw InputError(file, at("nodes", int(i)), "is its own descendant (the hierarchy has a cycle)");
+                throw InputError(file, gltfPlace("nodes", int(i)), "is its own descendant (the hierarchy has a cycle)");
             p = nodes[p].parent;
         }
     }
@@ -385,16 +202,16 @@ public:
         if (sceneIndex >= int(model_.scenes.size()))
             throw InputError(file_, "scene", "names scene " + std::to_string(sceneIndex) + ", which does not exist");
         const auto& roots = model_.scenes[sceneIndex].nodes;
-        if (roots.empty()) throw InputError(file_, at("scenes", sceneIndex), "has no nodes: nothing to render");
+        if (roots.empty()) throw InputError(file_, gltfPlace("scenes", sceneIndex), "has no nodes: nothing to render");
 
         const std::vector<Transform> world = scene.worldTransforms(scene.restLocals());
         std::vector<uint8_t> visited(scene.nodes.size(), 0);
         std::vector<int> stack;
         for (int r : roots) {
             if (r < 0 || r >= int(scene.nodes.size()))
-                throw InputError(file_, at("scenes", sceneIndex) + ".nodes", "refers to node " + std::to_string(r) + ", which does not exist");
+                throw InputError(file_, gltfPlace("scenes", sceneIndex) + ".nodes", "refers to node " + std::to_string(r) + ", which does not exist");
             if (scene.nodes[r].parent >= 0)
-                throw InputError(file_, at("scenes", sceneIndex) + ".nodes", "lists node " + std::to_string(r) + ", which is not a root");
+                throw InputError(file_, gltfPlace("scenes", sceneIndex) + ".nodes", "lists node " + std::to_string(r) + ", which is not a root");
             stack.push_back(r);
         }
         // Depth-first in file order, so vertex numbering is stable across runs.
@@ -409,6 +226,7 @@ public:
             for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
         }
         scene.cameras.resize(model_.cameras.size());
+        scene.animations = readGltfAnimations(model_, reader_, file_, warnings_);
         scene.finalize();
         checkSceneExtent(scene.positions, scene.bounds(), file_, "nodes");
         return scene;
@@ -419,11 +237,11 @@ private:
         const tinygltf::Node& node = model_.nodes[n];
         if (node.mesh >= 0) {
             if (node.mesh >= int(model_.meshes.size()))
-                throw InputError(file_, at("nodes", n) + ".mesh", "refers to mesh " + std::to_string(node.mesh) + ", which does not exist");
+                throw InputError(file_, gltfPlace("nodes", n) + ".mesh", "refers to mesh " + std::to_string(node.mesh) + ", which does not exist");
             if (node.skin >= 0) warnings_.add(file_ + ": skins are not applied; the base mesh is used");
             const tinygltf::Mesh& mesh = model_.meshes[node.mesh];
             for (size_t p = 0; p < mesh.primitives.size(); ++p)
-                addPrimitive(scene, n, mesh.primitives[p], at("meshes", node.mesh) + "." + at("primitives", int(p)));
+                addPrimitive(scene, n, mesh.primitives[p], gltfPlace("meshes", node.mesh) + "." + gltfPlace("primitives", int(p)));
         }
         if (node.camera >= 0) addCamera(scene, n, world);
         auto light = node.extensions.find("KHR_lights_punctual");
@@ -507,29 +325,44 @@ private:
     void addCamera(Scene& scene, int n, const Transform& world) {
         const tinygltf::Node& node = model_.nodes[n];
         if (node.camera >= int(model_.cameras.size()))
-            throw InputError(file_, at("nodes", n) + ".camera", "refers to a camera that does not exist");
+            throw InputError(file_, gltfPlace("nodes", n) + ".camera", "refers to a camera that does not exist");
         const tinygltf::Camera& cam = model_.cameras[node.camera];
         scene.cameras.resize(model_.cameras.size());
         if (scene.cameras[node.camera]) return;  // the first node using a camera places it
-        if (cam.type != "perspective") {
-            warnings_.add(file_ + ": " + at("cameras", node.camera) + ": only perspective cameras are used; skipped");
-            return;
+        Camera lens;
+        lens.node = n;
+        if (cam.type == "perspective") {
+            lens.yfov = float(cam.perspective.yfov);
+            lens.aspect = float(cam.perspective.aspectRatio);
+            lens.znear = float(cam.perspective.znear);
+            if (!(lens.yfov > 0 && lens.yfov < 3.14159f))
+                throw InputError(file_, gltfPlace("cameras", node.camera) + ".perspective.yfov", "must lie in (0, pi)");
+        } else if (cam.type == "orthographic") {
+            lens.projection = Projection::Orthographic;
+            // The specification forbids zero magnifications and advises against negative ones.
+            const double xmag = std::fabs(cam.orthographic.xmag), ymag = std::fabs(cam.orthographic.ymag);
+            if (!(xmag > 0 && ymag > 0 && xmag < 1e30 && ymag < 1e30))
+                throw InputError(file_, gltfPlace("cameras", node.camera) + ".orthographic",
+                                 "xmag and ymag must be non-zero and finite");
+            lens.ymag = float(ymag);
+            lens.aspect = float(xmag / ymag);
+            lens.znear = float(cam.orthographic.znear);
+        } else {
+            throw InputError(file_, gltfPlace("cameras", node.camera) + ".type",
+                             "'" + cam.type + "' is not perspective or orthographic");
         }
-        PerspectiveCamera c;
-        c.position = Vec3f(world.applyPoint(Vec3d(0.0)));
-        c.forward = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
-        c.up = Vec3f(normalize(world.applyVector(Vec3d(0, 1, 0))));
-        c.yfov = float(cam.perspective.yfov);
-        c.aspect = float(cam.perspective.aspectRatio);
-        c.znear = float(cam.perspective.znear);
-        if (!(c.yfov > 0 && c.yfov < 3.14159f) || !isFinite(c.position) || !isFinite(c.forward))
-            throw InputError(file_, at("cameras", node.camera), "yfov must lie in (0, pi) and the camera node's transform must be finite");
+        if (!(lens.znear >= 0) || !std::isfinite(lens.znear))
+            throw InputError(file_, gltfPlace("cameras", node.camera), "znear must be non-negative and finite");
+        // World space here: Scene::finalize re-centres it with the lights.
+        const Camera c = placeCamera(lens, world, Vec3d(0.0));
+        if (!isFinite(c.position) || !isFinite(c.forward) || !isFinite(c.up))
+            throw InputError(file_, gltfPlace("nodes", n), "the camera node's transform is not finite or not invertible");
         scene.cameras[node.camera] = c;
         if (!scene.camera) scene.camera = c;
     }
 
     void addLight(Scene& scene, int n, const Transform& world, const tinygltf::Value& ref) {
-        const std::string place = at("nodes", n) + ".extensions.KHR_lights_punctual.light";
+        const std::string place = gltfPlace("nodes", n) + ".extensions.KHR_lights_punctual.light";
         if (!ref.IsNumber()) throw InputError(file_, place, "must be a light index");
         const int index = ref.GetNumberAsInt();
         if (index < 0 || index >= int(model_.lights.size()))
@@ -540,20 +373,19 @@ private:
         out.node = n;
         const Vec3f colour = vec3FromFactor(l.color, Vec3f(1.0f));
         out.intensity = colour * float(l.intensity);
-        out.position = Vec3f(world.applyPoint(Vec3d(0.0)));  // world space; Scene::finalize re-centres it
-        out.direction = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
+        placeLight(out, world, Vec3d(0.0));  // world space; Scene::finalize re-centres it
         if (l.type == "point") out.type = LightType::Point;
         else if (l.type == "spot") {
             out.type = LightType::Spot;
             const double outer = l.spot.outerConeAngle;
             if (!(outer > 0 && outer <= M_PI / 2 + 1e-9))
-                throw InputError(file_, at("KHR_lights_punctual.lights", index) + ".spot.outerConeAngle", "must lie in (0, pi/2]");
+                throw InputError(file_, gltfPlace("KHR_lights_punctual.lights", index) + ".spot.outerConeAngle", "must lie in (0, pi/2]");
             out.cosOuterCone = float(std::cos(outer));
         } else if (l.type == "directional") out.type = LightType::Directional;
-        else throw InputError(file_, at("KHR_lights_punctual.lights", index) + ".type", "unknown light type '" + l.type + "'");
+        else throw InputError(file_, gltfPlace("KHR_lights_punctual.lights", index) + ".type", "unknown light type '" + l.type + "'");
         if (!isFinite(out.intensity) || out.intensity.x < 0 || out.intensity.y < 0 || out.intensity.z < 0 ||
             !isFinite(out.position) || dot(out.direction, out.direction) == 0)
-            throw InputError(file_, at("KHR_lights_punctual.lights", index), "colour and intensity must be finite and non-negative");
+            throw InputError(file_, gltfPlace("KHR_lights_punctual.lights", index), "colour and intensity must be finite and non-negative");
         scene.lights.push_back(out);
     }
 

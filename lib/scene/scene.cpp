@@ -123,6 +123,22 @@ bool Scene::applyPose(const std::vector<Transform>& locals, std::vector<uint32_t
     return any;
 }
 
+void placeLight(PunctualLight& light, const Transform& world, const Vec3d& worldOrigin) {
+    light.position = Vec3f(world.applyPoint(Vec3d(0.0)) - worldOrigin);
+    light.direction = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
+}
+
+void Scene::setRestPose(const std::vector<Transform>& locals) {
+    for (size_t i = 0; i < nodes.size(); ++i) nodes[i].local = locals[i];
+    applyPose(locals);
+    const std::vector<Transform> world = worldTransforms(locals);
+    for (PunctualLight& l : lights)
+        if (l.node >= 0) placeLight(l, world[size_t(l.node)], worldOrigin);
+    if (camera && camera->node >= 0) camera = placeCamera(*camera, world[size_t(camera->node)], worldOrigin);
+    for (auto& c : cameras)
+        if (c && c->node >= 0) c = placeCamera(*c, world[size_t(c->node)], worldOrigin);
+}
+
 void Scene::markDynamic(const std::vector<int>& movedNodes) {
     std::vector<uint8_t> nodeDynamic(nodes.size(), 0);
     std::function<void(int)> mark = [&](int n) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "scene/camera.h"
+#include "scene/keyframes.h"
 #include "util/vecmath.h"
 
 namespace qsgi {
@@ -43,11 +44,18 @@ struct PunctualLight {
     int node = -1;              // glTF node it hangs from (-1: added by the config)
 };
 
+// Places a node's light: at the node's origin, shining down its −Z (spot axis, directional),
+// re-centred by the scene's worldOrigin.
+void placeLight(PunctualLight& light, const Transform& world, const Vec3d& worldOrigin);
+
 struct SceneNode {
     std::string name;
     int parent = -1;
     std::vector<int> children;
-    Transform local;  // rest pose, from the glTF file
+    Transform local;  // rest pose: from the glTF file, then the animation's first frame (setRestPose)
+    // glTF's translation, rotation and scale, which animation channels replace one by one
+    // (absent when the file gives a matrix, which glTF forbids animating).
+    std::optional<NodeTrs> trs;
 };
 
 // One mesh primitive placed by one node: a contiguous block of scene vertices and triangles.
@@ -78,8 +86,9 @@ struct Scene {
     std::vector<MeshInstance> instances;
     std::vector<Material> materials;
     std::vector<PunctualLight> lights;
-    std::optional<PerspectiveCamera> camera;          // the first camera node's
-    std::vector<std::optional<PerspectiveCamera>> cameras;  // by glTF camera index (first node using it)
+    std::optional<Camera> camera;          // the first camera node's
+    std::vector<std::optional<Camera>> cameras;  // by glTF camera index (first node using it)
+    std::vector<KeyframeAnimation> animations;             // the file's own (glTF animations)
 
     // World space, current pose, relative to worldOrigin: re-centring keeps float positions
     // precise for scenes far from the origin (DESIGN §4), so a scene translated by 1e5 m traces
@@ -126,6 +135,11 @@ struct Scene {
     bool applyPose(const std::vector<Transform>& locals, std::vector<uint32_t>* moved = nullptr,
                    std::vector<Bounds3f>* movedBounds = nullptr);
     Bounds3f instanceBounds(size_t instanceIndex) const;
+
+    // Makes `locals` the rest pose: the run's first frame, so that static geometry is placed once
+    // in the pose every frame shows (DESIGN §6 step 0). Re-places instances, and the lights and
+    // cameras hung from nodes.
+    void setRestPose(const std::vector<Transform>& locals);
 
     // Marks the vertices/triangles of every instance at or below one of the given nodes.
     void markDynamic(const std::vector<int>& movedNodes);

@@ -1,0 +1,180 @@
+#include "scene/gltf_accessor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "util/error.h"
+#include "util/memory.h"
+
+namespace qsgi {
+
+std::string gltfPlace(const std::string& what, int index) { return what + "[" + std::to_string(index) + "]"; }
+
+namespace {
+std::string typeName(int type) {
+    switch (type) {
+        case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+        case TINYGLTF_TYPE_VEC2: return "VEC2";
+        case TINYGLTF_TYPE_VEC3: return "VEC3";
+        case TINYGLTF_TYPE_VEC4: return "VEC4";
+        case TINYGLTF_TYPE_MAT4: return "MAT4";
+        default: return "type " + std::to_string(type);
+    }
+}
+}  // namespace
+
+std::string componentTypeName(int type) {
+    switch (type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
+        default: return "componentType " + std::to_string(type);
+    }
+}
+
+AccessorReader::AccessorReader(const GltfDocument& document, const std::string& file)
+    : model_(document.model), absentBuffers_(document.absentBuffers), file_(file) {
+    for (const auto& ext : model_.extensionsRequired) quantized_ = quantized_ || ext == "KHR_mesh_quantization";
+}
+
+AccessorData AccessorReader::read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const {
+    const std::string place = usedBy + " -> " + gltfPlace("accessors", accessorIndex);
+    if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
+        throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) +
+                                            ", which does not exist");
+    const tinygltf::Accessor& acc = model_.accessors[accessorIndex];
+    checkFormat(acc, format, place);
+    AccessorData out;
+    out.count = acc.count;
+    out.components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+    refuseBeyondMemory(saturatingMultiply(acc.count, uint64_t(out.components) * sizeof(double)), file_, place,
+                       "its " + std::to_string(acc.count) + " elements");
+    if (acc.bufferView >= 0)
+        checkRange(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, out.components, place);
+    out.values.assign(acc.count * size_t(out.components), 0.0);
+    // Without a bufferView the elements are zeros, typically overridden by sparse values.
+    if (acc.bufferView >= 0)
+        decode(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, acc.normalized, out.components,
+               out.values.data(), nullptr);
+    if (acc.sparse.isSparse) applySparse(acc, out, place);
+    for (double v : out.values)
+        if (!std::isfinite(v)) throw InputError(file_, place, "holds a non-finite number (NaN or Inf)");
+    return out;
+}
+
+void AccessorReader::checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const {
+    const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+    if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
+        throw InputError(file_, place, "unknown accessor type or componentType");
+    if (acc.type != format.type)
+        throw InputError(file_, place, "must be of type " + typeName(format.type));
+    const std::pair<int, bool> used{acc.componentType, acc.normalized};
+    auto allows = [&](const std::vector<std::pair<int, bool>>& list) {
+        return std::find(list.begin(), list.end(), used) != list.end();
+    };
+    if (allows(format.allowed) || (quantized_ && allows(format.allowedQuantized))) return;
+    const std::string what = (acc.normalized ? "normalized " : "") + componentTypeName(acc.componentType);
+    if (allows(format.allowedQuantized))
+        throw InputError(file_, place, what + " components need the KHR_mesh_quantization extension, which the "
+                                              "file does not list in extensionsRequired");
+    throw InputError(file_, place, what + " components are not allowed here by the glTF 2.0 specification");
+}
+
+void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
+                const std::string& place) const {
+    if (viewIndex < 0 || viewIndex >= int(model_.bufferViews.size()))
+        throw InputError(file_, place, "refers to bufferView " + std::to_string(viewIndex) + ", which does not exist");
+    const std::string viewPlace = gltfPlace("bufferViews", viewIndex);
+    const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
+    if (view.buffer < 0 || view.buffer >= int(model_.buffers.size()))
+        throw InputError(file_, viewPlace, "refers to a buffer that does not exist");
+    if (absentBuffers_.count(view.buffer))
+        throw InputError(file_, viewPlace, "reads buffer " + std::to_string(view.buffer) +
+                                               ", which has no uri and so no data");
+    const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
+    if (uint64_t(view.byteOffset) + uint64_t(view.byteLength) > buffer.data.size())
+        throw InputError(file_, viewPlace,
+                         "reaches byte " + std::to_string(uint64_t(view.byteOffset) + view.byteLength) + " of buffer " +
+                             std::to_string(view.buffer) + ", which holds only " + std::to_string(buffer.data.size()));
+    const uint64_t componentSize = uint64_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
+    const uint64_t elementSize = componentSize * uint64_t(components);
+    if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
+        throw InputError(file_, viewPlace + ".byteStride",
+                         std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
+    if (view.byteStride != 0 && view.byteStride < elementSize)
+        throw InputError(file_, viewPlace + ".byteStride", std::to_string(view.byteStride) + " is smaller than the " +
+                                                               std::to_string(elementSize) + "-byte elements of " + place);
+    if (byteOffset % componentSize != 0 || (view.byteOffset + byteOffset) % componentSize != 0)
+        throw InputError(file_, place, "byteOffset is not a multiple of its " + std::to_string(componentSize) +
+                                           "-byte component size");
+    const uint64_t stride = view.byteStride ? view.byteStride : elementSize;
+    if (count > 0 && uint64_t(byteOffset) + saturatingMultiply(stride, count - 1) + elementSize > view.byteLength)
+        throw InputError(file_, place, "reads past the end of bufferView " + std::to_string(viewIndex));
+}
+
+void AccessorReader::decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized,
+            int components, double* doubles, std::vector<size_t>* indices) const {
+    const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
+    const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
+    const size_t componentSize = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
+    const size_t elementSize = componentSize * size_t(components);
+    const size_t stride = view.byteStride ? view.byteStride : elementSize;
+    const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
+    for (size_t e = 0; e < count; ++e) {
+        const unsigned char* element = base + e * stride;
+        for (int c = 0; c < components; ++c) {
+            const double v = component(element + c * componentSize, componentType, normalized);
+            if (indices) (*indices)[e] = size_t(v);
+            else doubles[e * components + c] = v;
+        }
+    }
+}
+
+double AccessorReader::component(const unsigned char* p, int type, bool normalized) {
+    switch (type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0, -1.0) : v; }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { uint8_t v; std::memcpy(&v, p, 1); return normalized ? v / 255.0 : v; }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? v / 4294967295.0 : v; }
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
+        default: return 0;
+    }
+}
+
+void AccessorReader::applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const {
+    if (acc.sparse.count < 1 || size_t(acc.sparse.count) > out.count)
+        throw InputError(file_, place + ".sparse.count", std::to_string(acc.sparse.count) +
+                                                             " is outside 1..count of the accessor");
+    const size_t n = size_t(acc.sparse.count);
+    const int indexType = acc.sparse.indices.componentType;
+    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        throw InputError(file_, place + ".sparse.indices.componentType", "must be an unsigned integer type");
+    checkRange(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, 1,
+               place + ".sparse.indices");
+    checkRange(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
+               out.components, place + ".sparse.values");
+    std::vector<size_t> targets(n);
+    decode(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, false, 1, nullptr,
+           &targets);
+    std::vector<double> values(n * size_t(out.components));
+    decode(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
+           acc.normalized, out.components, values.data(), nullptr);
+    for (size_t i = 0; i < n; ++i) {
+        if (targets[i] >= out.count)
+            throw InputError(file_, place + ".sparse.indices", "index " + std::to_string(targets[i]) +
+                                                                   " is beyond the accessor's count");
+        if (i > 0 && targets[i] <= targets[i - 1])
+            throw InputError(file_, place + ".sparse.indices", "must strictly increase (index " +
+                                                                   std::to_string(targets[i]) + " follows " +
+                                                                   std::to_string(targets[i - 1]) + ")");
+        for (int c = 0; c < out.components; ++c) out.values[targets[i] * out.components + c] = values[i * out.components + c];
+    }
+}
+
+}  // namespace qsgi

@@ -1,0 +1,70 @@
+// glTF accessors as numbers (glTF 2.0 §3.6–3.7): an accessor's elements decoded to doubles, with
+// every rule the specification sets on them checked (element type and component types for the
+// use, normalisation, buffer-view ranges, strides and alignment, sparse substitution) before any
+// byte is read. The scene loader and the animation reader both read through it.
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scene/gltf_document.h"
+
+namespace qsgi {
+
+// "what[index]": a place in a glTF document, for messages.
+std::string gltfPlace(const std::string& what, int index);
+
+// What the glTF 2.0 specification (§3.7.2.1, and KHR_mesh_quantization when the file requires it)
+// allows for the accessors qsgi reads: their element type, component types and normalisation.
+struct AccessorFormat {
+    int type;  // TINYGLTF_TYPE_*
+    std::vector<std::pair<int, bool>> allowed;           // (componentType, normalized)
+    std::vector<std::pair<int, bool>> allowedQuantized;  // more, with KHR_mesh_quantization
+};
+
+// "FLOAT", "UNSIGNED_SHORT", …
+std::string componentTypeName(int type);
+
+// An accessor's elements as doubles, `components` per element, normalised integers mapped to
+// [0,1] or [-1,1] as the glTF spec says. Every offset is bounds-checked against its buffer, and
+// sizes against the machine's memory, before anything is allocated.
+struct AccessorData {
+    size_t count = 0;
+    int components = 0;
+    std::vector<double> values;
+    double operator()(size_t element, int component) const { return values[element * components + component]; }
+};
+
+// Reads accessors for one document, with the checks above. `file` names the document in messages.
+class AccessorReader {
+public:
+    AccessorReader(const GltfDocument& document, const std::string& file);
+
+    // The accessor's elements, checked against `format`; `usedBy` names the referring place.
+    // Throws InputError naming the file and the place.
+    AccessorData read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const;
+
+private:
+    void checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const;
+    // Checks that `count` elements from a buffer view lie inside the view and its buffer, with
+    // the alignment and stride the specification requires.
+    void checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
+                    const std::string& place) const;
+    // Decodes `count` elements (checked by checkRange) into `doubles` or, for sparse indices,
+    // into `indices`.
+    void decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized, int components,
+                double* doubles, std::vector<size_t>* indices) const;
+    static double component(const unsigned char* p, int type, bool normalized);
+    void applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const;
+
+    const tinygltf::Model& model_;
+    const std::set<int>& absentBuffers_;
+    std::string file_;
+    bool quantized_ = false;
+};
+
+}  // namespace qsgi

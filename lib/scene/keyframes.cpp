@@ -1,0 +1,131 @@
+#include "scene/keyframes.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace qsgi {
+
+const char* interpolationName(Interpolation i) {
+    switch (i) {
+        case Interpolation::Step: return "STEP";
+        case Interpolation::Linear: return "LINEAR";
+        case Interpolation::CubicSpline: return "CUBICSPLINE";
+    }
+    return "?";
+}
+
+const char* animatedPropertyName(AnimatedProperty p) {
+    switch (p) {
+        case AnimatedProperty::Translation: return "translation";
+        case AnimatedProperty::Rotation: return "rotation";
+        case AnimatedProperty::Scale: return "scale";
+        case AnimatedProperty::Weights: return "weights";
+    }
+    return "?";
+}
+
+namespace {
+using Quat = std::array<double, 4>;
+
+double dot4(const Quat& a, const Quat& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+
+Quat normalised(Quat q) {
+    const double n = std::sqrt(dot4(q, q));
+    if (!(n > 0)) return {0, 0, 0, 1};
+    for (double& c : q) c /= n;
+    return q;
+}
+}  // namespace
+
+Quat slerp(const Quat& a, const Quat& bIn, double t) {
+    Quat b = bIn;
+    double d = dot4(a, b);
+    if (d < 0) {  // q and −q are one rotation: go the shorter way
+        for (double& c : b) c = -c;
+        d = -d;
+    }
+    Quat out;
+    if (d > 1 - 1e-9) {  // nearly equal: sin θ ≈ 0, the chord is the arc
+        for (int c = 0; c < 4; ++c) out[c] = a[c] + t * (b[c] - a[c]);
+        return normalised(out);
+    }
+    const double theta = std::acos(std::min(d, 1.0));
+    const double wa = std::sin((1 - t) * theta) / std::sin(theta), wb = std::sin(t * theta) / std::sin(theta);
+    for (int c = 0; c < 4; ++c) out[c] = wa * a[c] + wb * b[c];
+    return normalised(out);
+}
+
+void KeyframeTrack::sample(double time, bool isRotation, double* out) const {
+    const size_t keys = times.size();
+    const int n = components;
+    // Key k's value: for CUBICSPLINE the middle of its (in-tangent, value, out-tangent) triple.
+    const size_t group = interpolation == Interpolation::CubicSpline ? 3 : 1;
+    auto value = [&](size_t k) { return &values[(k * group + (group == 3 ? 1 : 0)) * size_t(n)]; };
+    auto finish = [&] {
+        if (!isRotation) return;
+        Quat q{out[0], out[1], out[2], out[3]};
+        q = normalised(q);
+        std::copy(q.begin(), q.end(), out);
+    };
+    if (keys == 0) return;
+    if (keys == 1 || !(time > times.front())) {  // before the first key (or NaN): clamp
+        std::copy(value(0), value(0) + n, out);
+        return finish();
+    }
+    if (time >= times.back()) {
+        std::copy(value(keys - 1), value(keys - 1) + n, out);
+        return finish();
+    }
+    // The key interval [t_k, t_k+1) holding `time`.
+    const size_t k = size_t(std::upper_bound(times.begin(), times.end(), time) - times.begin()) - 1;
+    const double td = times[k + 1] - times[k], s = (time - times[k]) / td;
+    switch (interpolation) {
+        case Interpolation::Step: std::copy(value(k), value(k) + n, out); break;
+        case Interpolation::Linear:
+            if (isRotation) {
+                const double* a = value(k);
+                const double* b = value(k + 1);
+                const Quat q = slerp({a[0], a[1], a[2], a[3]}, {b[0], b[1], b[2], b[3]}, s);
+                std::copy(q.begin(), q.end(), out);
+            } else {
+                for (int c = 0; c < n; ++c) out[c] = value(k)[c] + s * (value(k + 1)[c] - value(k)[c]);
+            }
+            break;
+        case Interpolation::CubicSpline: {
+            // Hermite spline (glTF 2.0 Appendix C): v_k, out-tangent b_k, in-tangent a_k+1, v_k+1,
+            // tangents scaled by the interval's length.
+            const double* outTangent = &values[(k * 3 + 2) * size_t(n)];
+            const double* inTangent = &values[((k + 1) * 3 + 0) * size_t(n)];
+            const double s2 = s * s, s3 = s2 * s;
+            const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+            for (int c = 0; c < n; ++c)
+                out[c] = h00 * value(k)[c] + td * h10 * outTangent[c] + h01 * value(k + 1)[c] + td * h11 * inTangent[c];
+            break;
+        }
+    }
+    finish();
+}
+
+void KeyframeAnimation::apply(double time, std::vector<NodeTrs>& nodes) const {
+    double v[4];
+    for (const AnimationChannel& c : channels) {
+        NodeTrs& trs = nodes[size_t(c.node)];
+        switch (c.property) {
+            case AnimatedProperty::Translation:
+                c.track.sample(time, false, v);
+                trs.translation = Vec3d(v[0], v[1], v[2]);
+                break;
+            case AnimatedProperty::Rotation:
+                c.track.sample(time, true, v);
+                trs.rotation = {v[0], v[1], v[2], v[3]};
+                break;
+            case AnimatedProperty::Scale:
+                c.track.sample(time, false, v);
+                trs.scale = Vec3d(v[0], v[1], v[2]);
+                break;
+            case AnimatedProperty::Weights: break;  // morph weights deform meshes, not nodes
+        }
+    }
+}
+
+}  // namespace qsgi
