@@ -47,7 +47,7 @@ struct CliOptions {
     std::optional<double> exposure, radius, fps;
     std::optional<int64_t> k;
     bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false, resume = false;
-    bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false;
+    bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false, gltfOut = false;
 };
 
 // Later sources override earlier ones: defaults, then --config, then explicit options.
@@ -89,6 +89,7 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.camera) s.cameraIndex = int(qsgi::checkedInteger(*o.camera, 0, INT32_MAX, cli, "--camera"));
     if (o.exposure) s.exposure = float(*o.exposure);
     if (o.png) s.writePng = true;
+    if (o.gltfOut) s.writeGltf = true;
     if (o.noExr) s.writeExr = false;
     if (o.exrHalf) s.exrHalf = true;
     s.quiet = o.quiet;
@@ -174,6 +175,9 @@ int main(int argc, char** argv) {
     render->add_flag("--no-exr", o.noExr, "do not write frame_NNNN.exr");
     render->add_flag("--exr-half", o.exrHalf, "write EXRs as half floats instead of float");
     render->add_flag("--png", o.png, "also write an 8-bit sRGB preview frame_NNNN.png");
+    render->add_flag("--gltf-out", o.gltfOut,
+                     "also write frame_NNNN.glb: the posed geometry with COLOR_0 = radiosity/pi on an unlit material "
+                     "(irradiance in _IRRADIANCE), for glTF viewers");
     render->add_option("--exposure", o.exposure, "PNG exposure multiplier (default: automatic, fixed at the first frame)");
     render->add_flag("--quiet", o.quiet, "print nothing but errors");
     render->add_flag("--verbose", o.verbose, "print per-frame timings");

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages qsgi builds and tests with. Idempotent and non-interactive:
+# Installs the Debian 12 packages qsgi builds and tests with, and the npm packages of scripts/gltf-check. Idempotent and non-interactive:
 # packages already installed are skipped; runs apt-get directly as root, through sudo otherwise.
 set -euo pipefail
 
@@ -19,6 +19,26 @@ packages=(
   python3-numpy python3-matplotlib   # scripts/sweep.py: error figures and plots
 )
 
+# scripts/gltf-check (the Khronos glTF-Validator for --gltf-out) needs node and npm: Debian's
+# nodejs and npm where the machine has none (a machine with NodeSource's nodejs has both, and
+# Debian's npm would conflict with it).
+command -v node >/dev/null 2>&1 || packages+=(nodejs)
+command -v npm >/dev/null 2>&1 || packages+=(npm)
+
+# The glTF checkers (npm packages pinned by scripts/gltf-check/package-lock.json), after the
+# Debian packages; skipped when already installed at the locked versions.
+install_gltf_checkers() {
+  local dir
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/gltf-check"
+  if node -e 'const l = require(process.argv[1] + "/package-lock.json").packages;
+              for (const [p, v] of Object.entries(l)) if (p && require(process.argv[1] + "/" + p + "/package.json").version !== v.version) process.exit(1);' \
+       "$dir" 2>/dev/null; then
+    return 0
+  fi
+  echo "setup: npm ci in $dir"
+  (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+}
+
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -28,6 +48,7 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages already installed"
+  install_gltf_checkers
   exit 0
 fi
 
@@ -36,3 +57,4 @@ echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 "${sudo[@]}" apt-get update -qq
 "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+install_gltf_checkers

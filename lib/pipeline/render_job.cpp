@@ -14,6 +14,7 @@
 
 #include "estimate/estimator.h"
 #include "estimate/impact_count.h"
+#include "output/glb_writer.h"
 #include "output/image_files.h"
 #include "output/ply_writer.h"
 #include "output/radiosity_image.h"
@@ -191,7 +192,8 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         std::error_code missing;
         return fs::exists(outDir / frameFileName(frame, "ply"), missing) &&
                (!settings_.writeExr || fs::exists(outDir / frameFileName(frame, "exr"), missing)) &&
-               (!settings_.writePng || fs::exists(outDir / frameFileName(frame, "png"), missing));
+               (!settings_.writePng || fs::exists(outDir / frameFileName(frame, "png"), missing)) &&
+               (!settings_.writeGltf || fs::exists(outDir / frameFileName(frame, "glb"), missing));
     };
     // The first frame to compute: with --resume, the first of the range an earlier run of the
     // same inputs has not completed. Its entries for earlier frames stay in the log.
@@ -316,6 +318,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         writeVertexRadiosityPly(outDir / frameFileName(frame, "ply"), scene_, result, *tonemap);
         if (settings_.writeExr) writeExr(outDir / frameFileName(frame, "exr"), *image, imageMetadata(frame), settings_.exrHalf);
         if (settings_.writePng) writePngPreview(outDir / frameFileName(frame, "png"), *image, *exposure);
+        if (settings_.writeGltf) writeVertexRadiosityGlb(outDir / frameFileName(frame, "glb"), scene_, result, *tonemap);
         timing.writeSeconds = clock.seconds();
         log.frames.push_back(timing);
         // Rewritten after every frame, so it always describes the frames on disk (DESIGN §7).

@@ -138,7 +138,7 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
 const std::vector<std::string> kConfigKeys = {
     "scene", "animation", "fps", "out", "estimator", "radius", "k", "ray_cache", "sort_queries", "full_recompute",
     "envelope", "blocking_grid", "detp_index", "detp_boundary", "photons", "seed", "max_bounces", "threads",
-    "frames", "lights", "width", "height", "spp", "exr", "exr_half", "png", "exposure", "camera"};
+    "frames", "lights", "width", "height", "spp", "exr", "exr_half", "png", "gltf_out", "exposure", "camera"};
 
 void applyConfig(const std::string& path, const json& doc, RenderSettings& s);
 }  // namespace
@@ -219,9 +219,9 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
         } else if (key == "exr_half") {
             if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
             s.exrHalf = v.get<bool>();
-        } else if (key == "png") {
+        } else if (key == "png" || key == "gltf_out") {
             if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
-            s.writePng = v.get<bool>();
+            (key == "png" ? s.writePng : s.writeGltf) = v.get<bool>();
         } else if (key == "exposure") {
             if (!v.is_number() || !(v.get<double>() > 0) || !std::isfinite(v.get<double>()))
                 throw InputError(path, key, "must be a positive number");

@@ -43,6 +43,7 @@ struct RenderSettings {
     int width = 640, height = 480;
     int samplesPerPixel = 1;
     bool writeExr = true, exrHalf = false, writePng = false;
+    bool writeGltf = false;  // frame_NNNN.glb with the solution as unlit vertex colours
     std::optional<float> exposure;        // PNG preview; unset: automatic from frame 0
     std::optional<int> cameraIndex;       // a glTF camera by index
     struct LookAt { Vec3f position, target, up{0, 1, 0}; float yfov = 0.8f; };

@@ -1,0 +1,99 @@
+// --gltf-out (issue 11): every frame_NNNN.glb passes the Khronos glTF-Validator with no error, and
+// an independent reader (glTF Transform, through scripts/gltf-check/check.mjs) finds in it the
+// frame's posed geometry and radiance equal to the PLY's: _RADIANCE = B/π, COLOR_0 = min(1,
+// exposure·B/π). Both tools are installed by scripts/setup.sh (npm ci in scripts/gltf-check).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "output/ply_reader.h"
+#include "test_support.h"
+
+using namespace qsgi;
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json checkGlb(const fs::path& glb) {
+    const fs::path tool = sourceDir() / "scripts/gltf-check";
+    if (!fs::exists(tool / "node_modules/gltf-validator"))
+        throw std::runtime_error("the glTF checkers are not installed: run scripts/setup.sh (npm ci in " +
+                                 tool.string() + ")");
+    const CommandResult r = runCommand("node " + (tool / "check.mjs").string() + " " + glb.string() + " 2>/dev/null");
+    if (r.exitCode != 0) throw std::runtime_error("check.mjs failed on " + glb.string() + ": " + r.output);
+    return nlohmann::json::parse(r.output);
+}
+
+// Relative difference, with a floor for values near zero.
+double relativeDifference(double a, double b) { return std::fabs(a - b) / std::max({std::fabs(a), std::fabs(b), 1e-6}); }
+
+}  // namespace
+
+TEST(GltfOut, FramesPassTheKhronosValidatorAndCarryThePlysGeometryAndRadiance) {
+    const fs::path out = testScratchDir("gltf-out");
+    const std::string common = (sourceDir() / "data/cornell/cornell.gltf").string() + " --animation " +
+                               (sourceDir() / "data/cornell/animation.json").string() +
+                               " --frames 0:2 --photons 20000 --no-exr --gltf-out --quiet";
+    const CommandResult r = runQsgi("render " + common + " --threads 2 --out " + (out / "a").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+
+    std::vector<float> firstPositions;
+    for (int frame = 0; frame <= 2; ++frame) {
+        SCOPED_TRACE("frame " + std::to_string(frame));
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04d", frame);
+        nlohmann::json glb;
+        ASSERT_NO_THROW(glb = checkGlb(out / "a" / (std::string(name) + ".glb")));
+        const nlohmann::json& v = glb["validator"];
+        EXPECT_EQ(v["errors"], 0) << v["messages"].dump(1);
+        EXPECT_EQ(v["warnings"], 0) << v["messages"].dump(1);
+
+        const VertexRadiosityPly ply = readVertexRadiosityPly((out / "a" / (std::string(name) + ".ply")).string());
+        const size_t n = ply.positions.size();
+        const auto position = glb["position"].get<std::vector<float>>();
+        const auto radiance = glb["radiance"].get<std::vector<float>>();
+        const auto colour = glb["color"].get<std::vector<float>>();
+        const auto irradiance = glb["irradiance"].get<std::vector<float>>();
+        const auto translation = glb["translation"].get<std::vector<double>>();
+        ASSERT_EQ(position.size(), 3 * n);
+        ASSERT_EQ(radiance.size(), 3 * n);
+        ASSERT_EQ(colour.size(), 3 * n);
+        ASSERT_EQ(irradiance.size(), 3 * n);
+        EXPECT_EQ(glb["indices"].get<size_t>(), 3 * ply.triangles.size());
+        const double exposure = glb["extras"]["qsgi"]["exposure"].get<double>();
+        ASSERT_GT(exposure, 0);
+        double worstPosition = 0, worstRadiance = 0, worstColour = 0;
+        size_t clamped = 0;
+        for (size_t i = 0; i < n; ++i)
+            for (int c = 0; c < 3; ++c) {
+                // Node translation + relative position = the PLY's world position (both float).
+                const double world = double(position[3 * i + c]) + translation[size_t(c)];
+                worstPosition = std::max(worstPosition, std::fabs(world - double(ply.positions[i][c])));
+                const double b = ply.radiosity[i][c];
+                worstRadiance = std::max(worstRadiance, relativeDifference(radiance[3 * i + c], b / M_PI));
+                const double expectedColour = std::min(1.0, exposure * double(radiance[3 * i + c]));
+                worstColour = std::max(worstColour, std::fabs(double(colour[3 * i + c]) - expectedColour));
+                clamped += expectedColour == 1.0;
+                EXPECT_TRUE(std::isfinite(irradiance[3 * i + c]) && irradiance[3 * i + c] >= 0);
+            }
+        // Float rounding of a coordinate of magnitude ≤ 2 (Cornell's box), of B/π, of a colour.
+        EXPECT_LT(worstPosition, 1e-6);
+        EXPECT_LT(worstRadiance, 1e-6);
+        EXPECT_LT(worstColour, 1e-6);
+        EXPECT_GT(clamped, 0u);  // the emitter is brighter than white: the clamp is exercised
+        // The geometry is posed per frame: the block moves between frames 0 and 2.
+        if (frame == 0) firstPositions = position;
+        if (frame == 2) {
+            EXPECT_NE(position, firstPositions);
+        }
+    }
+
+    // Same inputs and seed, other thread count: the same bytes.
+    const CommandResult one = runQsgi("render " + common + " --threads 1 --out " + (out / "b").string());
+    ASSERT_EQ(one.exitCode, 0) << one.output;
+    for (const char* frame : {"frame_0000.glb", "frame_0002.glb"})
+        EXPECT_EQ(readFileBytes(out / "a" / frame), readFileBytes(out / "b" / frame)) << frame;
+}
