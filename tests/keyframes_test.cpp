@@ -332,3 +332,29 @@ TEST(Keyframes, MalformedSamplersAreRefusedNamingThePlace) {
         }
     }
 }
+
+TEST(Keyframes, AGltfAnimationRendersIncrementallyAsAFullRecomputationWould) {
+    // The box slides and turns over the floor for 1 s under the lamp (LINEAR translation, STEP
+    // rotation), sampled at 8 fps: frames 0..8, each incremental frame bit-identical to a
+    // from-scratch one, and the frame count from the keys.
+    const auto q = aboutMinusZ(30);
+    const fs::path file = writeAnimatedScene(
+        "render", {{{1, "translation", {0, 1}, {-0.5f, 0.3f, 0, 0.5f, 0.3f, 0}},
+                    {1, "rotation", {0, 0.5f}, {0, 0, 0, 1, float(q[0]), float(q[1]), float(q[2]), float(q[3])}}}});
+    const fs::path out = testScratchDir("keyframes-render");
+    const std::string common = "render " + file.string() + " --animation gltf --fps 8 --photons 20000 --no-exr --quiet";
+    const CommandResult incremental = runQsgi(common + " --out " + (out / "incremental").string());
+    ASSERT_EQ(incremental.exitCode, 0) << incremental.output;
+    const CommandResult full = runQsgi(common + " --full-recompute --out " + (out / "full").string());
+    ASSERT_EQ(full.exitCode, 0) << full.output;
+    for (int frame = 0; frame <= 8; ++frame) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04d.ply", frame);
+        const std::string a = readFileBytes(out / "incremental" / name);
+        ASSERT_FALSE(a.empty()) << name;
+        EXPECT_EQ(a, readFileBytes(out / "full" / name)) << name;
+    }
+    EXPECT_FALSE(fs::exists(out / "incremental" / "frame_0009.ply"));
+    // The box moved: frame 8's PLY differs from frame 0's.
+    EXPECT_NE(readFileBytes(out / "full" / "frame_0000.ply"), readFileBytes(out / "full" / "frame_0008.ply"));
+}
