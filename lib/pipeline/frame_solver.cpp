@@ -22,14 +22,14 @@ bool FrameSolver::updatesSums() const {
     return e.kind == EstimatorKind::ImpactCount || (e.kind == EstimatorKind::Detp && e.detpIndex == DetpIndex::Embree);
 }
 
-FrameSolver::PoseChange FrameSolver::pose(const std::vector<Transform>& locals) {
+FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     PoseChange change;
     // Only instances the animation moves can move: keep their positions to compare with.
     previousPositions_.resize(scene_.vertexCount());
     for (const MeshInstance& inst : scene_.instances)
         if (inst.vertexCount > 0 && scene_.vertexDynamic[inst.firstVertex])
             std::copy_n(scene_.positions.begin() + inst.firstVertex, inst.vertexCount, previousPositions_.begin() + inst.firstVertex);
-    change.any = scene_.applyPose(locals, &change.instances, &change.bounds);
+    change.any = scene_.applyPose(target, &change.instances, &change.bounds);
     for (size_t i = 1; i < change.bounds.size(); i += 2) change.newBounds.push_back(change.bounds[i]);
     // Moved is decided per vertex and triangle: an instance re-placed by a transform that leaves
     // some of its vertices where they were (or a paused mover) moves nothing there.
@@ -68,9 +68,9 @@ void FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameWork&
     work.discRegionsSeconds = clock.seconds();
 }
 
-const VertexRadiosity& FrameSolver::solve(const std::vector<Transform>& locals, FrameWork& work) {
+const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameWork& work) {
     work = FrameWork();
-    const PoseChange change = pose(locals);
+    const PoseChange change = pose(target);
     if (!solved_ || settings_.fullRecompute) {
         Stopwatch clock;
         const std::vector<uint32_t> touched = regionsValid_ && change.any ? touchedVertices(change) : std::vector<uint32_t>();

@@ -54,8 +54,8 @@ public:
     FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings);
     ~FrameSolver();
 
-    // Poses the scene with the frame's local transforms and computes its radiosity.
-    const VertexRadiosity& solve(const std::vector<Transform>& locals, FrameWork& work);
+    // Poses the scene as the frame shows it and computes its radiosity.
+    const VertexRadiosity& solve(const Pose& pose, FrameWork& work);
     // The next solve starts from scratch, disc regions included.
     void reset() { solved_ = regionsValid_ = false; }
 
@@ -72,7 +72,7 @@ private:
         std::vector<uint8_t> vertexMoved, triangleMoved;
         bool any = false;
     };
-    PoseChange pose(const std::vector<Transform>& locals);
+    PoseChange pose(const Pose& target);
     // Vertices whose disc moved or whose regions the move touched (the moved ones without regions).
     std::vector<uint32_t> touchedVertices(const PoseChange& change) const;
     // Computes every vertex's regions the first time, afterwards only the touched ones (if given).

@@ -96,8 +96,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         animation_ = Animation::fromGltf(scene_, *gltfAnimation, settings_.fps.value_or(kDefaultGltfFps), animationSource);
     } else animation_ = Animation::fromTransformFile(settings_.animationPath, scene_);
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, animationSource);
-    scene_.setRestPose(animation_.localsAt(0));
-    scene_.markDynamic(animation_.movedNodes());
+    scene_.setRestPose(animation_.poseAt(0));
+    scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
     if (!settings_.animationPath.empty())
         checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");
@@ -255,7 +255,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     solverSettings.useEnvelope = settings_.useEnvelope;
     solverSettings.gridForBlocking = settings_.blockingGrid;
     // Built in the rest pose, before any frame: every run refits the same BVHs (DESIGN §6.0).
-    scene_.applyPose(scene_.restLocals());
+    scene_.applyPose(scene_.restPose());
     FrameSolver solver(scene_, device, solverSettings);
     const ImageSettings imageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.seed};
 
@@ -271,7 +271,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     };
     if (start > 0) {
         FrameWork work;
-        fixPreviews(solver.solve(animation_.localsAt(0), work), solver.bvh());
+        fixPreviews(solver.solve(animation_.poseAt(0), work), solver.bvh());
         solver.reset();
     }
 
@@ -279,7 +279,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     for (int frame = start; frame <= last_; ++frame) {
         Stopwatch frameClock;
         FrameWork work;
-        const VertexRadiosity& result = solver.solve(animation_.localsAt(frame), work);
+        const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), work);
         if (!tonemap) fixPreviews(result, solver.bvh());
         FrameTiming timing;
         timing.frame = frame;

@@ -123,7 +123,7 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
                                               " (frames must increase)");
         previousFrame = int(frame);
         place = "frame " + std::to_string(frame);
-        Key key{int(frame), {}};
+        Key key{int(frame), {}, {}};
         if (f.contains("nodes")) {
             if (!f["nodes"].is_object()) throw InputError(path, place + ".nodes", "must be an object keyed by node name");
             for (auto it = f["nodes"].begin(); it != f["nodes"].end(); ++it) {
@@ -160,19 +160,18 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
         if (index < 0 || int(i) == index) played.push_back(&scene.animations[i]);
     // Played together, two animations must not drive one property of one node.
     std::map<std::pair<int, AnimatedProperty>, const KeyframeAnimation*> driver;
-    std::set<int> animated;
+    std::set<int> animated, weighted;
     double end = 0;
     for (const KeyframeAnimation* anim : played) {
         end = std::max(end, anim->endTime);
         for (const AnimationChannel& c : anim->channels) {
-            if (c.property == AnimatedProperty::Weights) continue;
             auto [it, fresh] = driver.emplace(std::make_pair(c.node, c.property), anim);
             if (!fresh)
                 throw InputError(source, "", "animations '" + it->second->name + "' and '" + anim->name +
                                                  "' both drive the " + animatedPropertyName(c.property) + " of node '" +
                                                  scene.nodes[c.node].name + "'; choose one with --animation gltf:N" +
                                                  listing());
-            animated.insert(c.node);
+            (c.property == AnimatedProperty::Weights ? weighted : animated).insert(c.node);
         }
     }
     // Frame f shows time f / fps; the last frame is the first at or past the last key. Key times
@@ -192,7 +191,7 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
         const double time = frame / fps;
         std::vector<NodeTrs> trs = rest;
         for (const KeyframeAnimation* anim : played) anim->apply(time, trs);
-        Key key{frame, {}};
+        Key key{frame, {}, {}};
         for (int node : animated) {
             const Transform t = trs[node].matrix();
             if (!t.isFinite() || !(std::fabs(t.determinant3x3()) > 1e-12))
@@ -201,6 +200,13 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
                                  "the animated transform is not invertible (a zero scale?), which qsgi cannot light");
             key.nodes.emplace_back(node, t);
         }
+        for (const KeyframeAnimation* anim : played)
+            for (const AnimationChannel& c : anim->channels)
+                if (c.property == AnimatedProperty::Weights) {
+                    std::vector<double> w(size_t(c.track.components));
+                    c.track.sample(time, false, w.data());
+                    key.weights.emplace_back(c.node, std::move(w));
+                }
         a.keys_.push_back(std::move(key));
     }
     a.findMovedNodes();
@@ -210,12 +216,23 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
 void Animation::findMovedNodes() {
     // Between keys nothing changes, so a node moves iff some key gives it another transform than
     // it has at frame 0.
-    const std::vector<Transform> first = localsAt(0);
-    std::set<int> moved;
-    for (const Key& k : keys_)
+    const Pose first = poseAt(0);
+    std::set<int> moved, morphed;
+    for (const Key& k : keys_) {
         for (const auto& [node, t] : k.nodes)
-            if (!(t == first[node])) moved.insert(node);
+            if (!(t == first.locals[node])) moved.insert(node);
+        for (const auto& [node, w] : k.weights)
+            if (w != first.morphWeights[size_t(node)]) morphed.insert(node);
+    }
     moved_.assign(moved.begin(), moved.end());
+    morphed_.assign(morphed.begin(), morphed.end());
+}
+
+Pose Animation::poseAt(int frame) const {
+    Pose pose(localsAt(frame), std::vector<std::vector<double>>(rest_.size()));
+    if (everyFrameKeyed_)  // only glTF animations drive weights, and they key every frame
+        for (const auto& [node, w] : keys_[size_t(std::clamp(frame, 0, lastFrame_))].weights) pose.morphWeights[size_t(node)] = w;
+    return pose;
 }
 
 std::vector<Transform> Animation::localsAt(int frame) const {
@@ -232,6 +249,7 @@ std::vector<Transform> Animation::localsAt(int frame) const {
 }
 
 void checkLightsAreStatic(const Scene& scene, const Animation& animation, const std::string& animationFile) {
+    const std::vector<uint8_t> dynamicInstance = scene.dynamicInstances(animation.movedNodes(), animation.morphedNodes());
     std::vector<uint8_t> dynamicNode(scene.nodes.size(), 0);
     std::vector<int> stack(animation.movedNodes());
     while (!stack.empty()) {
@@ -245,23 +263,26 @@ void checkLightsAreStatic(const Scene& scene, const Animation& animation, const 
         if (l.node >= 0 && dynamicNode[l.node])
             throw InputError(animationFile, "node '" + scene.nodes[l.node].name + "'",
                              "moves light '" + l.name + "', but lights must be static");
-    for (const MeshInstance& inst : scene.instances)
-        if (dynamicNode[inst.node] && scene.materials[scene.vertexMaterial[inst.firstVertex]].isEmissive())
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const MeshInstance& inst = scene.instances[i];
+        if (dynamicInstance[i] && inst.vertexCount > 0 && scene.materials[scene.vertexMaterial[inst.firstVertex]].isEmissive())
             throw InputError(animationFile, "node '" + scene.nodes[inst.node].name + "'",
-                             "moves an emissive mesh, but lights must be static");
+                             std::string(inst.deforms() && !dynamicNode[inst.node] ? "deforms" : "moves") +
+                                 " an emissive mesh, but lights must be static");
+    }
 }
 
 void sweepAnimationBounds(Scene& scene, const Animation& animation) {
-    sweepAnimationBounds(scene, animation.lastFrame(), [&](int frame) { return animation.localsAt(frame); });
+    sweepAnimationBounds(scene, animation.lastFrame(), [&](int frame) { return animation.poseAt(frame); });
 }
 
-void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<std::vector<Transform>(int)>& localsAt) {
+void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<Pose(int)>& poseAt) {
     Bounds3f swept = scene.bounds();
     std::vector<Bounds3f> perInstance(scene.instances.size());
     std::vector<uint32_t> moved;
     for (int frame = 0; frame <= lastFrame; ++frame) {
         moved.clear();
-        if (!scene.applyPose(localsAt(frame), &moved)) continue;
+        if (!scene.applyPose(poseAt(frame), &moved)) continue;
         swept.extend(scene.bounds());
         for (uint32_t i : moved) {
             perInstance[i].extend(scene.instanceBounds(i));
@@ -276,7 +297,7 @@ void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<std::
         }
     }
     moved.clear();
-    scene.applyPose(scene.restLocals(), &moved);
+    scene.applyPose(scene.restPose(), &moved);
     // An instance that moved away from its rest pose was somewhere in between at rest too.
     for (uint32_t i : moved) perInstance[i].extend(scene.instanceBounds(i));
     scene.animationBounds = swept;

@@ -36,20 +36,25 @@ public:
     double fps() const { return fps_; }
     // Local transform of every node at the frame (frames past the last keep the last pose).
     std::vector<Transform> localsAt(int frame) const;
+    // The whole pose at the frame: local transforms and the morph weights the animation drives.
+    Pose poseAt(int frame) const;
     // Nodes whose local transform differs from frame 0's in some frame.
     const std::vector<int>& movedNodes() const { return moved_; }
+    // Nodes whose morph target weights differ from frame 0's in some frame.
+    const std::vector<int>& morphedNodes() const { return morphed_; }
 
 private:
     struct Key {
         int frame;
         std::vector<std::pair<int, Transform>> nodes;
+        std::vector<std::pair<int, std::vector<double>>> weights;  // glTF weights channels
     };
     void findMovedNodes();
 
     std::vector<Transform> rest_;
     std::vector<Key> keys_;  // increasing frame
     bool everyFrameKeyed_ = false;  // keys_[f] is frame f and lists every animated node
-    std::vector<int> moved_;
+    std::vector<int> moved_, morphed_;
     int lastFrame_ = 0;
     double fps_ = 24;
 };
@@ -59,10 +64,10 @@ private:
 // uses it, so no value depends on which frame is being rendered (DESIGN §6 step 0).
 void sweepAnimationBounds(Scene& scene, const Animation& animation);
 // The same for any source of poses: localsAt(frame) for frames 0…lastFrame.
-void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<std::vector<Transform>(int)>& localsAt);
+void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<Pose(int)>& poseAt);
 
 // Lights are static (DESIGN §2): throws InputError if a punctual light or an emissive mesh hangs
-// under a node the animation moves.
+// under a node the animation moves, or an emissive mesh deforms.
 void checkLightsAreStatic(const Scene& scene, const Animation& animation, const std::string& animationFile);
 
 }  // namespace qsgi

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include "scene/gltf_accessor.h"
@@ -38,6 +39,16 @@ const AccessorFormat kNormalFormat{
     TINYGLTF_TYPE_VEC3,
     {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}},
     {{TINYGLTF_COMPONENT_TYPE_BYTE, true}, {TINYGLTF_COMPONENT_TYPE_SHORT, true}}};
+const AccessorFormat kJointsFormat{
+    TINYGLTF_TYPE_VEC4,
+    {{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false}},
+    {}};
+const AccessorFormat kWeightsFormat{
+    TINYGLTF_TYPE_VEC4,
+    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
+     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
+    {}};
+const AccessorFormat kMatrixFormat{TINYGLTF_TYPE_MAT4, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, {}};
 const AccessorFormat kIndexFormat{
     TINYGLTF_TYPE_SCALAR,
     {{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false},
@@ -238,24 +249,35 @@ private:
         if (node.mesh >= 0) {
             if (node.mesh >= int(model_.meshes.size()))
                 throw InputError(file_, gltfPlace("nodes", n) + ".mesh", "refers to mesh " + std::to_string(node.mesh) + ", which does not exist");
-            if (node.skin >= 0) warnings_.add(file_ + ": skins are not applied; the base mesh is used");
             const tinygltf::Mesh& mesh = model_.meshes[node.mesh];
-            for (size_t p = 0; p < mesh.primitives.size(); ++p)
-                addPrimitive(scene, n, mesh.primitives[p], gltfPlace("meshes", node.mesh) + "." + gltfPlace("primitives", int(p)));
+            const int skin = node.skin >= 0 ? addSkin(scene, node.skin, gltfPlace("nodes", n) + ".skin") : -1;
+            // Morph target weights: the node's, else the mesh's, else zeros (glTF 2.0 §3.7.2.2).
+            const std::vector<double>& weights = !node.weights.empty() ? node.weights : mesh.weights;
+            for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+                const std::string place = gltfPlace("meshes", node.mesh) + "." + gltfPlace("primitives", int(p));
+                if (mesh.primitives[p].targets.size() != mesh.primitives[0].targets.size())
+                    throw InputError(file_, place + ".targets", "has " + std::to_string(mesh.primitives[p].targets.size()) +
+                                                                   " morph targets but primitive 0 has " +
+                                                                   std::to_string(mesh.primitives[0].targets.size()));
+                if (!weights.empty() && weights.size() != mesh.primitives[p].targets.size())
+                    throw InputError(file_, (!node.weights.empty() ? gltfPlace("nodes", n) : gltfPlace("meshes", node.mesh)) + ".weights",
+                                     "has " + std::to_string(weights.size()) + " weights for " +
+                                         std::to_string(mesh.primitives[p].targets.size()) + " morph targets");
+                addPrimitive(scene, n, mesh.primitives[p], place, skin, weights);
+            }
         }
         if (node.camera >= 0) addCamera(scene, n, world);
         auto light = node.extensions.find("KHR_lights_punctual");
         if (light != node.extensions.end() && light->second.Has("light")) addLight(scene, n, world, light->second.Get("light"));
     }
 
-    void addPrimitive(Scene& scene, int nodeIndex, const tinygltf::Primitive& prim,
-                      const std::string& place) {
+    void addPrimitive(Scene& scene, int nodeIndex, const tinygltf::Primitive& prim, const std::string& place, int skin,
+                      const std::vector<double>& morphWeights) {
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
             warnings_.add(file_ + ": point and line primitives are skipped");
             return;
         }
-        if (!prim.targets.empty()) warnings_.add(file_ + ": morph targets are not applied; the base mesh is used");
         auto pos = prim.attributes.find("POSITION");
         if (pos == prim.attributes.end()) throw InputError(file_, place, "has no POSITION attribute");
         const AccessorData positions = reader_.read(pos->second, place + ".attributes.POSITION", kPositionFormat);
@@ -320,6 +342,120 @@ private:
                 objectNormals[i] = Vec3f(float((*normals)(i, 0)), float((*normals)(i, 1)), float((*normals)(i, 2)));
         }
         scene.addInstance(nodeIndex, std::move(objectPositions), std::move(objectNormals), tri, material);
+        MeshInstance& instance = scene.instances.back();
+        if (skin >= 0) addInfluences(scene, instance, prim, place, skin);
+        addMorphTargets(instance, prim, place, morphWeights, normals.has_value());
+    }
+
+    // The Scene::skins index of glTF skin `index`, read on first use.
+    int addSkin(Scene& scene, int index, const std::string& usedBy) {
+        if (index >= int(model_.skins.size()))
+            throw InputError(file_, usedBy, "refers to skin " + std::to_string(index) + ", which does not exist");
+        auto known = skinOf_.find(index);
+        if (known != skinOf_.end()) return known->second;
+        const tinygltf::Skin& source = model_.skins[size_t(index)];
+        const std::string place = gltfPlace("skins", index);
+        Skin skin;
+        skin.name = source.name;
+        if (source.joints.empty()) throw InputError(file_, place + ".joints", "is empty");
+        for (int j : source.joints) {
+            if (j < 0 || j >= int(model_.nodes.size()))
+                throw InputError(file_, place + ".joints", "refers to node " + std::to_string(j) + ", which does not exist");
+            skin.joints.push_back(j);
+        }
+        skin.inverseBind.assign(skin.joints.size(), Transform());
+        if (source.inverseBindMatrices >= 0) {
+            const AccessorData m = reader_.read(source.inverseBindMatrices, place + ".inverseBindMatrices", kMatrixFormat);
+            if (m.count < skin.joints.size())
+                throw InputError(file_, place + ".inverseBindMatrices", "has " + std::to_string(m.count) + " matrices for " +
+                                                                          std::to_string(skin.joints.size()) + " joints");
+            for (size_t j = 0; j < skin.joints.size(); ++j) skin.inverseBind[j] = Transform::fromColumnMajor(&m.values[16 * j]);
+        }
+        scene.skins.push_back(std::move(skin));
+        return skinOf_[index] = int(scene.skins.size()) - 1;
+    }
+
+    // JOINTS_n / WEIGHTS_n of a skinned primitive, each vertex's weights normalised to sum 1.
+    void addInfluences(const Scene& scene, MeshInstance& instance, const tinygltf::Primitive& prim,
+                       const std::string& place, int skin) {
+        const size_t joints = scene.skins[size_t(skin)].joints.size();
+        std::vector<AccessorData> jointSets, weightSets;
+        for (int set = 0;; ++set) {
+            auto j = prim.attributes.find("JOINTS_" + std::to_string(set));
+            auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
+            if (j == prim.attributes.end() && w == prim.attributes.end()) break;
+            if (j == prim.attributes.end() || w == prim.attributes.end())
+                throw InputError(file_, place + ".attributes", "has JOINTS_" + std::to_string(set) + " or WEIGHTS_" +
+                                                                   std::to_string(set) + " without the other");
+            jointSets.push_back(reader_.read(j->second, place + ".attributes." + j->first, kJointsFormat));
+            weightSets.push_back(reader_.read(w->second, place + ".attributes." + w->first, kWeightsFormat));
+        }
+        if (jointSets.empty()) {
+            warnings_.add(file_ + ": " + place + " is on a skinned node but has no JOINTS_0/WEIGHTS_0; it is not skinned");
+            return;
+        }
+        const size_t n = instance.vertexCount;
+        instance.skin = skin;
+        instance.influences = int(4 * jointSets.size());
+        instance.skinJoints.assign(n * size_t(instance.influences), 0);
+        instance.skinWeights.assign(n * size_t(instance.influences), 0.0f);
+        for (size_t v = 0; v < n; ++v) {
+            double total = 0;
+            for (size_t s = 0; s < jointSets.size(); ++s)
+                for (int k = 0; k < 4; ++k) {
+                    const double joint = jointSets[s](v, k), weight = weightSets[s](v, k);
+                    if (weight < 0)
+                        throw InputError(file_, place + ".attributes.WEIGHTS_" + std::to_string(s), "holds a negative weight");
+                    if (weight > 0 && joint >= double(joints))
+                        throw InputError(file_, place + ".attributes.JOINTS_" + std::to_string(s),
+                                         "vertex " + std::to_string(v) + " names joint " + std::to_string(size_t(joint)) +
+                                             " of a skin with " + std::to_string(joints));
+                    const size_t at = v * size_t(instance.influences) + s * 4 + size_t(k);
+                    instance.skinJoints[at] = weight > 0 ? uint16_t(joint) : 0;
+                    instance.skinWeights[at] = float(weight);
+                    total += weight;
+                }
+            // Exporters leave sums a little off 1 (CesiumMan's reach 0.185): normalised, so a
+            // vertex is never shrunk towards the origin.
+            if (total > 0)
+                for (int k = 0; k < instance.influences; ++k)
+                    instance.skinWeights[v * size_t(instance.influences) + size_t(k)] =
+                        float(instance.skinWeights[v * size_t(instance.influences) + size_t(k)] / total);
+        }
+    }
+
+    void addMorphTargets(MeshInstance& instance, const tinygltf::Primitive& prim, const std::string& place,
+                         const std::vector<double>& weights, bool hasNormals) {
+        const size_t n = instance.vertexCount;
+        for (size_t t = 0; t < prim.targets.size(); ++t) {
+            const std::string targetPlace = place + "." + gltfPlace("targets", int(t));
+            std::vector<Vec3f> dp(n, Vec3f(0.0f)), dn;
+            auto pos = prim.targets[t].find("POSITION");
+            if (pos != prim.targets[t].end()) {
+                const AccessorData d = reader_.read(pos->second, targetPlace + ".POSITION", kPositionFormat);
+                if (d.count != n)
+                    throw InputError(file_, targetPlace + ".POSITION", "has " + std::to_string(d.count) +
+                                                                          " elements for " + std::to_string(n) + " vertices");
+                for (size_t v = 0; v < n; ++v) dp[v] = Vec3f(float(d(v, 0)), float(d(v, 1)), float(d(v, 2)));
+            }
+            auto nrm = prim.targets[t].find("NORMAL");
+            if (hasNormals && nrm != prim.targets[t].end()) {
+                const AccessorData d = reader_.read(nrm->second, targetPlace + ".NORMAL", kNormalFormat);
+                if (d.count != n)
+                    throw InputError(file_, targetPlace + ".NORMAL", "has " + std::to_string(d.count) +
+                                                                        " elements for " + std::to_string(n) + " vertices");
+                dn.resize(n);
+                for (size_t v = 0; v < n; ++v) dn[v] = Vec3f(float(d(v, 0)), float(d(v, 1)), float(d(v, 2)));
+            }
+            instance.morphPositions.push_back(std::move(dp));
+            instance.morphNormals.push_back(std::move(dn));
+        }
+        if (!prim.targets.empty()) {
+            instance.morphRest = weights;
+            instance.morphRest.resize(prim.targets.size(), 0.0);
+            for (double w : instance.morphRest)
+                if (!std::isfinite(w)) throw InputError(file_, place, "a morph target weight is not finite");
+        }
     }
 
     void addCamera(Scene& scene, int n, const Transform& world) {
@@ -393,6 +529,7 @@ private:
     const std::string& file_;
     Warnings& warnings_;
     AccessorReader reader_;
+    std::map<int, int> skinOf_;  // glTF skin -> Scene::skins
     uint32_t defaultMaterial_ = 0;
 };
 

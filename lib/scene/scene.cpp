@@ -73,17 +73,49 @@ std::vector<Transform> Scene::worldTransforms(const std::vector<Transform>& loca
     return world;
 }
 
-void Scene::placeInstance(size_t instanceIndex, const Transform& world) {
+void Scene::placeInstance(size_t instanceIndex, const Transform& world, const std::vector<Transform>& jointMatrices,
+                          const std::vector<double>& weights) {
     const MeshInstance& inst = instances[instanceIndex];
-    for (uint32_t i = 0; i < inst.vertexCount; ++i)
-        positions[inst.firstVertex + i] = Vec3f(world.applyPoint(Vec3d(inst.objectPositions[i])) - worldOrigin);
-    if (!inst.objectNormals.empty()) {
-        const Transform nm = world.normalMatrix();
-        for (uint32_t i = 0; i < inst.vertexCount; ++i)
-            normals[inst.firstVertex + i] = Vec3f(normalize(nm.applyVector(Vec3d(inst.objectNormals[i]))));
-    } else {
+    // Object space, morphed by the weights.
+    std::vector<Vec3d> objectPosition(inst.vertexCount), objectNormal(inst.objectNormals.empty() ? 0 : inst.vertexCount);
+    for (uint32_t i = 0; i < inst.vertexCount; ++i) objectPosition[i] = Vec3d(inst.objectPositions[i]);
+    for (uint32_t i = 0; i < objectNormal.size(); ++i) objectNormal[i] = Vec3d(inst.objectNormals[i]);
+    for (size_t t = 0; t < inst.morphPositions.size() && t < weights.size(); ++t) {
+        if (weights[t] == 0) continue;
+        for (uint32_t i = 0; i < inst.vertexCount; ++i) objectPosition[i] += Vec3d(inst.morphPositions[t][i]) * weights[t];
+        if (!objectNormal.empty() && !inst.morphNormals[t].empty())
+            for (uint32_t i = 0; i < inst.vertexCount; ++i) objectNormal[i] += Vec3d(inst.morphNormals[t][i]) * weights[t];
+    }
+    // Each vertex's world transform: the skin's blend of joint matrices, or the node's.
+    const bool skinned = inst.skin >= 0 && !jointMatrices.empty();
+    auto vertexTransform = [&](uint32_t i) {
+        if (!skinned) return world;
+        Transform blend;
+        blend.m.fill(0);
+        double total = 0;
+        for (int k = 0; k < inst.influences; ++k) {
+            const size_t at = size_t(i) * size_t(inst.influences) + size_t(k);
+            const double w = inst.skinWeights[at];
+            if (w == 0) continue;
+            const Transform& j = jointMatrices[inst.skinJoints[at]];
+            for (int e = 0; e < 16; ++e) blend.m[size_t(e)] += w * j.m[size_t(e)];
+            total += w;
+        }
+        return total > 0 ? blend : world;  // a vertex no joint holds stays with its node
+    };
+    const bool transformNormals = !objectNormal.empty();
+    const Transform rigidNormals = transformNormals && !skinned ? world.normalMatrix() : Transform();
+    for (uint32_t i = 0; i < inst.vertexCount; ++i) {
+        const Transform m = skinned ? vertexTransform(i) : world;
+        positions[inst.firstVertex + i] = Vec3f(m.applyPoint(objectPosition[i]) - worldOrigin);
+        if (transformNormals) {
+            Vec3d n = normalize((skinned ? m.normalMatrix() : rigidNormals).applyVector(objectNormal[i]));
+            if (!(dot(n, n) > 0) || !isFinite(Vec3f(n))) n = Vec3d(0, 1, 0);  // a degenerate blend: any unit normal
+            normals[inst.firstVertex + i] = Vec3f(n);
+        }
+    }
+    if (!transformNormals) {
         // Area-weighted face normals: the unnormalised cross product is twice the area.
-        for (uint32_t i = 0; i < inst.vertexCount; ++i) normals[inst.firstVertex + i] = Vec3f(0.0f);
         std::vector<Vec3d> sum(inst.vertexCount, Vec3d(0.0));
         for (uint32_t t = 0; t < inst.triangleCount; ++t) {
             const Triangle& tri = triangles[inst.firstTriangle + t];
@@ -99,7 +131,28 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world) {
         }
     }
     placedWith[instanceIndex] = world;
+    placedJoints[instanceIndex] = jointMatrices;
+    placedWeights[instanceIndex] = weights;
 }
+
+namespace {
+// A skinned instance's joint matrices J·IBM for the given world transforms.
+std::vector<Transform> jointMatricesOf(const Scene& scene, const MeshInstance& inst, const std::vector<Transform>& world) {
+    std::vector<Transform> out;
+    if (inst.skin < 0) return out;
+    const Skin& skin = scene.skins[size_t(inst.skin)];
+    out.reserve(skin.joints.size());
+    for (size_t j = 0; j < skin.joints.size(); ++j) out.push_back(world[size_t(skin.joints[j])] * skin.inverseBind[j]);
+    return out;
+}
+
+const std::vector<double>& weightsOf(const MeshInstance& inst, const Pose& pose) {
+    const size_t node = size_t(inst.node);
+    if (inst.morphPositions.empty() || node >= pose.morphWeights.size() || pose.morphWeights[node].empty())
+        return inst.morphRest;
+    return pose.morphWeights[node];
+}
+}  // namespace
 
 Bounds3f Scene::instanceBounds(size_t instanceIndex) const {
     const MeshInstance& inst = instances[instanceIndex];
@@ -108,14 +161,19 @@ Bounds3f Scene::instanceBounds(size_t instanceIndex) const {
     return b;
 }
 
-bool Scene::applyPose(const std::vector<Transform>& locals, std::vector<uint32_t>* moved, std::vector<Bounds3f>* movedBounds) {
-    const std::vector<Transform> world = worldTransforms(locals);
+bool Scene::applyPose(const Pose& pose, std::vector<uint32_t>* moved, std::vector<Bounds3f>* movedBounds) {
+    const std::vector<Transform> world = worldTransforms(pose.locals);
     bool any = false;
     for (size_t i = 0; i < instances.size(); ++i) {
-        const Transform& w = world[instances[i].node];
-        if (w == placedWith[i]) continue;
+        const MeshInstance& inst = instances[i];
+        const Transform& w = world[size_t(inst.node)];
+        const std::vector<Transform> joints = jointMatricesOf(*this, inst, world);
+        const std::vector<double>& weights = weightsOf(inst, pose);
+        // A skinned mesh follows its joints only; a rigid one its node.
+        const bool same = (inst.skin >= 0 ? joints == placedJoints[i] : w == placedWith[i]) && weights == placedWeights[i];
+        if (same) continue;
         if (movedBounds) movedBounds->push_back(instanceBounds(i));
-        placeInstance(i, w);
+        placeInstance(i, w, joints, weights);
         if (movedBounds) movedBounds->push_back(instanceBounds(i));
         if (moved) moved->push_back(uint32_t(i));
         any = true;
@@ -128,10 +186,11 @@ void placeLight(PunctualLight& light, const Transform& world, const Vec3d& world
     light.direction = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));
 }
 
-void Scene::setRestPose(const std::vector<Transform>& locals) {
-    for (size_t i = 0; i < nodes.size(); ++i) nodes[i].local = locals[i];
-    applyPose(locals);
-    const std::vector<Transform> world = worldTransforms(locals);
+void Scene::setRestPose(const Pose& pose) {
+    for (size_t i = 0; i < nodes.size(); ++i) nodes[i].local = pose.locals[i];
+    applyPose(pose);
+    for (MeshInstance& inst : instances) inst.morphRest = weightsOf(inst, pose);
+    const std::vector<Transform> world = worldTransforms(pose.locals);
     for (PunctualLight& l : lights)
         if (l.node >= 0) placeLight(l, world[size_t(l.node)], worldOrigin);
     if (camera && camera->node >= 0) camera = placeCamera(*camera, world[size_t(camera->node)], worldOrigin);
@@ -139,7 +198,7 @@ void Scene::setRestPose(const std::vector<Transform>& locals) {
         if (c && c->node >= 0) c = placeCamera(*c, world[size_t(c->node)], worldOrigin);
 }
 
-void Scene::markDynamic(const std::vector<int>& movedNodes) {
+std::vector<uint8_t> Scene::dynamicInstances(const std::vector<int>& movedNodes, const std::vector<int>& morphedNodes) const {
     std::vector<uint8_t> nodeDynamic(nodes.size(), 0);
     std::function<void(int)> mark = [&](int n) {
         if (nodeDynamic[n]) return;
@@ -147,10 +206,26 @@ void Scene::markDynamic(const std::vector<int>& movedNodes) {
         for (int c : nodes[n].children) mark(c);
     };
     for (int n : movedNodes) mark(n);
+    std::vector<uint8_t> morphed(nodes.size(), 0);
+    for (int n : morphedNodes) morphed[size_t(n)] = 1;
+    std::vector<uint8_t> out(instances.size(), 0);
+    for (size_t i = 0; i < instances.size(); ++i) {
+        const MeshInstance& inst = instances[i];
+        bool dynamic = nodeDynamic[size_t(inst.node)] || (!inst.morphPositions.empty() && morphed[size_t(inst.node)]);
+        if (inst.skin >= 0)
+            for (int j : skins[size_t(inst.skin)].joints) dynamic = dynamic || nodeDynamic[size_t(j)];
+        out[i] = dynamic;
+    }
+    return out;
+}
+
+void Scene::markDynamic(const std::vector<int>& movedNodes, const std::vector<int>& morphedNodes) {
+    const std::vector<uint8_t> dynamic = dynamicInstances(movedNodes, morphedNodes);
     vertexDynamic.assign(positions.size(), 0);
     triangleDynamic.assign(triangles.size(), 0);
-    for (const MeshInstance& inst : instances) {
-        if (!nodeDynamic[inst.node]) continue;
+    for (size_t i = 0; i < instances.size(); ++i) {
+        const MeshInstance& inst = instances[i];
+        if (!dynamic[i]) continue;
         std::fill_n(vertexDynamic.begin() + inst.firstVertex, inst.vertexCount, 1);
         std::fill_n(triangleDynamic.begin() + inst.firstTriangle, inst.triangleCount, 1);
     }
@@ -209,7 +284,10 @@ void Scene::finalize() {
     for (auto& c : cameras)
         if (c) c->position = Vec3f(Vec3d(c->position) - worldOrigin);
     placedWith.assign(instances.size(), Transform());
-    for (size_t i = 0; i < instances.size(); ++i) placeInstance(i, world[instances[i].node]);
+    placedJoints.assign(instances.size(), {});
+    placedWeights.assign(instances.size(), {});
+    for (size_t i = 0; i < instances.size(); ++i)
+        placeInstance(i, world[size_t(instances[i].node)], jointMatricesOf(*this, instances[i], world), instances[i].morphRest);
     markDynamic({});
     animationBounds = bounds();
 }

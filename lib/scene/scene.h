@@ -58,8 +58,19 @@ struct SceneNode {
     std::optional<NodeTrs> trs;
 };
 
+// A glTF skin: the joints (nodes) that pose a skinned mesh, each with its inverse bind matrix.
+struct Skin {
+    std::string name;
+    std::vector<int> joints;
+    std::vector<Transform> inverseBind;  // one per joint
+};
+
 // One mesh primitive placed by one node: a contiguous block of scene vertices and triangles.
-// Object-space data is kept so that a new node transform re-places the block exactly.
+// Object-space data is kept so that a new pose re-places the block exactly:
+//   morph targets: p = p₀ + Σ_t w_t Δp_t (normals likewise, then normalised);
+//   skin: p_world = (Σ_k ω_k · J(joint_k) · IBM(joint_k)) p, the node's own transform ignored
+//   (glTF 2.0 §3.7.3), normals by the inverse-transpose of the blended matrix;
+//   otherwise p_world = node world transform · p.
 struct MeshInstance {
     int node = -1;
     uint32_t firstVertex = 0, vertexCount = 0;
@@ -67,6 +78,25 @@ struct MeshInstance {
     std::vector<Vec3f> objectPositions;
     std::vector<Vec3f> objectNormals;  // empty: area-weighted normals from world triangles
     bool mirrored = false;             // rest transform has a negative determinant
+
+    int skin = -1;              // Scene::skins index, or -1
+    int influences = 0;         // joint influences per vertex (4 per JOINTS_n/WEIGHTS_n set)
+    std::vector<uint16_t> skinJoints;  // vertex-major, `influences` each: indices into the skin's joints
+    std::vector<float> skinWeights;    // the same layout; each vertex's weights sum to 1
+    std::vector<std::vector<Vec3f>> morphPositions, morphNormals;  // per target, per vertex (deltas)
+    std::vector<double> morphRest;     // the rest pose's target weights
+
+    bool deforms() const { return skin >= 0 || !morphPositions.empty(); }
+};
+
+// A pose of the scene: every node's local transform, and the morph target weights of the nodes an
+// animation drives (per node; an empty entry, or none, keeps an instance's rest weights).
+struct Pose {
+    std::vector<Transform> locals;
+    std::vector<std::vector<double>> morphWeights;
+    // Implicit from node transforms alone: most poses have no morph weights.
+    Pose(std::vector<Transform> nodeLocals = {}, std::vector<std::vector<double>> weights = {})
+        : locals(std::move(nodeLocals)), morphWeights(std::move(weights)) {}
 };
 
 // The largest bounding-box diagonal qsgi accepts, in scene units. Beyond it float areas and
@@ -89,6 +119,7 @@ struct Scene {
     std::optional<Camera> camera;          // the first camera node's
     std::vector<std::optional<Camera>> cameras;  // by glTF camera index (first node using it)
     std::vector<KeyframeAnimation> animations;             // the file's own (glTF animations)
+    std::vector<Skin> skins;
 
     // World space, current pose, relative to worldOrigin: re-centring keeps float positions
     // precise for scenes far from the origin (DESIGN §4), so a scene translated by 1e5 m traces
@@ -128,21 +159,25 @@ struct Scene {
     // World transform of every node for the given local transforms (one per node).
     std::vector<Transform> worldTransforms(const std::vector<Transform>& locals) const;
     std::vector<Transform> restLocals() const;
+    Pose restPose() const { return Pose(restLocals()); }
 
     // Re-places the instances whose world transform differs from the one they were placed with.
     // Returns true if any vertex moved. If `moved` is given, appends the index of every re-placed
     // instance and, to `movedBounds`, its bounds before and after.
-    bool applyPose(const std::vector<Transform>& locals, std::vector<uint32_t>* moved = nullptr,
+    bool applyPose(const Pose& pose, std::vector<uint32_t>* moved = nullptr,
                    std::vector<Bounds3f>* movedBounds = nullptr);
     Bounds3f instanceBounds(size_t instanceIndex) const;
 
     // Makes `locals` the rest pose: the run's first frame, so that static geometry is placed once
     // in the pose every frame shows (DESIGN §6 step 0). Re-places instances, and the lights and
     // cameras hung from nodes.
-    void setRestPose(const std::vector<Transform>& locals);
+    void setRestPose(const Pose& pose);
 
-    // Marks the vertices/triangles of every instance at or below one of the given nodes.
-    void markDynamic(const std::vector<int>& movedNodes);
+    // Which instances an animation moves: those at or below one of `movedNodes`, skinned ones
+    // with a joint there, and morphing ones on one of `morphedNodes`.
+    std::vector<uint8_t> dynamicInstances(const std::vector<int>& movedNodes, const std::vector<int>& morphedNodes) const;
+    // Marks the vertices/triangles of those instances dynamic.
+    void markDynamic(const std::vector<int>& movedNodes, const std::vector<int>& morphedNodes = {});
     bool hasDynamicGeometry() const;
 
     // Assembly (the glTF loader and procedural scenes use these).
@@ -156,9 +191,13 @@ struct Scene {
     // given in world space, and marks everything static.
     void finalize();
 
-    // Internal: the world transform each instance was last placed with.
+    // Internal: what each instance was last placed with (its node's world transform; a skinned
+    // one's joint matrices J·IBM; a morphing one's weights).
     std::vector<Transform> placedWith;
-    void placeInstance(size_t instanceIndex, const Transform& world);
+    std::vector<std::vector<Transform>> placedJoints;
+    std::vector<std::vector<double>> placedWeights;
+    void placeInstance(size_t instanceIndex, const Transform& world, const std::vector<Transform>& jointMatrices,
+                       const std::vector<double>& weights);
 };
 
 }  // namespace qsgi
