@@ -4,6 +4,8 @@
 // move, static lights, conflicting animations.
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <cmath>
 
 #include "scene/animation.h"
@@ -357,4 +359,60 @@ TEST(Keyframes, AGltfAnimationRendersIncrementallyAsAFullRecomputationWould) {
     EXPECT_FALSE(fs::exists(out / "incremental" / "frame_0009.ply"));
     // The box moved: frame 8's PLY differs from frame 0's.
     EXPECT_NE(readFileBytes(out / "full" / "frame_0000.ply"), readFileBytes(out / "full" / "frame_0008.ply"));
+}
+
+namespace {
+// Pixels of an EXR with any red, and their mean column.
+std::pair<size_t, double> litPixels(const fs::path& exr) {
+    auto in = OIIO::ImageInput::open(exr.string());
+    if (!in) return {0, 0};
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+    in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data());
+    size_t lit = 0;
+    double columns = 0;
+    for (int y = 0; y < spec.height; ++y)
+        for (int x = 0; x < spec.width; ++x)
+            if (pixels[(size_t(y) * size_t(spec.width) + size_t(x)) * size_t(spec.nchannels)] > 0) {
+                ++lit;
+                columns += x;
+            }
+    return {lit, lit ? columns / double(lit) : 0};
+}
+}  // namespace
+
+TEST(Keyframes, AnAnimatedOrthographicCameraPansTheView) {
+    // A glowing 1 m quad facing +z, and an orthographic camera (xmag = ymag = 1: a 2 m square view)
+    // 2 m in front of it, panned 0.5 m along +x over 1 s. At 64×64 pixels the quad covers the
+    // middle 32×32 at first, then the same 32×32 shifted left by a quarter of the view: 16 pixels.
+    testscenes::GltfWriter w;
+    using nlohmann::json;
+    const int positions = w.accessor({-0.5f, -0.5f, 0, 0.5f, -0.5f, 0, 0.5f, 0.5f, 0, -0.5f, 0.5f, 0}, "VEC3");
+    const int indices = w.indices({0, 1, 2, 0, 2, 3});
+    w.doc["meshes"] = json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", positions}}}, {"indices", indices},
+                                                               {"material", 0}}})}}});
+    w.doc["materials"] = json::array({{{"emissiveFactor", {1, 1, 1}}}});
+    w.doc["cameras"] = json::array({{{"type", "orthographic"},
+                                     {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.01}, {"zfar", 10}}}}});
+    const int quad = w.node({{"name", "Quad"}, {"mesh", 0}});
+    const int camera = w.node({{"name", "Camera"}, {"camera", 0}, {"translation", {0, 0, 2}}});
+    w.doc["scenes"] = json::array({{{"nodes", {quad, camera}}}});
+    const int times = w.accessor({0, 1}, "SCALAR");
+    const int pan = w.accessor({0, 0, 2, 0.5f, 0, 2}, "VEC3");
+    w.doc["animations"] = json::array({{{"samplers", json::array({{{"input", times}, {"output", pan}}})},
+                                        {"channels", json::array({{{"sampler", 0}, {"target", {{"node", camera}, {"path", "translation"}}}}})}}});
+    const fs::path dir = testScratchDir("keyframes-camera");
+    w.write((dir / "camera.gltf").string());
+    const CommandResult r = runQsgi("render " + (dir / "camera.gltf").string() +
+                                    " --animation gltf --fps 2 --photons 1000 --width 64 --height 64 --quiet --out " +
+                                    (dir / "out").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const auto [lit0, column0] = litPixels(dir / "out/frame_0000.exr");
+    const auto [lit2, column2] = litPixels(dir / "out/frame_0002.exr");
+    EXPECT_EQ(lit0, 32u * 32u);
+    EXPECT_EQ(lit2, 32u * 32u);
+    EXPECT_NEAR(column0, 31.5, 1e-9);
+    EXPECT_NEAR(column2, 31.5 - 16, 1e-9);
+    // The camera alone moves: the quad is static geometry, its PLY the same in every frame.
+    EXPECT_EQ(readFileBytes(dir / "out/frame_0000.ply"), readFileBytes(dir / "out/frame_0002.ply"));
 }
