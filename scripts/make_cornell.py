@@ -106,6 +106,19 @@ class GltfBuilder:
         self.doc["accessors"].append(a)
         return len(self.doc["accessors"]) - 1
 
+    def add_accessor(self, data, component, count, kind, lo=None, hi=None, target=None):
+        """An accessor over raw little-endian bytes (its own buffer view); returns its index."""
+        view = self._view(data, target) if target else self._view_untargeted(data)
+        return self._accessor(view, component, count, kind, lo, hi)
+
+    def _view_untargeted(self, data):
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        offset = len(self.bin)
+        self.bin += data
+        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": offset, "byteLength": len(data)})
+        return len(self.doc["bufferViews"]) - 1
+
     def mesh(self, name, positions, normals, indices, material):
         pv = self._view(b"".join(struct.pack("<3f", *p) for p in positions), 34962)
         lo = [min(p[k] for p in positions) for k in range(3)]
