@@ -1,7 +1,11 @@
 // Fuzzes the glTF loader through qsgi's scene building: tinygltf's parser behind our document
 // checks, accessor decoding, the node hierarchy, materials, lights and cameras, then what
 // RenderJob computes from a scene before tracing (animation bounds, default radius, face
-// normals). Only InputError may leave qsgi's code, and no position or normal may be non-finite.
+// normals), and, when the file has animations, what --animation gltf does with them: sampling,
+// skinning and morphing every frame (at most ~100 frames, whatever the key times), static lights,
+// dynamic marking. Only InputError may leave qsgi's code, and no position or normal may be
+// non-finite.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -20,6 +24,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             "fuzz.gltf", std::string(reinterpret_cast<const char*>(data), size), "/nonexistent", warnings);
         const qsgi::Animation still = qsgi::Animation::still(scene);
         qsgi::sweepAnimationBounds(scene, still);
+        if (!scene.animations.empty()) {
+            double end = 0;
+            for (const qsgi::KeyframeAnimation& a : scene.animations) end = std::max(end, a.endTime);
+            const double fps = end > 4 ? 100 / end : 24;
+            const qsgi::Animation animation = qsgi::Animation::fromGltf(scene, -1, fps, "fuzz.gltf");
+            qsgi::checkLightsAreStatic(scene, animation, "fuzz.gltf");
+            scene.setRestPose(animation.poseAt(0));
+            scene.markDynamic(animation.movedNodes(), animation.morphedNodes());
+            qsgi::sweepAnimationBounds(scene, animation);
+            for (int frame = 0; frame <= animation.lastFrame(); ++frame) {
+                scene.applyPose(animation.poseAt(frame));
+                for (size_t v = 0; v < scene.vertexCount(); ++v)
+                    if (!qsgi::isFinite(scene.positions[v]) || !qsgi::isFinite(scene.normals[v])) std::abort();
+            }
+        }
         const float radius = qsgi::defaultRadius(scene);
         if (!std::isfinite(radius) || !(radius > 0)) std::abort();
         for (const qsgi::Vec3f& p : scene.positions)

@@ -123,7 +123,7 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
                                               " (frames must increase)");
         previousFrame = int(frame);
         place = "frame " + std::to_string(frame);
-        Key key{int(frame), {}, {}};
+        Key key{int(frame), {}};
         if (f.contains("nodes")) {
             if (!f["nodes"].is_object()) throw InputError(path, place + ".nodes", "must be an object keyed by node name");
             for (auto it = f["nodes"].begin(); it != f["nodes"].end(); ++it) {
@@ -160,7 +160,7 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
         if (index < 0 || int(i) == index) played.push_back(&scene.animations[i]);
     // Played together, two animations must not drive one property of one node.
     std::map<std::pair<int, AnimatedProperty>, const KeyframeAnimation*> driver;
-    std::set<int> animated, weighted;
+    std::set<int> animated;
     double end = 0;
     for (const KeyframeAnimation* anim : played) {
         end = std::max(end, anim->endTime);
@@ -171,7 +171,7 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
                                                  "' both drive the " + animatedPropertyName(c.property) + " of node '" +
                                                  scene.nodes[c.node].name + "'; choose one with --animation gltf:N" +
                                                  listing());
-            (c.property == AnimatedProperty::Weights ? weighted : animated).insert(c.node);
+            if (c.property != AnimatedProperty::Weights) animated.insert(c.node);
         }
     }
     // Frame f shows time f / fps; the last frame is the first at or past the last key. Key times
@@ -183,46 +183,46 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
     Animation a = still(scene);
     a.fps_ = fps;
     a.lastFrame_ = int(std::max(0.0, lastFrame));
-    a.everyFrameKeyed_ = true;
-    std::vector<NodeTrs> rest(scene.nodes.size());
+    // Frames are sampled when asked for (poseAt), so a long animation costs no memory per frame.
+    auto sampled = std::make_shared<SampledAnimations>();
+    for (const KeyframeAnimation* anim : played) sampled->played.push_back(*anim);
+    sampled->restTrs.resize(scene.nodes.size());
     for (size_t n = 0; n < scene.nodes.size(); ++n)
-        if (scene.nodes[n].trs) rest[n] = *scene.nodes[n].trs;
+        if (scene.nodes[n].trs) sampled->restTrs[n] = *scene.nodes[n].trs;
+    sampled->animated.assign(animated.begin(), animated.end());
+    a.sampled_ = std::move(sampled);
+    // Every frame's transforms must be usable: scan them once, naming the first that is not.
     for (int frame = 0; frame <= a.lastFrame_; ++frame) {
-        const double time = frame / fps;
-        std::vector<NodeTrs> trs = rest;
-        for (const KeyframeAnimation* anim : played) anim->apply(time, trs);
-        Key key{frame, {}, {}};
-        for (int node : animated) {
-            const Transform t = trs[node].matrix();
+        const std::vector<Transform> locals = a.localsAt(frame);
+        for (int node : a.sampled_->animated) {
+            const Transform& t = locals[size_t(node)];
             if (!t.isFinite() || !(std::fabs(t.determinant3x3()) > 1e-12))
-                throw InputError(source, "frame " + std::to_string(frame) + " (" + std::to_string(time) + " s), node '" +
-                                             scene.nodes[node].name + "'",
+                throw InputError(source, "frame " + std::to_string(frame) + " (" + std::to_string(frame / fps) +
+                                             " s), node '" + scene.nodes[node].name + "'",
                                  "the animated transform is not invertible (a zero scale?), which qsgi cannot light");
-            key.nodes.emplace_back(node, t);
         }
-        for (const KeyframeAnimation* anim : played)
-            for (const AnimationChannel& c : anim->channels)
-                if (c.property == AnimatedProperty::Weights) {
-                    std::vector<double> w(size_t(c.track.components));
-                    c.track.sample(time, false, w.data());
-                    key.weights.emplace_back(c.node, std::move(w));
-                }
-        a.keys_.push_back(std::move(key));
     }
     a.findMovedNodes();
     return a;
 }
 
 void Animation::findMovedNodes() {
-    // Between keys nothing changes, so a node moves iff some key gives it another transform than
-    // it has at frame 0.
     const Pose first = poseAt(0);
     std::set<int> moved, morphed;
-    for (const Key& k : keys_) {
-        for (const auto& [node, t] : k.nodes)
-            if (!(t == first.locals[node])) moved.insert(node);
-        for (const auto& [node, w] : k.weights)
-            if (w != first.morphWeights[size_t(node)]) morphed.insert(node);
+    if (sampled_) {  // every frame, compared with frame 0 (the scan fromGltf made already)
+        for (int frame = 1; frame <= lastFrame_; ++frame) {
+            const Pose p = poseAt(frame);
+            for (int node : sampled_->animated)
+                if (!(p.locals[size_t(node)] == first.locals[size_t(node)])) moved.insert(node);
+            for (size_t node = 0; node < p.morphWeights.size(); ++node)
+                if (p.morphWeights[node] != first.morphWeights[node]) morphed.insert(int(node));
+        }
+    } else {
+        // Between keys nothing changes, so a node moves iff some key gives it another transform
+        // than it has at frame 0.
+        for (const Key& k : keys_)
+            for (const auto& [node, t] : k.nodes)
+                if (!(t == first.locals[node])) moved.insert(node);
     }
     moved_.assign(moved.begin(), moved.end());
     morphed_.assign(morphed.begin(), morphed.end());
@@ -230,15 +230,26 @@ void Animation::findMovedNodes() {
 
 Pose Animation::poseAt(int frame) const {
     Pose pose(localsAt(frame), std::vector<std::vector<double>>(rest_.size()));
-    if (everyFrameKeyed_)  // only glTF animations drive weights, and they key every frame
-        for (const auto& [node, w] : keys_[size_t(std::clamp(frame, 0, lastFrame_))].weights) pose.morphWeights[size_t(node)] = w;
+    if (sampled_) {  // only glTF animations drive morph weights
+        const double time = std::clamp(frame, 0, lastFrame_) / fps_;
+        for (const KeyframeAnimation& anim : sampled_->played)
+            for (const AnimationChannel& c : anim.channels)
+                if (c.property == AnimatedProperty::Weights) {
+                    std::vector<double>& w = pose.morphWeights[size_t(c.node)];
+                    w.resize(size_t(c.track.components));
+                    c.track.sample(time, false, w.data());
+                }
+    }
     return pose;
 }
 
 std::vector<Transform> Animation::localsAt(int frame) const {
     std::vector<Transform> locals = rest_;
-    if (everyFrameKeyed_) {
-        for (const auto& [node, t] : keys_[size_t(std::clamp(frame, 0, lastFrame_))].nodes) locals[node] = t;
+    if (sampled_) {
+        std::vector<NodeTrs> trs = sampled_->restTrs;
+        const double time = std::clamp(frame, 0, lastFrame_) / fps_;
+        for (const KeyframeAnimation& anim : sampled_->played) anim.apply(time, trs);
+        for (int node : sampled_->animated) locals[size_t(node)] = trs[size_t(node)].matrix();
         return locals;
     }
     for (const Key& k : keys_) {

@@ -10,6 +10,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -47,13 +48,18 @@ private:
     struct Key {
         int frame;
         std::vector<std::pair<int, Transform>> nodes;
-        std::vector<std::pair<int, std::vector<double>>> weights;  // glTF weights channels
+    };
+    // glTF animations, sampled at frame / fps when asked (shared: copies of an Animation are cheap).
+    struct SampledAnimations {
+        std::vector<KeyframeAnimation> played;
+        std::vector<NodeTrs> restTrs;  // per node: what channels do not drive
+        std::vector<int> animated;     // nodes with a translation, rotation or scale channel
     };
     void findMovedNodes();
 
     std::vector<Transform> rest_;
-    std::vector<Key> keys_;  // increasing frame
-    bool everyFrameKeyed_ = false;  // keys_[f] is frame f and lists every animated node
+    std::vector<Key> keys_;  // increasing frame (transform files)
+    std::shared_ptr<const SampledAnimations> sampled_;  // or glTF animations
     std::vector<int> moved_, morphed_;
     int lastFrame_ = 0;
     double fps_ = 24;
