@@ -117,11 +117,16 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     }
     std::string animationBytes;
     if (gltfAnimation) {
-        // What the run shows of it: every moving node's transform at every frame.
+        // What the run shows of it: every moving node's transform and every morphing node's
+        // weights at every frame.
         for (int frame = 0; frame <= animation_.lastFrame(); ++frame) {
-            const std::vector<Transform> locals = animation_.localsAt(frame);
+            const Pose pose = animation_.poseAt(frame);
             for (int node : animation_.movedNodes())
-                animationBytes.append(reinterpret_cast<const char*>(locals[size_t(node)].m.data()), sizeof(double) * 16);
+                animationBytes.append(reinterpret_cast<const char*>(pose.locals[size_t(node)].m.data()), sizeof(double) * 16);
+            for (int node : animation_.morphedNodes()) {
+                const std::vector<double>& w = pose.morphWeights[size_t(node)];
+                animationBytes.append(reinterpret_cast<const char*>(w.data()), sizeof(double) * w.size());
+            }
         }
     } else if (!settings_.animationPath.empty()) {
         std::ifstream in(settings_.animationPath, std::ios::binary);
