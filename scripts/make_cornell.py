@@ -27,19 +27,21 @@ WHITE = [0.725, 0.71, 0.68]
 LIGHT_RADIANCE = 12.0  # W m^-2 sr^-1 (emissive strength on a white emissiveFactor)
 
 
-def grid(corner, u, v, cells):
-    """A quad grid from corner spanning u and v; front side (CCW) faces cross(u, v)."""
+def grid(corner, u, v, cells, cells_v=None):
+    """A quad grid from corner spanning u and v (cells along u, cells_v along v, default the
+    same); front side (CCW) faces cross(u, v)."""
+    cells_v = cells if cells_v is None else cells_v
     n = cross(u, v)
     length = math.sqrt(sum(c * c for c in n))
     n = [c / length for c in n]
     positions, normals, indices = [], [], []
-    for j in range(cells + 1):
+    for j in range(cells_v + 1):
         for i in range(cells + 1):
-            s, t = i / cells, j / cells
+            s, t = i / cells, j / cells_v
             positions.append([corner[k] + s * u[k] + t * v[k] for k in range(3)])
             normals.append(n)
     row = cells + 1
-    for j in range(cells):
+    for j in range(cells_v):
         for i in range(cells):
             a = j * row + i
             indices += [a, a + 1, a + row + 1, a, a + row + 1, a + row]

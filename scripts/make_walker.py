@@ -45,23 +45,6 @@ def merged(parts):
     return positions, normals, indices
 
 
-def grid_cells(corner, u, v, cells_u, cells_v):
-    """grid() with its own cell count along each side (cells about 25 cm)."""
-    p, n, _ = grid(corner, u, v, 1)
-    positions, normals, indices = [], [], []
-    for j in range(cells_v + 1):
-        for i in range(cells_u + 1):
-            s, t = i / cells_u, j / cells_v
-            positions.append([corner[k] + s * u[k] + t * v[k] for k in range(3)])
-            normals.append(n[0])
-    row = cells_u + 1
-    for j in range(cells_v):
-        for i in range(cells_u):
-            a = j * row + i
-            indices += [a, a + 1, a + row + 1, a, a + row + 1, a + row]
-    return positions, normals, indices
-
-
 def box(centre_xz, base_y, half, cells):
     """box_faces moved to stand at (x, base_y, z)."""
     p, n, i = box_faces(half, cells)
@@ -112,7 +95,7 @@ def main():
              ("LeftWall", [-4, 0, 3], [0, 0, -6], [0, 3, 0], 24, 12),
              ("RightWall", [4, 0, -3], [0, 0, 6], [0, 3, 0], 24, 12)]
     for name, corner, u, v, cu, cv in walls:  # inward-facing; the front (z = 3) is open
-        p, n, i = grid_cells(corner, u, v, cu, cv)
+        p, n, i = grid(corner, u, v, cu, cv)
         g.node({"name": name, "mesh": g.mesh(name, p, n, i, white)})
     # Furniture: table (top and four legs), chair (seat, back, legs), bench.
     table = [box((0.8, -1.6), 0.72, [0.6, 0.02, 0.35], 6)]

@@ -13,23 +13,31 @@
 namespace qsgi {
 namespace {
 
-// Appends `count` VEC3 floats as a buffer view and an accessor; returns the accessor's index.
-int addVec3Accessor(tinygltf::Model& model, const std::vector<Vec3f>& values, bool withBounds) {
+// Appends `elements` records of `elementBytes` (filled by `write(i, destination)`) to the buffer
+// as a new buffer view; returns its index.
+template <typename Write>
+int appendBufferView(tinygltf::Model& model, size_t elements, size_t elementBytes, int target, Write write) {
     tinygltf::Buffer& buffer = model.buffers[0];
     const size_t offset = buffer.data.size();
-    buffer.data.resize(offset + values.size() * sizeof(Vec3f));
-    for (size_t i = 0; i < values.size(); ++i) {
-        const float xyz[3] = {values[i].x, values[i].y, values[i].z};
-        std::memcpy(&buffer.data[offset + i * 12], xyz, 12);
-    }
+    buffer.data.resize(offset + elements * elementBytes);
+    for (size_t i = 0; i < elements; ++i) write(i, &buffer.data[offset + i * elementBytes]);
     tinygltf::BufferView view;
     view.buffer = 0;
     view.byteOffset = offset;
-    view.byteLength = values.size() * 12;
-    view.target = TINYGLTF_TARGET_ARRAY_BUFFER;
+    view.byteLength = elements * elementBytes;
+    view.target = target;
     model.bufferViews.push_back(view);
+    return int(model.bufferViews.size()) - 1;
+}
+
+// Appends VEC3 floats as a buffer view and an accessor; returns the accessor's index.
+int addVec3Accessor(tinygltf::Model& model, const std::vector<Vec3f>& values, bool withBounds) {
     tinygltf::Accessor accessor;
-    accessor.bufferView = int(model.bufferViews.size()) - 1;
+    accessor.bufferView = appendBufferView(model, values.size(), 12, TINYGLTF_TARGET_ARRAY_BUFFER,
+                                           [&](size_t i, unsigned char* out) {
+                                               const float xyz[3] = {values[i].x, values[i].y, values[i].z};
+                                               std::memcpy(out, xyz, 12);
+                                           });
     accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
     accessor.type = TINYGLTF_TYPE_VEC3;
     accessor.count = values.size();
@@ -44,18 +52,9 @@ int addVec3Accessor(tinygltf::Model& model, const std::vector<Vec3f>& values, bo
 }
 
 int addIndexAccessor(tinygltf::Model& model, const std::vector<Triangle>& triangles) {
-    tinygltf::Buffer& buffer = model.buffers[0];
-    const size_t offset = buffer.data.size();
-    buffer.data.resize(offset + triangles.size() * 12);
-    for (size_t t = 0; t < triangles.size(); ++t) std::memcpy(&buffer.data[offset + t * 12], triangles[t].v, 12);
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = offset;
-    view.byteLength = triangles.size() * 12;
-    view.target = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
-    model.bufferViews.push_back(view);
     tinygltf::Accessor accessor;
-    accessor.bufferView = int(model.bufferViews.size()) - 1;
+    accessor.bufferView = appendBufferView(model, triangles.size(), 12, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                                           [&](size_t t, unsigned char* out) { std::memcpy(out, triangles[t].v, 12); });
     accessor.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
     accessor.type = TINYGLTF_TYPE_SCALAR;
     accessor.count = triangles.size() * 3;
