@@ -176,6 +176,33 @@ TEST(Keyframes, InterpolationTestModelMatchesHandWorkedValues) {
     EXPECT_EQ(v[1], 6.0);
 }
 
+TEST(Keyframes, AnimatedTriangleTurnsAlongTheShorterArcThroughEveryQuarter) {
+    // Khronos' AnimatedTriangle: one LINEAR rotation about +z, keys 0°, 90°, 180°, 270°, 360° at
+    // t = 0, 0.25, 0.5, 0.75, 1 s, written as (0, 0, 0.707, 0.707), (0, 0, 1, 0), (0, 0, 0.707,
+    // −0.707), (0, 0, 0, 1). Halfway between keys: 45°, 225° and 315° — the last key is the
+    // negation of 360°'s quaternion as it follows 270°'s, so only the shorter arc gives 315°.
+    // The file's 0.707 is not √½: expected values hold to 2e-4.
+    const fs::path file = sharedDir() / "data/gltf-samples/models/AnimatedTriangle/glTF-Embedded/AnimatedTriangle.gltf";
+    if (!fs::exists(file)) GTEST_SKIP() << "../shared is absent: " << file;
+    Warnings warnings;
+    const Scene scene = loadGltfScene(file.string(), warnings);
+    ASSERT_EQ(scene.animations.size(), 1u);
+    const KeyframeTrack& t = scene.animations[0].channels.at(0).track;
+    auto aboutZ = [](double degrees) {
+        const double half = degrees * M_PI / 360;
+        return std::array<double, 4>{0, 0, std::sin(half), std::cos(half)};
+    };
+    expectRotation(sampleRotation(t, 0.125), aboutZ(45), 2e-4);
+    expectRotation(sampleRotation(t, 0.625), aboutZ(225), 2e-4);
+    expectRotation(sampleRotation(t, 0.875), aboutZ(315), 2e-4);
+    // Via the animation at 8 fps: frame 1 is t = 0.125 s.
+    const Animation a = Animation::fromGltf(scene, 0, 8, "test");
+    EXPECT_EQ(a.lastFrame(), 8);
+    const Vec3d x = a.localsAt(1)[0].applyVector(Vec3d(1, 0, 0));
+    EXPECT_NEAR(x.x, std::sqrt(0.5), 2e-4);
+    EXPECT_NEAR(x.y, std::sqrt(0.5), 2e-4);
+}
+
 TEST(Keyframes, GltfAnimationGivesFramesAtTheFrameRateThroughTheLastKey) {
     const fs::path file = sharedDir() / "data/gltf-samples/models/InterpolationTest/glTF/InterpolationTest.gltf";
     if (!fs::exists(file)) GTEST_SKIP() << "../shared is absent: " << file;
