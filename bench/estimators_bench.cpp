@@ -308,7 +308,7 @@ void estimatorArguments(benchmark::internal::Benchmark* b) {
 
 }  // namespace
 
-BENCHMARK(BM_TracePhotons)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_TracePhotons)->Arg(100000)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EmbreeClosestHitCeiling)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DetpSegments)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
