@@ -269,7 +269,7 @@ fs::path writeAnimatedScene(const std::string& name, const std::vector<std::vect
         }
         w.doc["animations"].push_back(animation);
     }
-    const fs::path path = fs::path(testScratchDir("keyframes")) / (name + ".gltf");
+    const fs::path path = fs::path(testScratchDir("keyframes-scene-" + name)) / (name + ".gltf");
     w.write(path.string());
     return path;
 }

@@ -29,18 +29,30 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     for (const MeshInstance& inst : scene_.instances)
         if (inst.vertexCount > 0 && scene_.vertexDynamic[inst.firstVertex])
             std::copy_n(scene_.positions.begin() + inst.firstVertex, inst.vertexCount, previousPositions_.begin() + inst.firstVertex);
-    change.any = scene_.applyPose(target, &change.instances, &change.bounds);
-    for (size_t i = 1; i < change.bounds.size(); i += 2) change.newBounds.push_back(change.bounds[i]);
+    change.any = scene_.applyPose(target, &change.instances);
     // Moved is decided per vertex and triangle: an instance re-placed by a transform that leaves
-    // some of its vertices where they were (or a paused mover) moves nothing there.
+    // some of its vertices where they were (a paused mover, a mesh deforming in one region)
+    // moves nothing there. The bounds that later steps search are those of the moved triangles,
+    // before and after: for a rigid mover its whole bounds, for a deforming mesh its moved region.
     change.vertexMoved.assign(scene_.vertexCount(), 0);
     change.triangleMoved.assign(scene_.triangleCount(), 0);
     for (uint32_t i : change.instances) {
         const MeshInstance& inst = scene_.instances[i];
         for (uint32_t v = inst.firstVertex; v < inst.firstVertex + inst.vertexCount; ++v)
             change.vertexMoved[v] = std::memcmp(&previousPositions_[v], &scene_.positions[v], sizeof(Vec3f)) != 0;
-        for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t)
+        Bounds3f before, after;
+        for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t) {
             for (uint32_t v : scene_.triangles[t].v) change.triangleMoved[t] |= change.vertexMoved[v];
+            if (!change.triangleMoved[t]) continue;
+            for (uint32_t v : scene_.triangles[t].v) {
+                before.extend(previousPositions_[v]);
+                after.extend(scene_.positions[v]);
+            }
+        }
+        if (after.empty()) continue;  // re-placed, yet nothing moved
+        change.bounds.push_back(before);
+        change.bounds.push_back(after);
+        change.newBounds.push_back(after);
     }
     if (change.any) bvh_.updateDynamic(scene_);
     return change;

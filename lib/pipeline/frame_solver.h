@@ -67,7 +67,7 @@ public:
 private:
     struct PoseChange {
         std::vector<uint32_t> instances;
-        std::vector<Bounds3f> bounds;      // old and new of each moved instance
+        std::vector<Bounds3f> bounds;      // old and new of each instance's moved triangles
         std::vector<Bounds3f> newBounds;
         std::vector<uint8_t> vertexMoved, triangleMoved;
         bool any = false;

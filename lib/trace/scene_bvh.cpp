@@ -56,13 +56,30 @@ bool occludes(RTCScene scene, const Vec3f& origin, const Vec3f& direction, float
     return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 
+// An occlusion query that counts only triangles flagged in `moved` (by scene triangle): a
+// deforming mesh's unmoved triangles are dynamic geometry, but they block nothing new.
+struct MovedOnlyContext {
+    RTCIntersectContext base;  // first member: Embree hands back a pointer to it
+    const std::vector<uint8_t>* moved;
+    const std::vector<uint32_t>* sceneTriangle;  // primID -> scene triangle
+};
+
+void acceptMovedOnly(const RTCFilterFunctionNArguments* args) {
+    const auto* ctx = reinterpret_cast<const MovedOnlyContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i] != 0 && !(*ctx->moved)[(*ctx->sceneTriangle)[RTCHitN_primID(args->hit, args->N, i)]])
+            args->valid[i] = 0;
+}
+
 }  // namespace
 
 SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     : device_(device), staticScene_(device), dynamicScene_(device) {
     // Robust traversal never culls a box that a ray touches: whether a ray grazing a surface at
     // the scene epsilon (the disc regions' tests) hits must not depend on a BVH's layout.
-    for (RTCScene s : {staticScene_.get(), dynamicScene_.get()}) rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    // movedOccludes filters the dynamic part through its context.
+    rtcSetSceneFlags(staticScene_.get(), RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneFlags(dynamicScene_.get(), RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(staticScene_.get(), RTC_BUILD_QUALITY_HIGH);
     static_ = addPart(staticScene_.get(), scene, false, RTC_BUILD_QUALITY_HIGH);
     dynamic_ = addPart(dynamicScene_.get(), scene, true, RTC_BUILD_QUALITY_REFIT);
@@ -151,6 +168,19 @@ bool SceneBvh::occluded(const Vec3f& origin, const Vec3f& direction, float tnear
 
 bool SceneBvh::dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
     return !dynamic_.empty() && occludes(dynamicScene_.get(), origin, direction, tnear, tfar);
+}
+
+bool SceneBvh::movedOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
+                             const std::vector<uint8_t>& triangleMoved) const {
+    if (dynamic_.empty()) return false;
+    MovedOnlyContext context;
+    rtcInitIntersectContext(&context.base);
+    context.base.filter = acceptMovedOnly;
+    context.moved = &triangleMoved;
+    context.sceneTriangle = &dynamic_.triangles;
+    RTCRay ray = makeRay(origin, direction, tnear, tfar).ray;
+    rtcOccluded1(dynamicScene_.get(), &context.base, &ray);
+    return ray.tfar < 0;
 }
 
 }  // namespace qsgi

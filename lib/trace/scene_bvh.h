@@ -34,6 +34,9 @@ public:
     bool occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // True if the dynamic geometry alone blocks the ray within (tnear, tfar].
     bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // The same, counting only the triangles flagged in triangleMoved (by scene triangle).
+    bool movedOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
+                       const std::vector<uint8_t>& triangleMoved) const;
 
     // Offset that lifts spawned rays off surfaces: scaled with the scene, never with metres.
     float rayEpsilon() const { return rayEpsilon_; }

@@ -86,13 +86,14 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint8_t>&
     for (uint32_t f : from) changes.affectedByImpact += f != kNone;
 
     // (b) A segment that a moved triangle now blocks before its impact. Only segments passing
-    // through a moved object's new bounds can be; the grid lists them, the dynamic BVH decides.
+    // through a moved object's new bounds can be; the grid lists them, the dynamic BVH decides,
+    // counting moved triangles only (a deforming mesh's unmoved part blocks nothing new).
     // The test reaches a little past the impact: a tie there is the tracer's to decide, and
     // retracing a path that would not change repeats the full trace exactly.
     const float eps = bvh.rayEpsilon();
     auto blocked = [&](const Segment& s) {
         const float end = s.hasImpact() ? s.length + eps : s.length;
-        return bvh.dynamicOccludes(s.origin, s.direction, 0.0f, end);
+        return bvh.movedOccludes(s.origin, s.direction, 0.0f, end, triangleMoved);
     };
     std::vector<SegmentRef> candidates;
     if (useGrid) {
