@@ -33,6 +33,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             scene.setRestPose(animation.poseAt(0));
             scene.markDynamic(animation.movedNodes(), animation.morphedNodes());
             qsgi::sweepAnimationBounds(scene, animation);
+            // As RenderJob: an animation that throws geometry beyond float range is refused.
+            qsgi::checkSceneExtent(scene.positions, scene.animationBounds, "fuzz.gltf (--animation gltf)", "frames");
             for (int frame = 0; frame <= animation.lastFrame(); ++frame) {
                 scene.applyPose(animation.poseAt(frame));
                 for (size_t v = 0; v < scene.vertexCount(); ++v)
