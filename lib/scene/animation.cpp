@@ -191,41 +191,37 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
         if (scene.nodes[n].trs) sampled->restTrs[n] = *scene.nodes[n].trs;
     sampled->animated.assign(animated.begin(), animated.end());
     a.sampled_ = std::move(sampled);
-    // Every frame's transforms must be usable: scan them once, naming the first that is not.
+    // One scan of every frame: each transform must be usable (the first that is not is named),
+    // and a node moves, or morphs, if it differs from frame 0 at some frame.
+    const Pose first = a.poseAt(0);
+    std::set<int> moved, morphed;
     for (int frame = 0; frame <= a.lastFrame_; ++frame) {
-        const std::vector<Transform> locals = a.localsAt(frame);
+        const Pose p = a.poseAt(frame);
         for (int node : a.sampled_->animated) {
-            const Transform& t = locals[size_t(node)];
+            const Transform& t = p.locals[size_t(node)];
             if (!t.isFinite() || !(std::fabs(t.determinant3x3()) > 1e-12))
                 throw InputError(source, "frame " + std::to_string(frame) + " (" + std::to_string(frame / fps) +
                                              " s), node '" + scene.nodes[node].name + "'",
                                  "the animated transform is not invertible (a zero scale?), which qsgi cannot light");
+            if (!(t == first.locals[size_t(node)])) moved.insert(node);
         }
+        for (size_t node = 0; node < p.morphWeights.size(); ++node)
+            if (p.morphWeights[node] != first.morphWeights[node]) morphed.insert(int(node));
     }
-    a.findMovedNodes();
+    a.moved_.assign(moved.begin(), moved.end());
+    a.morphed_.assign(morphed.begin(), morphed.end());
     return a;
 }
 
 void Animation::findMovedNodes() {
-    const Pose first = poseAt(0);
-    std::set<int> moved, morphed;
-    if (sampled_) {  // every frame, compared with frame 0 (the scan fromGltf made already)
-        for (int frame = 1; frame <= lastFrame_; ++frame) {
-            const Pose p = poseAt(frame);
-            for (int node : sampled_->animated)
-                if (!(p.locals[size_t(node)] == first.locals[size_t(node)])) moved.insert(node);
-            for (size_t node = 0; node < p.morphWeights.size(); ++node)
-                if (p.morphWeights[node] != first.morphWeights[node]) morphed.insert(int(node));
-        }
-    } else {
-        // Between keys nothing changes, so a node moves iff some key gives it another transform
-        // than it has at frame 0.
-        for (const Key& k : keys_)
-            for (const auto& [node, t] : k.nodes)
-                if (!(t == first.locals[node])) moved.insert(node);
-    }
+    // Transform files: between keys nothing changes, so a node moves iff some key gives it
+    // another transform than it has at frame 0.
+    const std::vector<Transform> first = localsAt(0);
+    std::set<int> moved;
+    for (const Key& k : keys_)
+        for (const auto& [node, t] : k.nodes)
+            if (!(t == first[node])) moved.insert(node);
     moved_.assign(moved.begin(), moved.end());
-    morphed_.assign(morphed.begin(), morphed.end());
 }
 
 Pose Animation::poseAt(int frame) const {

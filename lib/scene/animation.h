@@ -55,7 +55,7 @@ private:
         std::vector<NodeTrs> restTrs;  // per node: what channels do not drive
         std::vector<int> animated;     // nodes with a translation, rotation or scale channel
     };
-    void findMovedNodes();
+    void findMovedNodes();  // transform files (fromGltf finds them in its own scan of every frame)
 
     std::vector<Transform> rest_;
     std::vector<Key> keys_;  // increasing frame (transform files)
