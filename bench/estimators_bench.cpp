@@ -51,7 +51,7 @@ struct CornellFixture {
     }
     const RayCache& cache(uint64_t photons) {
         auto& c = caches[photons];
-        if (!c) c = std::make_unique<RayCache>(PhotonTracer(scene, *bvh, TraceSettings{photons, 1, 32}).traceAll());
+        if (!c) c = std::make_unique<RayCache>(PhotonTracer(scene, *bvh, TraceSettings{photons, 1, 32, EmissionAim{}}).traceAll());
         return *c;
     }
     const std::vector<Vec3f>& exact(uint64_t photons, int radiusMm) {
@@ -126,7 +126,7 @@ void BM_TracePhotons(benchmark::State& state) {
     CornellFixture& f = fixture();
     const uint64_t photons = uint64_t(state.range(0));
     SceneBvh bvh(f.device, f.scene);
-    const PhotonTracer tracer(f.scene, bvh, TraceSettings{photons, 1, 32});
+    const PhotonTracer tracer(f.scene, bvh, TraceSettings{photons, 1, 32, EmissionAim{}});
     size_t segments = 0;
     for (auto _ : state) {
         const RayCache cache = tracer.traceAll();

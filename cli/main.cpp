@@ -46,7 +46,7 @@ struct CliOptions {
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
     std::optional<double> exposure, radius, fps;
     std::optional<int64_t> k;
-    bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false, resume = false;
+    bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false, noAim = false, resume = false;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false, gltfOut = false;
 };
 
@@ -74,6 +74,7 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.noSortQueries) s.estimator.sortQueries = false;
     if (o.fullRecompute) s.fullRecompute = true;
     if (o.noEnvelope) s.useEnvelope = false;
+    if (o.noAim) s.aimEmission = false;
     if (o.resume) s.resume = true;
     if (!o.frames.empty()) {
         s.frames = qsgi::parseFrameRange(o.frames, cli);
@@ -160,6 +161,9 @@ int main(int argc, char** argv) {
     render->add_flag("--no-envelope", o.noEnvelope,
                      "track every light path instead of only those that meet the moving geometry's envelope (same "
                      "bytes, more memory and work per frame)");
+    render->add_flag("--no-aim", o.noAim,
+                     "emit photons in every direction a light shines, not only toward the scene (projection maps "
+                     "off; the same estimate in expectation, more photons wasted)");
     render->add_option("--photons", o.photons, "photons traced per frame (default 1000000)");
     render->add_option("--seed", o.seed, "random seed (default 1); same seed, same bytes");
     render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");

@@ -33,10 +33,16 @@ void TimingLog::write(const std::filesystem::path& path) const {
                    {"detp_index", estimator == "detp" ? nlohmann::json(detpIndex) : nlohmann::json(nullptr)},
                    {"detp_boundary", hasRadius ? nlohmann::json(boundary) : nlohmann::json(nullptr)},
                    {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute}, {"envelope", envelope},
-                   {"seed", seed}, {"threads", threads}, {"inputs_fingerprint", inputsFingerprint}};
+                   {"aim_emission", aimEmission}, {"seed", seed}, {"threads", threads}, {"inputs_fingerprint", inputsFingerprint}};
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
                   {"degenerate_triangles", degenerateTriangles}, {"animation_diagonal", animationDiagonal}};
+    // Aimed emission's effect (issue 12), from the run's first frame: the share of the lights'
+    // power sent toward the scene, and the photons whose first segment still hit nothing.
+    const bool traced = emissionMeasured;
+    j["emission"] = {{"emitted_fraction", traced ? json(emittedFraction) : json(nullptr)},
+                     {"first_segment_miss_rate",
+                      traced ? json(double(photonsMissingScene) / double(std::max<uint64_t>(photons, 1))) : json(nullptr)}};
     std::vector<double> updates, estimates;
     for (size_t i = 1; i < frames.size(); ++i) {
         updates.push_back(frames[i].photonSimulationSeconds);

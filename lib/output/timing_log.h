@@ -76,7 +76,10 @@ struct TimingLog {
     int threads = 0;
     bool fullRecompute = false;
     bool envelope = true;
+    bool aimEmission = true;
     uint64_t photonsMissingScene = 0;  // at the run's first frame
+    double emittedFraction = 1;        // LightSampler::emittedFraction
+    bool emissionMeasured = false;     // the two above are set (after this run's first frame)
     // scene
     std::string scene;
     uint64_t vertices = 0, triangles = 0, dynamicVertices = 0, lights = 0;

@@ -10,8 +10,20 @@
 
 namespace qsgi {
 
+namespace {
+
+// Photons are aimed at what the estimator can count: DETP's discs reach r beside the geometry
+// (segments passing an open edge cross them); the other estimators count impacts only.
+TraceSettings aimedAtEstimator(TraceSettings trace, const EstimatorSettings& e) {
+    trace.aim.margin = e.kind == EstimatorKind::Detp ? e.radius : 0.0f;
+    return trace;
+}
+
+}  // namespace
+
 FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings)
-    : scene_(scene), device_(device), settings_(settings), bvh_(device, scene), tracer_(scene, bvh_, settings.trace) {
+    : scene_(scene), device_(device), settings_(settings), bvh_(device, scene),
+      tracer_(scene, bvh_, aimedAtEstimator(settings.trace, settings.estimator)) {
     if (needsDiscRegions(settings_.estimator)) regions_.emplace(makeDiscRegions(settings_.estimator));
 }
 
@@ -109,7 +121,7 @@ void FrameSolver::solveFromScratch(FrameWork& work) {
     const RayCache cache = tracer_.traceAll();
     work.photonSeconds = clock.seconds();
     work.segments = cache.segments.size();
-    work.photonsMissingScene = cache.pathsMissingScene();
+    work.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
     work.pathsRetraced = cache.pathCount();
     work.segmentsAdded = cache.segments.size();
     maxPhotonPower_ = cache.maxPhotonPower;

@@ -60,6 +60,8 @@ public:
     void reset() { solved_ = regionsValid_ = false; }
 
     const SceneBvh& bvh() const { return bvh_; }
+    // The share of the lights' power that emission sends toward the scene (LightSampler).
+    double emittedFraction() const { return tracer_.lights().emittedFraction(); }
     const DiscRegions* regions() const { return regions_ ? &*regions_ : nullptr; }
     uint64_t ownSurfaceFallbacks() const { return regions_ ? regions_->fallbackVertices() : 0; }
     uint64_t buriedVertices() const { return regions_ ? regions_->buriedVertices() : 0; }

@@ -217,6 +217,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     log.rayCache = settings_.estimator.useIndex;
     log.fullRecompute = settings_.fullRecompute;
     log.envelope = settings_.useEnvelope;
+    log.aimEmission = settings_.aimEmission;
     log.sortQueries = settings_.estimator.sortQueries;
     log.detpIndex = settings_.estimator.detpIndex == DetpIndex::Flann ? "flann" : "embree";
     log.boundary = detpBoundaryName(settings_.estimator.boundary);
@@ -255,7 +256,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     };
     FrameSolverSettings solverSettings;
     solverSettings.estimator = settings_.estimator;
-    solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces};
+    solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces, EmissionAim{settings_.aimEmission, 0}};
     solverSettings.fullRecompute = settings_.fullRecompute;
     solverSettings.useEnvelope = settings_.useEnvelope;
     solverSettings.gridForBlocking = settings_.blockingGrid;
@@ -310,7 +311,11 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         timing.discRegionsUpdated = work.discRegionsUpdated;
         timing.ownSurfaceFallbacks = solver.ownSurfaceFallbacks();
         timing.buriedVertices = solver.buriedVertices();
-        if (frame == start) log.photonsMissingScene = work.photonsMissingScene;
+        if (frame == start) {
+            log.photonsMissingScene = work.photonsMissingScene;
+            log.emittedFraction = solver.emittedFraction();
+            log.emissionMeasured = true;
+        }
 
         std::optional<RgbImage> image;
         Stopwatch clock;

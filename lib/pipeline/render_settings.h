@@ -33,6 +33,7 @@ struct RenderSettings {
     int threads = 0;  // 0: all cores
     bool fullRecompute = false;  // every frame from scratch instead of the incremental update
     bool useEnvelope = true;     // fold paths that never meet the moving geometry's envelope
+    bool aimEmission = true;     // projection maps: lights emit only toward the scene
     bool blockingGrid = true;    // find blocked segments through the grid (false: test every tracked one)
     std::optional<FrameRange> frames;
     bool resume = false;  // continue outDir after its last complete frame (same fingerprint only)

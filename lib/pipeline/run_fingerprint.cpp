@@ -63,7 +63,7 @@ std::string runFingerprint(const RenderSettings& s, const Scene& scene, const st
                                int64_t(e.detpIndex), int64_t(e.boundary), int64_t(s.photons), int64_t(s.seed),
                                int64_t(s.maxBounces), s.width, s.height, s.samplesPerPixel, int64_t(s.writeExr),
                                int64_t(s.exrHalf), int64_t(s.writePng), int64_t(s.exposure.has_value()),
-                               int64_t(s.writeGltf)});
+                               int64_t(s.writeGltf), int64_t(s.aimEmission)});
     f.addValue(e.radius);
     f.addValue(s.exposure.value_or(0.0f));
     f.addValue(camera.position);

@@ -32,6 +32,7 @@ private:
 // impact of segment k-1.
 namespace rng_dim {
 constexpr uint32_t kLightChoice = 0, kEmitPosition0 = 1, kEmitPosition1 = 2, kEmitDirection0 = 3, kEmitDirection1 = 4;
+constexpr uint32_t kEmitCell = 5;  // a projection map's cell (aimed emission)
 constexpr uint32_t kSurvival = 0, kScatterDirection0 = 1, kScatterDirection1 = 2;
 }  // namespace rng_dim
 

@@ -6,7 +6,17 @@
 
 namespace qsgi {
 
-LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon)
+namespace {
+
+// Projection maps have 2^8 × 2^8 cells: around a far scene's silhouette the kept cells that
+// reach nothing are a few per cent of the kept ones, and a map costs a few milliseconds.
+constexpr int kMapDepth = 8;
+
+Vec3d toDouble(const Vec3f& v) { return {double(v.x), double(v.y), double(v.z)}; }
+
+}  // namespace
+
+LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim)
     : scene_(scene), rayEpsilon_(rayEpsilon) {
     const Bounds3f b = scene.animationBounds;
     boundsCentre_ = b.center();
@@ -36,6 +46,19 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         // One-sided Lambertian emitter: exitance π L_e over the area.
         emitters_.push_back({Emitter::Triangle, t, m.emission * (kPi * area), Vec3f(0.0f)});
     }
+    double unaimed = 0;
+    for (Emitter& e : emitters_) {
+        if (e.kind == Emitter::Triangle || !aim.enabled) {
+            unaimed += luminance(e.power);
+            continue;
+        }
+        // Unaimed, a directional light crosses the disc around the scene (padded by the margin).
+        const double padded = double(boundsRadius_) + double(aim.margin);
+        unaimed += e.kind == Emitter::Directional
+                       ? double(luminance(scene.lights[e.index].intensity)) * M_PI * padded * padded
+                       : double(luminance(e.power));
+        aimLight(e, aim);
+    }
     // Drop emitters that would never be chosen.
     emitters_.erase(std::remove_if(emitters_.begin(), emitters_.end(),
                                    [](const Emitter& e) { return !(luminance(e.power) > 0); }),
@@ -46,11 +69,58 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         cdf_.push_back(sum);
         totalPower_ += e.power;
     }
+    emittedFraction_ = unaimed > 0 ? std::min(1.0, sum / unaimed) : 1.0;
     for (Emitter& e : emitters_) {
         const double p = luminance(e.power) / sum;
         e.photonPower = e.power * float(1.0 / (double(photonCount) * p));
         maxPhotonPower_ = std::max(maxPhotonPower_, maxComponent(e.photonPower));
     }
+}
+
+void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
+    const PunctualLight& l = scene_.lights[e.index];
+    // Every point that counts lies within `margin` of geometry, so within `reach` of the centre.
+    const double epsilon = 16.0 * double(scene_.sceneEpsilon());
+    const double margin = double(settings.margin) + epsilon;
+    const Vec3d centre = toDouble(boundsCentre_);
+    const double reach = double(boundsRadius_) + margin;
+    Aim a;
+    std::vector<Target> targets;
+    if (e.kind == Emitter::Directional) {
+        a.axis = normalize(toDouble(l.direction));
+        a.halfSize = reach;
+        targets = mapTargets(scene_, epsilon, settings.margin, [&](const Vec3d&) { return a.axis; });
+        a.map = footprintMap(centre, a.axis, a.halfSize, targets, kMapDepth);
+        e.power = l.intensity * float(4 * reach * reach * a.map.keptFraction());
+    } else {
+        const Vec3d apex = toDouble(l.position);
+        const double distance = length(centre - apex);
+        const bool outside = distance > reach;
+        // The domain: the cone around the scene's sphere for a light outside it, the spot's own
+        // cone if that is narrower, or every direction.
+        const double cosScene = outside ? std::sqrt(std::max(0.0, 1 - (reach / distance) * (reach / distance))) : -1.0;
+        const double cosSpot = e.kind == Emitter::Spot ? double(l.cosOuterCone) : -1.0;
+        const Vec3d spotAxis = normalize(toDouble(l.direction));
+        if (cosSpot >= cosScene) {
+            a.axis = e.kind == Emitter::Spot ? spotAxis : Vec3d(0, 0, 1);
+            a.cosMax = cosSpot;
+        } else {
+            a.axis = (centre - apex) * (1.0 / distance);
+            a.cosMax = cosScene;
+            if (e.kind == Emitter::Spot) {
+                a.spotAxis = spotAxis;
+                a.cosSpot = cosSpot;
+            }
+        }
+        targets = mapTargets(scene_, epsilon, settings.margin, [&](const Vec3d& q) { return normalize(q - apex); });
+        a.map = directionMap(apex, a.axis, a.cosMax, spotAxis, a.spotAxis ? cosSpot : -1.0, targets, kMapDepth);
+        // A light inside the scene whose every direction may reach something emits as unaimed.
+        if (a.map.keptFraction() == 1 && !outside && !a.spotAxis) return;
+        e.power = l.intensity * float(2 * M_PI * (1 - a.cosMax) * a.map.keptFraction());
+    }
+    orthonormalBasis(a.axis, a.t, a.b);
+    e.aim = int(aims_.size());
+    aims_.push_back(std::move(a));
 }
 
 PhotonEmission LightSampler::sample(const PhotonRandom& rng) const {
@@ -64,6 +134,27 @@ PhotonEmission LightSampler::sample(const PhotonRandom& rng) const {
 
     PhotonEmission out;
     out.power = e.photonPower;
+    if (e.aim >= 0) {
+        const Aim& a = aims_[size_t(e.aim)];
+        const PunctualLight& l = scene_.lights[e.index];
+        double x, y;
+        if (e.kind == Emitter::Directional) {
+            a.map.sample(rng.uniform(0, kEmitCell), u0, u1, x, y);
+            const Vec3d across = a.t * ((2 * x - 1) * a.halfSize) + a.b * ((2 * y - 1) * a.halfSize);
+            out.origin = Vec3f(toDouble(boundsCentre_) + across - a.axis * (2 * a.halfSize));
+            out.direction = l.direction;
+            return out;
+        }
+        // uniformCone's parameterisation, in double: the map's cells are exact in it.
+        a.map.sample(rng.uniform(0, kEmitCell), v0, v1, x, y);
+        const double cosTheta = 1 - x * (1 - a.cosMax), sinTheta = std::sqrt(std::max(0.0, 1 - cosTheta * cosTheta));
+        const double phi = 2 * M_PI * y;
+        const Vec3d d = normalize(a.t * (sinTheta * std::cos(phi)) + a.b * (sinTheta * std::sin(phi)) + a.axis * cosTheta);
+        out.origin = l.position;
+        out.direction = Vec3f(d);
+        if (a.spotAxis && dot(d, *a.spotAxis) < a.cosSpot) out.power = Vec3f(0.0f);
+        return out;
+    }
     switch (e.kind) {
         case Emitter::Point: {
             out.origin = scene_.lights[e.index].position;

@@ -1,42 +1,71 @@
 // Chooses where photons start (DESIGN §4): every emitter — punctual lights and each emissive
-// triangle — in proportion to its power's luminance.
+// triangle — in proportion to the power it sends toward the scene. With aiming on, point, spot
+// and directional lights emit only where their projection map (projection_map.h) says photons
+// may reach geometry, each photon carrying the power of the part actually sampled.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "scene/scene.h"
 #include "trace/counter_rng.h"
+#include "trace/projection_map.h"
 
 namespace qsgi {
 
 struct PhotonEmission {
     Vec3f origin;
     Vec3f direction;
-    Vec3f power;       // W per photon, RGB
+    Vec3f power;       // W per photon, RGB; zero for a photon a spot light does not send
     float originOffsetT = 0;  // tnear for the first segment (area lights: lift off the surface)
+};
+
+// How emission is aimed. margin: how far from geometry a first segment still counts (DETP's
+// disc radius: segments that pass beside an open edge cross its discs; 0 for estimators that
+// count impacts only).
+struct EmissionAim {
+    bool enabled = true;
+    float margin = 0;
 };
 
 class LightSampler {
 public:
     // photonCount is the number of photons the power is shared among.
-    LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon);
+    LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim = {false, 0});
 
     bool empty() const { return emitters_.empty(); }
-    Vec3f totalPower() const { return totalPower_; }  // W, RGB
+    Vec3f totalPower() const { return totalPower_; }  // W, RGB, that the emitters send
+    // The luminance of what the emitters send over what they would send unaimed: the share of
+    // the lights' power that can reach the scene (1 unaimed).
+    double emittedFraction() const { return emittedFraction_; }
     float maxPhotonPower() const { return maxPhotonPower_; }
     PhotonEmission sample(const PhotonRandom& rng) const;
 
 private:
+    // A light's projection map and the domain it covers.
+    struct Aim {
+        ProjectionMap map;
+        Vec3d axis{0, 0, 1}, t, b;  // the cone's axis (point, spot) or the light's direction, and its basis
+        double cosMax = -1;         // point, spot: the cone the map covers
+        double halfSize = 0;        // directional: the square the map covers
+        std::optional<Vec3d> spotAxis;  // a spot light whose cone the map does not follow
+        double cosSpot = -1;
+    };
     struct Emitter {
         enum Kind { Point, Spot, Directional, Triangle } kind;
         uint32_t index;   // light or triangle index
-        Vec3f power;      // W
+        Vec3f power;      // W, sent toward the scene
         Vec3f photonPower;
+        int aim = -1;     // into aims_, −1: unaimed
     };
+    void aimLight(Emitter& e, const EmissionAim& aim);
+
     const Scene& scene_;
     std::vector<Emitter> emitters_;
+    std::vector<Aim> aims_;
     std::vector<double> cdf_;
     Vec3f totalPower_{0.0f};
+    double emittedFraction_ = 1;
     float maxPhotonPower_ = 0;
     Vec3f boundsCentre_;
     float boundsRadius_ = 0;

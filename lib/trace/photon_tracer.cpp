@@ -11,11 +11,12 @@
 namespace qsgi {
 
 PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings)
-    : scene_(scene), bvh_(bvh), settings_(settings), lights_(scene, settings.photons, bvh.rayEpsilon()),
+    : scene_(scene), bvh_(bvh), settings_(settings), lights_(scene, settings.photons, bvh.rayEpsilon(), settings.aim),
       bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {}
 
 void PhotonTracer::tracePath(uint64_t path, std::vector<Segment>& out) const {
     const PhotonEmission e = lights_.sample(PhotonRandom(settings_.seed, path));
+    if (!(maxComponent(e.power) > 0)) return;  // a spot light's photon outside its cone: nothing sent
     continuePath(path, 0, e.origin, e.direction, e.power, 0.0f, out);
 }
 

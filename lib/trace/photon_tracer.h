@@ -16,6 +16,7 @@ struct TraceSettings {
     uint64_t photons = 100000;
     uint64_t seed = 1;
     uint32_t maxBounces = 32;
+    EmissionAim aim;  // on by default; its margin is the estimator's reach (FrameSolver sets it)
 };
 
 class PhotonTracer {

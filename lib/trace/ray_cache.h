@@ -33,11 +33,12 @@ struct RayCache {
 
     size_t pathCount() const { return pathBegin.empty() ? 0 : pathBegin.size() - 1; }
 
-    // Photons whose first segment hit nothing (lights pointing away from, or far from, the scene).
+    // Photons whose first segment hit nothing (lights pointing away from, or far from, the scene),
+    // and photons with no segment (an aimed spot light's outside its cone).
     uint64_t pathsMissingScene() const {
         uint64_t missed = 0;
         for (size_t path = 0; path < pathCount(); ++path)
-            if (pathBegin[path] < pathBegin[path + 1] && !segments[pathBegin[path]].hasImpact()) ++missed;
+            if (pathBegin[path] == pathBegin[path + 1] || !segments[pathBegin[path]].hasImpact()) ++missed;
         return missed;
     }
 };
