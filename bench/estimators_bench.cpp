@@ -12,6 +12,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -306,8 +307,51 @@ void estimatorArguments(benchmark::internal::Benchmark* b) {
     b->ArgNames({"estimator", "photons", "radius_mm", "mode", "boundary"});
 }
 
+// Issue 12's wasteful case: a third-party model lit from a config, a point light 2 m from it and
+// a directional light (../shared's FlightHelmet). Each iteration builds the tracer (projection
+// maps included) and traces; landed_photons_per_s counts photons whose first segment hits
+// geometry. margin_mm: the reach the maps keep beside geometry (DETP's default radius for this
+// model is 13 mm; 0 for estimators that count impacts only).
+void BM_FlightHelmetEmission(benchmark::State& state) {
+    const std::string path = QSGI_SOURCE_DIR "/../shared/data/gltf-samples/models/FlightHelmet/glTF/FlightHelmet.gltf";
+    static Scene scene;
+    static bool loaded = false;
+    if (!loaded) {
+        if (!std::ifstream(path)) {
+            state.SkipWithError("../shared/data/gltf-samples (FlightHelmet) is absent beside the repository");
+            return;
+        }
+        Warnings w;
+        scene = loadGltfScene(path, w);
+        PunctualLight point;
+        point.type = LightType::Point;
+        point.position = Vec3f(Vec3d(0.0, 0.3, 2.0) - scene.worldOrigin);
+        point.intensity = Vec3f(10.0f);
+        PunctualLight sun;
+        sun.type = LightType::Directional;
+        sun.direction = normalize(Vec3f(0.0f, -1.0f, -0.3f));
+        sun.intensity = Vec3f(2.0f);
+        scene.lights = {point, sun};
+        loaded = true;
+    }
+    EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
+    const uint64_t photons = 200000;
+    const EmissionAim aim{state.range(0) != 0, float(state.range(1)) / 1000.0f};
+    uint64_t landed = 0;
+    for (auto _ : state) {
+        const PhotonTracer tracer(scene, bvh, TraceSettings{photons, 1, 32, aim});
+        const RayCache cache = tracer.traceAll();
+        landed = photons - cache.pathsMissingScene();
+    }
+    state.counters["landed_photons_per_s"] = benchmark::Counter(double(landed), benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["missed_fraction"] = 1.0 - double(landed) / double(photons);
+}
+
 }  // namespace
 
+BENCHMARK(BM_FlightHelmetEmission)->Args({0, 0})->Args({1, 0})->Args({1, 13})->ArgNames({"aim", "margin_mm"})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TracePhotons)->Arg(100000)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EmbreeClosestHitCeiling)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DetpSegments)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})

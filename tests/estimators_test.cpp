@@ -296,7 +296,9 @@ TEST(Estimators, DetpAndPhotonMapAreIndependentOfTessellation) {
     testscenes::addPointLight(coarse, Vec3f(0, 1, 0), Vec3f(1.0f));
     testscenes::addPointLight(fine, Vec3f(0, 1, 0), Vec3f(1.0f));
     const uint64_t photons = 400000;
-    const RayCache cc = trace(coarse, photons), cf = trace(fine, photons);
+    // Unaimed: a projection map follows the tessellation's discs, so aimed photons would not fly
+    // the same paths over both meshes, and this compares the estimators, not the emission.
+    const RayCache cc = traceScene(coarse, photons, 11, false), cf = traceScene(fine, photons, 11, false);
     // Shared interior vertices: coarse (i, j) is fine (8i, 8j).
     auto fineIndex = [](int i, int j) { return size_t(8 * j) * 129 + size_t(8 * i); };
     double detpDiff = 0, pmDiff = 0, icCoarseVar = 0, icFineVar = 0;

@@ -122,7 +122,8 @@ Vec3d slide(int f, double dx, double dz) { return Vec3d(dx * f, 0, dz * f); }
 
 // The scenes of the issue: the mover casts a shadow on lit static surfaces and is lit itself
 // (cube on a floor under a light); it stands on the floor, within r of it (reachable areas
-// change); a directional light; and a mover that leaves the static scene's bounds.
+// change); a directional light; a point light far outside the scene; and a mover that leaves
+// the static scene's bounds.
 std::vector<AnimatedScene> scenes() {
     auto cubeOnFloor = [](bool directional) {
         return [directional] {
@@ -139,10 +140,18 @@ std::vector<AnimatedScene> scenes() {
             return s;
         };
     };
+    // Emission is aimed (issue 12) in every scene: the point light above the floor is inside the
+    // scene's sphere, yet half its directions reach nothing; this one is far outside it.
+    auto farLight = [] {
+        Scene s = testscenes::boxOnFloor(16, 3, Vec3f(0.7f));
+        testscenes::addPointLight(s, Vec3f(6.0f, 9.0f, 4.0f), Vec3f(400.0f));
+        return s;
+    };
     return {
         {"shadow and lit mover", cubeOnFloor(false), "Cube", [](int f) { return slide(f, 0.11, 0.05); }, 5},
         {"directional light", cubeOnFloor(true), "Cube", [](int f) { return slide(f, -0.09, 0.07); }, 4},
         {"mover leaves the static bounds", cubeOnFloor(false), "Cube", [](int f) { return slide(f, 0.9, 0.0); }, 4},
+        {"light far outside the scene (aimed emission)", farLight, "Cube", [](int f) { return slide(f, 0.1, -0.08); }, 4},
         {"mover lifts off and back", cubeOnFloor(false), "Cube",
          [](int f) { return Vec3d(0.0, f % 2 ? 0.02 : 0.0, 0.03 * f); }, 5},
     };

@@ -57,13 +57,13 @@ EstimatorSettings NamedEstimator::settings(float radius, int k) const {
     return s;
 }
 
-RayCache traceScene(const Scene& scene, uint64_t photons, uint64_t seed) {
+RayCache traceScene(const Scene& scene, uint64_t photons, uint64_t seed, bool aim) {
     EmbreeDevice device;
     const SceneBvh bvh(device, scene);
     // Aimed as a render aims (issue 12), at 10 % of the diagonal beside the geometry: more than
     // any DETP radius the tests estimate these photons with.
-    const EmissionAim aim{true, 0.1f * scene.animationBounds.extent()};
-    return PhotonTracer(scene, bvh, TraceSettings{photons, seed, 32, aim}).traceAll();
+    const EmissionAim aiming{aim, 0.1f * scene.animationBounds.extent()};
+    return PhotonTracer(scene, bvh, TraceSettings{photons, seed, 32, aiming}).traceAll();
 }
 
 VertexRadiosity estimateWith(const Scene& scene, const RayCache& cache, const EstimatorSettings& settings) {
@@ -145,6 +145,20 @@ Scene plane(float halfSize, int cells, Vec3f albedo) {
     const uint32_t m = addMaterial(s, albedo);
     // y = 0, facing +y.
     addGrid(s, s.addNode("Plane", Transform()), {-halfSize, 0, halfSize}, {2 * halfSize, 0, 0}, {0, 0, -2 * halfSize}, cells, m);
+    s.finalize();
+    return s;
+}
+
+Scene plateAndSliver(float half, int cells, float width, float offset, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    addGrid(s, s.addNode("Plate", Transform()), {-half, 0, half}, {2 * half, 0, 0}, {0, 0, -2 * half}, cells, m);
+    // Ten pieces along its length (addGrid's grids are square in cells), one cell each.
+    for (int k = 0; k < 10; ++k) {
+        const float z = 0.5f - 0.1f * float(k);
+        addGrid(s, s.addNode("Sliver" + std::to_string(k), Transform()), {offset - 0.5f * width, 0, z}, {width, 0, 0},
+                {0, 0, -0.1f}, 1, m);
+    }
     s.finalize();
     return s;
 }

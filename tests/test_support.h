@@ -30,8 +30,9 @@ struct NamedEstimator {
     qsgi::EstimatorSettings settings(float radius, int k = 50) const;
 };
 
-// Every photon of the scene traced once (max 32 bounces), as a render's first frame does.
-qsgi::RayCache traceScene(const qsgi::Scene& scene, uint64_t photons, uint64_t seed);
+// Every photon of the scene traced once (max 32 bounces), as a render's first frame does; aimed
+// (issue 12) unless `aim` is false.
+qsgi::RayCache traceScene(const qsgi::Scene& scene, uint64_t photons, uint64_t seed, bool aim = true);
 // Density estimation of the scene's current pose with these settings (disc regions computed here).
 qsgi::VertexRadiosity estimateWith(const qsgi::Scene& scene, const qsgi::RayCache& cache,
                                    const qsgi::EstimatorSettings& settings);
@@ -57,6 +58,9 @@ qsgi::Scene partition(int cells, qsgi::Vec3f albedo);
 // normals are 45° from both faces); otherwise the crease row is duplicated, each side with its
 // face normal. Both have the same triangles in the same order.
 qsgi::Scene creasedSheet(int cells, bool welded, qsgi::Vec3f albedo);
+// A square plate y = 0 (half size `half`, `cells` per side, facing up) and, `offset` along x
+// from its centre, a sliver y = 0 (`width` along x, 1 along z, 10 cells, facing up).
+qsgi::Scene plateAndSliver(float half, int cells, float width, float offset, qsgi::Vec3f albedo);
 void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
 // Writes a small glTF (a quad; emissive if lit) with an embedded buffer.
 void writeQuadGltf(const std::string& path, bool lit);

@@ -155,7 +155,7 @@ ProjectionMap::ProjectionMap(int depth, const std::vector<Target>& targets, cons
         tbb::parallel_for(size_t(0), level.size(), [&](size_t i) {
             const Cell& c = level[i];
             const double x0 = c.column * size, y0 = c.row * size;
-            auto keep = [&](uint32_t t) { return mayOverlap(x0, y0, x0 + size, y0 + size, t); };
+            const auto keep = mayOverlap(x0, y0, x0 + size, y0 + size);
             const std::vector<uint32_t>& candidates = parentNear[c.parent];
             if (l < depth) near[i] = filterCandidates(candidates, keep);
             else if (std::any_of(candidates.begin(), candidates.end(), keep)) near[i].push_back(0);
@@ -192,7 +192,7 @@ ProjectionMap directionMap(const Vec3d& apex, const Vec3d& axis, double cosMax, 
     // normals of its edges' great circles, its orientation), and the angle its dilation adds at
     // its nearest point; or "around the apex".
     struct Seen {
-        Vec3d corner[3], edgeNormal[3];
+        Vec3d corner[3], edgeNormal[3], edgeCross[3];  // edgeCross: corner k × corner k+1
         bool edgeIsArc[3] = {false, false, false};
         double orientation = 0;  // sign of det(corners); 0: degenerate (a segment, a point, or edge-on)
         double angularRadius = 0;
@@ -209,6 +209,7 @@ ProjectionMap directionMap(const Vec3d& apex, const Vec3d& axis, double cosMax, 
         for (int k = 0; k < 3; ++k) s.corner[k] = normalize(t.corner[k] - apex);
         for (int k = 0; k < 3; ++k) {
             const Vec3d n = cross(s.corner[k], s.corner[(k + 1) % 3]);
+            s.edgeCross[k] = n;
             s.edgeIsArc[k] = length(n) >= 1e-12;
             if (s.edgeIsArc[k]) s.edgeNormal[k] = n * (1.0 / length(n));
             // Corners on opposite sides of the apex on one line: the edge passes beside it at
@@ -218,23 +219,29 @@ ProjectionMap directionMap(const Vec3d& apex, const Vec3d& axis, double cosMax, 
         const double det = dot(s.corner[0], cross(s.corner[1], s.corner[2]));
         s.orientation = std::abs(det) > 1e-15 ? (det > 0 ? 1.0 : -1.0) : 0.0;
     });
-    // The angle from unit u to the nearest direction of target s (0 inside it).
-    auto angleToTarget = [](const Seen& s, const Vec3d& u) {
+    // Whether some direction of target s lies within angle `reach` of unit u: inside the
+    // spherical triangle, or within reach of a corner or an edge's arc. Compared through cosines
+    // and sines (cos(reach), sin(reach) given), so no test calls a transcendental function.
+    auto within = [](const Seen& s, const Vec3d& u, double cosReach, double sinReach) {
         if (s.orientation != 0) {
             bool inside = true;
-            for (int k = 0; k < 3; ++k) inside &= s.orientation * dot(u, cross(s.corner[k], s.corner[(k + 1) % 3])) >= 0;
-            if (inside) return 0.0;
+            for (int k = 0; k < 3; ++k) inside &= s.orientation * dot(u, s.edgeCross[k]) >= 0;
+            if (inside) return true;
         }
-        double best = std::min({angleBetween(u, s.corner[0]), angleBetween(u, s.corner[1]), angleBetween(u, s.corner[2])});
+        for (int k = 0; k < 3; ++k)
+            if (dot(u, s.corner[k]) >= cosReach) return true;
         for (int k = 0; k < 3; ++k) {
             if (!s.edgeIsArc[k]) continue;
             const Vec3d& n = s.edgeNormal[k];
             const double h = dot(u, n);
             const Vec3d inPlane = u - n * h;
-            if (dot(cross(s.corner[k], inPlane), n) >= 0 && dot(cross(inPlane, s.corner[(k + 1) % 3]), n) >= 0)
-                best = std::min(best, std::asin(std::min(1.0, std::abs(h))));
+            // The nearest point of the great circle is u's projection, at angle asin|h|, if it
+            // falls on the arc (and on u's side of the sphere).
+            if (std::abs(h) <= sinReach && dot(inPlane, s.corner[k] + s.corner[(k + 1) % 3]) > 0 &&
+                dot(cross(s.corner[k], inPlane), n) >= 0 && dot(cross(inPlane, s.corner[(k + 1) % 3]), n) >= 0)
+                return true;
         }
-        return best;
+        return false;
     };
     Vec3d t, b;
     orthonormalBasis(axis, t, b);
@@ -244,15 +251,21 @@ ProjectionMap directionMap(const Vec3d& apex, const Vec3d& axis, double cosMax, 
     // (θm, φm), the middle of its θ and φ ranges; any direction (θ, φ) of the cell is within
     // sin θm·|φ − φm| (along the circle of latitude θm, no shorter than the great circle) plus
     // |θ − θm| (along the meridian) of it.
-    auto mayOverlap = [&](double x0, double y0, double x1, double y1, uint32_t i) {
-        const Seen& s = seen[i];
-        if (s.surroundsApex) return true;
+    auto mayOverlap = [&](double x0, double y0, double x1, double y1) {
         const double thetaA = theta(x0), thetaB = theta(x1), thetaM = 0.5 * (thetaA + thetaB);
         const double phiM = M_PI * (y0 + y1);
         const Vec3d cellAxis = t * (std::sin(thetaM) * std::cos(phiM)) + b * (std::sin(thetaM) * std::sin(phiM)) + axis * std::cos(thetaM);
         const double halfAngle = 0.5 * (thetaB - thetaA) + std::sin(thetaM) * M_PI * (y1 - y0) + kAngleSlack;
-        if (cosExtra > -1 && angleBetween(cellAxis, extraAxis) > halfAngle + extraAngle) return false;
-        return angleToTarget(s, cellAxis) <= halfAngle + s.angularRadius;
+        const bool outsideExtra = cosExtra > -1 && angleBetween(cellAxis, extraAxis) > halfAngle + extraAngle;
+        return [&seen, &within, cellAxis, halfAngle, outsideExtra](uint32_t i) {
+            const Seen& s = seen[i];
+            if (outsideExtra) return false;
+            if (s.surroundsApex) return true;
+            const double reach = halfAngle + s.angularRadius;
+            if (reach >= M_PI) return true;
+            // Beyond a right angle the arc test's "nearest point" reasoning needs |h| ≤ 1 only.
+            return within(s, cellAxis, std::cos(reach), reach >= M_PI / 2 ? 1.0 : std::sin(reach));
+        };
     };
     return ProjectionMap(depth, targets, mayOverlap);
 }
@@ -277,21 +290,23 @@ ProjectionMap footprintMap(const Vec3d& centre, const Vec3d& direction, double h
         f.orientation = area > 0 ? 1.0 : area < 0 ? -1.0 : 0.0;
     }
     const double slack = 1e-6 * halfSize;
-    auto mayOverlap = [&](double x0, double y0, double x1, double y1, uint32_t i) {
-        const Flat& f = flat[i];
+    auto mayOverlap = [&](double x0, double y0, double x1, double y1) {
         const double X0 = (2 * x0 - 1) * halfSize, X1 = (2 * x1 - 1) * halfSize;
         const double Y0 = (2 * y0 - 1) * halfSize, Y1 = (2 * y1 - 1) * halfSize;
-        const double reach = targets[i].radius + slack;
-        for (int k = 0; k < 3; ++k)
-            if (segmentToRectangle(f.x[k], f.y[k], f.x[(k + 1) % 3], f.y[(k + 1) % 3], X0, Y0, X1, Y1) <= reach) return true;
-        // No edge near the rectangle: it meets the triangle only if it lies inside it.
-        if (f.orientation == 0) return false;
-        const double cx = 0.5 * (X0 + X1), cy = 0.5 * (Y0 + Y1);
-        for (int k = 0; k < 3; ++k) {
-            const int j = (k + 1) % 3;
-            if (f.orientation * ((f.x[j] - f.x[k]) * (cy - f.y[k]) - (f.y[j] - f.y[k]) * (cx - f.x[k])) < 0) return false;
-        }
-        return true;
+        return [&flat, &targets, slack, X0, X1, Y0, Y1](uint32_t i) {
+            const Flat& f = flat[i];
+            const double reach = targets[i].radius + slack;
+            for (int k = 0; k < 3; ++k)
+                if (segmentToRectangle(f.x[k], f.y[k], f.x[(k + 1) % 3], f.y[(k + 1) % 3], X0, Y0, X1, Y1) <= reach) return true;
+            // No edge near the rectangle: it meets the triangle only if it lies inside it.
+            if (f.orientation == 0) return false;
+            const double cx = 0.5 * (X0 + X1), cy = 0.5 * (Y0 + Y1);
+            for (int k = 0; k < 3; ++k) {
+                const int j = (k + 1) % 3;
+                if (f.orientation * ((f.x[j] - f.x[k]) * (cy - f.y[k]) - (f.y[j] - f.y[k]) * (cx - f.x[k])) < 0) return false;
+            }
+            return true;
+        };
     };
     return ProjectionMap(depth, targets, mayOverlap);
 }

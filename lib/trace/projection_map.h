@@ -46,8 +46,9 @@ std::vector<Target> mapTargets(const Scene& scene, double epsilon, double discRa
 class ProjectionMap {
 public:
     ProjectionMap() = default;
-    // mayOverlap(x0, y0, x1, y1, i): whether target i may meet the part of the domain that the
-    // square [x0, x1] × [y0, y1] maps to (false only if it certainly does not). Defined, and
+    // mayOverlap(x0, y0, x1, y1) returns a test of the square [x0, x1] × [y0, y1]: called with
+    // a target's index, whether the target may meet the part of the domain the square maps to
+    // (false only if it certainly does not). The square's own bounds are worked out once. Defined, and
     // instantiated, in projection_map.cpp: directionMap and footprintMap make every map.
     template <class MayOverlap>
     ProjectionMap(int depth, const std::vector<Target>& targets, const MayOverlap& mayOverlap);

@@ -147,7 +147,8 @@ std::optional<SurfaceHit> SceneBvh::intersectPart(const EmbreeScene& embree, con
     RTCRayHit rh = makeRay(origin, direction, tnear, tfar);
     rtcIntersect1(embree.get(), &context.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-    return SurfaceHit{rh.ray.tfar, part.triangles[rh.hit.primID], rh.hit.u, rh.hit.v};
+    return SurfaceHit{rh.ray.tfar, part.triangles[rh.hit.primID], rh.hit.u, rh.hit.v,
+                      Vec3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)};
 }
 
 std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {

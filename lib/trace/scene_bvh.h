@@ -18,6 +18,7 @@ struct SurfaceHit {
     float t = 0;
     uint32_t triangle = 0;  // scene triangle index
     float u = 0, v = 0;     // barycentrics of vertices 1 and 2 of that triangle
+    Vec3f ng;               // Embree's geometric normal: unnormalised, out of the front (CCW) side
 };
 
 class SceneBvh {
