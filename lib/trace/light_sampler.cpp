@@ -8,11 +8,10 @@ namespace qsgi {
 
 namespace {
 
-// Projection maps have 2^8 × 2^8 cells: around a far scene's silhouette the kept cells that
-// reach nothing are a few per cent of the kept ones, and a map costs a few milliseconds.
+// Projection maps have 2^8 × 2^8 cells: around a far model's silhouette the kept cells that
+// reach nothing are a few per cent of the kept ones (FlightHelmet: 5 %). A map costs about
+// 0.25 s per 100,000 triangles on two cores, once per run.
 constexpr int kMapDepth = 8;
-
-Vec3d toDouble(const Vec3f& v) { return {double(v.x), double(v.y), double(v.z)}; }
 
 }  // namespace
 
@@ -82,25 +81,25 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
     // Every point that counts lies within `margin` of geometry, so within `reach` of the centre.
     const double epsilon = 16.0 * double(scene_.sceneEpsilon());
     const double margin = double(settings.margin) + epsilon;
-    const Vec3d centre = toDouble(boundsCentre_);
+    const Vec3d centre = Vec3d(boundsCentre_);
     const double reach = double(boundsRadius_) + margin;
     Aim a;
     std::vector<Target> targets;
     if (e.kind == Emitter::Directional) {
-        a.axis = normalize(toDouble(l.direction));
+        a.axis = normalize(Vec3d(l.direction));
         a.halfSize = reach;
         targets = mapTargets(scene_, epsilon, settings.margin, [&](const Vec3d&) { return a.axis; });
         a.map = footprintMap(centre, a.axis, a.halfSize, targets, kMapDepth);
         e.power = l.intensity * float(4 * reach * reach * a.map.keptFraction());
     } else {
-        const Vec3d apex = toDouble(l.position);
+        const Vec3d apex = Vec3d(l.position);
         const double distance = length(centre - apex);
         const bool outside = distance > reach;
         // The domain: the cone around the scene's sphere for a light outside it, the spot's own
         // cone if that is narrower, or every direction.
         const double cosScene = outside ? std::sqrt(std::max(0.0, 1 - (reach / distance) * (reach / distance))) : -1.0;
         const double cosSpot = e.kind == Emitter::Spot ? double(l.cosOuterCone) : -1.0;
-        const Vec3d spotAxis = normalize(toDouble(l.direction));
+        const Vec3d spotAxis = normalize(Vec3d(l.direction));
         if (cosSpot >= cosScene) {
             a.axis = e.kind == Emitter::Spot ? spotAxis : Vec3d(0, 0, 1);
             a.cosMax = cosSpot;
@@ -141,7 +140,7 @@ PhotonEmission LightSampler::sample(const PhotonRandom& rng) const {
         if (e.kind == Emitter::Directional) {
             a.map.sample(rng.uniform(0, kEmitCell), u0, u1, x, y);
             const Vec3d across = a.t * ((2 * x - 1) * a.halfSize) + a.b * ((2 * y - 1) * a.halfSize);
-            out.origin = Vec3f(toDouble(boundsCentre_) + across - a.axis * (2 * a.halfSize));
+            out.origin = Vec3f(Vec3d(boundsCentre_) + across - a.axis * (2 * a.halfSize));
             out.direction = l.direction;
             return out;
         }

@@ -15,8 +15,6 @@ namespace {
 // by ~1e-7 rad. This slack keeps every cell they can fall in.
 constexpr double kAngleSlack = 1e-6;
 
-Vec3d toDouble(const Vec3f& v) { return {double(v.x), double(v.y), double(v.z)}; }
-
 double angleBetween(const Vec3d& a, const Vec3d& b) { return std::acos(std::clamp(dot(a, b), -1.0, 1.0)); }
 
 double distanceToSegment(const Vec3d& p, const Vec3d& a, const Vec3d& b) {
@@ -120,14 +118,14 @@ std::vector<Target> mapTargets(const Scene& scene, double epsilon, double discRa
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
         if (scene.triangleDynamic[t]) continue;  // inside its instance's swept box
         const Triangle& tri = scene.triangles[t];
-        targets.push_back({{toDouble(scene.positions[tri.v[0]]), toDouble(scene.positions[tri.v[1]]),
-                            toDouble(scene.positions[tri.v[2]])},
+        targets.push_back({{Vec3d(scene.positions[tri.v[0]]), Vec3d(scene.positions[tri.v[1]]),
+                            Vec3d(scene.positions[tri.v[2]])},
                            epsilon});
     }
     if (discRadius > 0)
         for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
             if (scene.vertexDynamic[v]) continue;
-            const Vec3d p = toDouble(scene.positions[v]), n = toDouble(scene.normals[v]);
+            const Vec3d p = Vec3d(scene.positions[v]), n = Vec3d(scene.normals[v]);
             const Vec3d view = lightDirectionAt(p);
             // Crossed from the front only (d·n < 0); the tolerance keeps grazing discs.
             if (dot(view, n) < 1e-6) addDisc(p, n, discRadius, view, epsilon, targets);
