@@ -148,7 +148,7 @@ PhotonEmission LightSampler::sample(const PhotonRandom& rng) const {
         a.map.sample(rng.uniform(0, kEmitCell), v0, v1, x, y);
         const double cosTheta = 1 - x * (1 - a.cosMax), sinTheta = std::sqrt(std::max(0.0, 1 - cosTheta * cosTheta));
         const double phi = 2 * M_PI * y;
-        const Vec3d d = normalize(a.t * (sinTheta * std::cos(phi)) + a.b * (sinTheta * std::sin(phi)) + a.axis * cosTheta);
+        const Vec3d d = normalize(coneDirection(a.axis, a.t, a.b, cosTheta, sinTheta, phi));
         out.origin = l.position;
         out.direction = Vec3f(d);
         if (a.spotAxis && dot(d, *a.spotAxis) < a.cosSpot) out.power = Vec3f(0.0f);

@@ -252,7 +252,7 @@ ProjectionMap directionMap(const Vec3d& apex, const Vec3d& axis, double cosMax, 
     auto mayOverlap = [&](double x0, double y0, double x1, double y1) {
         const double thetaA = theta(x0), thetaB = theta(x1), thetaM = 0.5 * (thetaA + thetaB);
         const double phiM = M_PI * (y0 + y1);
-        const Vec3d cellAxis = t * (std::sin(thetaM) * std::cos(phiM)) + b * (std::sin(thetaM) * std::sin(phiM)) + axis * std::cos(thetaM);
+        const Vec3d cellAxis = coneDirection(axis, t, b, std::cos(thetaM), std::sin(thetaM), phiM);
         const double halfAngle = 0.5 * (thetaB - thetaA) + std::sin(thetaM) * M_PI * (y1 - y0) + kAngleSlack;
         const bool outsideExtra = cosExtra > -1 && angleBetween(cellAxis, extraAxis) > halfAngle + extraAngle;
         return [&seen, &within, cellAxis, halfAngle, outsideExtra](uint32_t i) {

@@ -17,6 +17,7 @@
 // only the cells' bounds are loose.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -66,6 +67,12 @@ private:
     int depth_ = 0;
     std::vector<uint32_t> cells_;  // (row << depth) | column, increasing
 };
+
+// The direction at polar angle θ (given as cos θ, sin θ) and azimuth φ about unit `axis`, with
+// t, b = orthonormalBasis(axis): uniformCone's parameterisation, which direction maps use.
+inline Vec3d coneDirection(const Vec3d& axis, const Vec3d& t, const Vec3d& b, double cosTheta, double sinTheta, double phi) {
+    return t * (sinTheta * std::cos(phi)) + b * (sinTheta * std::sin(phi)) + axis * cosTheta;
+}
 
 // The map of a point or spot light at `apex` over the cone of directions about unit `axis` with
 // cos half-angle cosMax (−1: every direction), with the parameterisation uniformCone uses.
