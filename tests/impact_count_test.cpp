@@ -70,7 +70,7 @@ TEST(ImpactCount, ClosedSphereGivesTwoWattsPerSquareMetre) {
     // predicted variance; the sample variance of ~10^4 vertices (correlated in groups of about 6
     // through shared triangles, so ~1700 independent ones) has a relative standard error of
     // sqrt(2/1700) ≈ 3.4 %; 15 % is over four standard errors.
-    const double phi0 = 4 * M_PI / double(photons);
+    const double phi0 = e.cache.maxPhotonPower;  // 4π I/N, or the aimed solid angle's I Ω/N
     std::vector<double> predictedVar(lit.vertexCount(), 0.0);
     std::vector<int> k(lit.vertexCount(), 0);
     for (uint32_t t = 0; t < lit.triangleCount(); ++t)
@@ -103,7 +103,7 @@ TEST(ImpactCount, PlaneUnderPointLightFollowsInverseSquareCosineLaw) {
     testscenes::addPointLight(scene, Vec3f(0, h, 0), Vec3f(1.0f));
     const uint64_t photons = 1000000;
     const Estimate e = runImpactCount(scene, photons);
-    const double phi0 = 4 * M_PI / double(photons);
+    const double phi0 = e.cache.maxPhotonPower;  // I Ω/N: the solid angle aimed at the plane
 
     std::vector<int> k(scene.vertexCount(), 0);
     for (const Triangle& t : scene.triangles)
