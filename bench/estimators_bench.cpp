@@ -308,71 +308,78 @@ void estimatorArguments(benchmark::internal::Benchmark* b) {
 }
 
 // Issue 12's wasteful case: a third-party model lit from a config, a point light 2 m from it and
-// a directional light (../shared's FlightHelmet), loaded once; null (and the benchmark skipped)
-// where ../shared is absent.
-const Scene* flightHelmet(benchmark::State& state) {
-    static const std::unique_ptr<Scene> scene = [] {
+// a directional light (../shared's FlightHelmet), made once per process like CornellFixture.
+// Both benchmarks trace kPhotons; DETP's default radius for this model, 1.5 % of its
+// diagonal, is 13 mm.
+struct FlightHelmetFixture {
+    static constexpr uint64_t kPhotons = 200000;
+    static constexpr float kDetpRadius = 0.013f;
+    Scene scene;
+    EmbreeDevice device;
+    std::unique_ptr<SceneBvh> bvh;  // null where ../shared is absent
+
+    FlightHelmetFixture() {
         const std::string path =
             QSGI_SOURCE_DIR "/../shared/data/gltf-samples/models/FlightHelmet/glTF/FlightHelmet.gltf";
-        if (!std::ifstream(path)) return std::unique_ptr<Scene>();
+        if (!std::ifstream(path)) return;
         Warnings w;
-        auto s = std::make_unique<Scene>(loadGltfScene(path, w));
+        scene = loadGltfScene(path, w);
         PunctualLight point;
         point.type = LightType::Point;
-        point.position = Vec3f(Vec3d(0.0, 0.3, 2.0) - s->worldOrigin);
+        point.position = Vec3f(Vec3d(0.0, 0.3, 2.0) - scene.worldOrigin);
         point.intensity = Vec3f(10.0f);
         PunctualLight sun;
         sun.type = LightType::Directional;
         sun.direction = normalize(Vec3f(0.0f, -1.0f, -0.3f));
         sun.intensity = Vec3f(2.0f);
-        s->lights = {point, sun};
-        return s;
-    }();
-    if (!scene) state.SkipWithError("../shared/data/gltf-samples (FlightHelmet) is absent beside the repository");
-    return scene.get();
+        scene.lights = {point, sun};
+        bvh = std::make_unique<SceneBvh>(device, scene);
+    }
+    RayCache trace(const EmissionAim& aim) const {
+        return PhotonTracer(scene, *bvh, TraceSettings{kPhotons, 1, 32, aim}).traceAll();
+    }
+};
+
+// The fixture, or null (and the benchmark skipped) where ../shared is absent.
+const FlightHelmetFixture* flightHelmet(benchmark::State& state) {
+    static const FlightHelmetFixture f;
+    if (!f.bvh) {
+        state.SkipWithError("../shared/data/gltf-samples (FlightHelmet) is absent beside the repository");
+        return nullptr;
+    }
+    return &f;
 }
 
 // Each iteration builds the tracer (projection maps included) and traces; landed_photons_per_s
 // counts photons whose first segment hits geometry. margin_mm: the reach the maps keep beside
-// geometry (DETP's default radius for this model, 1.5 % of its diagonal, is 13 mm; 0 for
-// estimators that count impacts only).
+// geometry (13 for DETP; 0 for estimators that count impacts only).
 void BM_FlightHelmetEmission(benchmark::State& state) {
-    const Scene* scene = flightHelmet(state);
-    if (!scene) return;
-    EmbreeDevice device;
-    const SceneBvh bvh(device, *scene);
-    const uint64_t photons = 200000;
+    const FlightHelmetFixture* f = flightHelmet(state);
+    if (!f) return;
     const EmissionAim aim{state.range(0) != 0, float(state.range(1)) / 1000.0f};
     uint64_t landed = 0;
-    for (auto _ : state) {
-        const PhotonTracer tracer(*scene, bvh, TraceSettings{photons, 1, 32, aim});
-        const RayCache cache = tracer.traceAll();
-        landed = photons - cache.pathsMissingScene();
-    }
+    for (auto _ : state) landed = f->kPhotons - f->trace(aim).pathsMissingScene();
     state.counters["landed_photons_per_s"] = benchmark::Counter(double(landed), benchmark::Counter::kIsIterationInvariantRate);
-    state.counters["missed_fraction"] = 1.0 - double(landed) / double(photons);
+    state.counters["missed_fraction"] = 1.0 - double(landed) / double(f->kPhotons);
 }
 
 // What DETP makes of the photons aimed within its radius of the geometry: a first segment that
 // hits nothing still counts where it crosses a disc beside an open edge or a silhouette (the
-// `clip` rule, r = 13 mm). wasted_fraction: photons whose first segment neither hits geometry
-// nor crosses any disc that counts; missed_fraction as above. Measured once: it is a count.
+// `clip` rule). wasted_fraction: photons whose first segment neither hits geometry nor crosses
+// any disc that counts; missed_fraction as above. Measured once: it is a count.
 void BM_FlightHelmetDetpWaste(benchmark::State& state) {
-    const Scene* scene = flightHelmet(state);
-    if (!scene) return;
-    EmbreeDevice device;
-    const SceneBvh bvh(device, *scene);
-    const float radius = 0.013f;
-    const uint64_t photons = 200000;
+    const FlightHelmetFixture* f = flightHelmet(state);
+    if (!f) return;
+    const float radius = f->kDetpRadius;
     uint64_t missed = 0, wasted = 0;
     for (auto _ : state) {
         DiscRegions regions(radius, false);
-        regions.computeAll(*scene, bvh);
-        const DetpDiscs discs(device, *scene, radius, DetpBoundary::Clip, &regions, &bvh);
-        const RayCache cache = PhotonTracer(*scene, bvh, TraceSettings{photons, 1, 32, EmissionAim{true, radius}}).traceAll();
+        regions.computeAll(f->scene, *f->bvh);
+        const DetpDiscs discs(f->device, f->scene, radius, DetpBoundary::Clip, &regions, f->bvh.get());
+        const RayCache cache = f->trace(EmissionAim{true, radius});
         const PowerQuantizer q(cache.maxPhotonPower);
-        const std::vector<uint8_t> skipNone(scene->vertexCount(), 0);
-        std::vector<DetpVertexSums> sums(scene->vertexCount());
+        const std::vector<uint8_t> skipNone(f->scene.vertexCount(), 0);
+        std::vector<DetpVertexSums> sums(f->scene.vertexCount());
         std::vector<uint32_t> changed;
         missed = cache.pathsMissingScene();
         wasted = 0;
@@ -388,8 +395,8 @@ void BM_FlightHelmetDetpWaste(benchmark::State& state) {
             wasted += changed.empty();
         }
     }
-    state.counters["missed_fraction"] = double(missed) / double(photons);
-    state.counters["wasted_fraction"] = double(wasted) / double(photons);
+    state.counters["missed_fraction"] = double(missed) / double(f->kPhotons);
+    state.counters["wasted_fraction"] = double(wasted) / double(f->kPhotons);
 }
 
 }  // namespace
