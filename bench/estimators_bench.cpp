@@ -377,23 +377,22 @@ void BM_FlightHelmetDetpWaste(benchmark::State& state) {
         regions.computeAll(f->scene, *f->bvh);
         const DetpDiscs discs(f->device, f->scene, radius, DetpBoundary::Clip, &regions, f->bvh.get());
         const RayCache cache = f->trace(EmissionAim{true, radius});
-        const PowerQuantizer q(cache.maxPhotonPower);
-        const std::vector<uint8_t> skipNone(f->scene.vertexCount(), 0);
-        std::vector<DetpVertexSums> sums(f->scene.vertexCount());
-        std::vector<uint32_t> changed;
         missed = cache.pathsMissingScene();
         wasted = 0;
+        std::vector<Segment> firstMisses;
         for (size_t path = 0; path < cache.pathCount(); ++path) {
             if (cache.pathBegin[path] == cache.pathBegin[path + 1]) {  // a spot light's photon outside its cone
                 ++wasted;
                 continue;
             }
             const Segment& first = cache.segments[cache.pathBegin[path]];
-            if (first.hasImpact()) continue;
-            changed.clear();
-            discs.accumulate({first}, q, +1, skipNone, sums, changed);
-            wasted += changed.empty();
+            if (!first.hasImpact()) firstMisses.push_back(first);
         }
+        std::vector<SegmentCrossing> crossings;
+        discs.findCrossings(firstMisses, DetpDiscs::Discs::All, crossings);
+        std::vector<uint8_t> crosses(firstMisses.size(), 0);
+        for (const SegmentCrossing& c : crossings) crosses[c.segment] = 1;
+        wasted += uint64_t(std::count(crosses.begin(), crosses.end(), uint8_t(0)));
     }
     state.counters["missed_fraction"] = double(missed) / double(f->kPhotons);
     state.counters["wasted_fraction"] = double(wasted) / double(f->kPhotons);

@@ -46,7 +46,7 @@ struct CliOptions {
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
     std::optional<double> exposure, radius, fps;
     std::optional<int64_t> k;
-    bool noRayCache = false, noSortQueries = false, fullRecompute = false, noEnvelope = false, noAim = false, resume = false;
+    bool noRayCache = false, noSortQueries = false, fullRecompute = false, alwaysUpdate = false, noEnvelope = false, noAim = false, resume = false;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false, gltfOut = false;
 };
 
@@ -73,6 +73,7 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.noRayCache) s.estimator.useIndex = false;
     if (o.noSortQueries) s.estimator.sortQueries = false;
     if (o.fullRecompute) s.fullRecompute = true;
+    if (o.alwaysUpdate) s.alwaysUpdate = true;
     if (o.noEnvelope) s.useEnvelope = false;
     if (o.noAim) s.aimEmission = false;
     if (o.resume) s.resume = true;
@@ -158,6 +159,9 @@ int main(int argc, char** argv) {
     render->add_flag("--no-sort-queries", o.noSortQueries, "queries in input order instead of Morton order");
     render->add_flag("--full-recompute", o.fullRecompute,
                      "compute every frame from scratch instead of updating the previous one (same bytes, slower)");
+    render->add_flag("--always-update", o.alwaysUpdate,
+                     "update every frame after the first incrementally, even one whose change would cost more to update "
+                     "than to recompute (same bytes; for measuring the update)");
     render->add_flag("--no-envelope", o.noEnvelope,
                      "track every light path instead of only those that meet the moving geometry's envelope (same "
                      "bytes, more memory and work per frame)");

@@ -38,7 +38,7 @@ Solved solveDetp(const Scene& source, uint64_t photons, bool aim, float radius) 
     s.trace = TraceSettings{photons, 3, 32, EmissionAim{aim, 0}};
     s.fullRecompute = true;
     FrameSolver solver(scene, device, s);
-    FrameWork work;
+    FrameTiming work;
     Solved out;
     out.irradiance = solver.solve(scene.restPose(), work).irradiance;
     out.missing = work.photonsMissingScene;

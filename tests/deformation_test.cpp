@@ -163,7 +163,7 @@ TEST(Deformation, IncrementalEqualsFullRecomputationForADeformingMesh) {
     const fs::path out = testScratchDir("deformation-render-out");
     for (const char* estimator : {"impact-count", "detp"}) {
         SCOPED_TRACE(estimator);
-        const std::string common = "render " + scene.string() + " --animation gltf --fps 48 --photons 20000 --no-exr --quiet " +
+        const std::string common = "render " + scene.string() + " --animation gltf --fps 48 --photons 20000 --no-exr --quiet --always-update " +
                                    "--estimator " + estimator;
         const fs::path inc = out / (std::string(estimator) + "-incremental"), full = out / (std::string(estimator) + "-full");
         const CommandResult a = runQsgi(common + " --out " + inc.string());

@@ -85,6 +85,7 @@ FrameSolverSettings solverSettings(const EstimatorCase& e, float radius, uint64_
     s.estimator.useIndex = e.index;
     s.trace.photons = photons;
     s.trace.seed = 7;
+    s.alwaysUpdate = true;  // these tests exercise the update, however large the change
     return s;
 }
 
@@ -103,7 +104,7 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
     FrameSolver inc(incScene, device, incremental), ref(fullScene, device, full);
     uint64_t retraced = 0;
     for (int f = 0; f < a.frames; ++f) {
-        FrameWork wi, wf;
+        FrameTiming wi, wf;
         const VertexRadiosity& ri = inc.solve(localsAt(incScene, moverA, a.offset(f)), wi);
         const VertexRadiosity& rf = ref.solve(localsAt(fullScene, moverB, a.offset(f)), wf);
         if (f > 0) {
@@ -189,7 +190,7 @@ TEST(Incremental, ThreadCountDoesNotChangeTheBits) {
         EmbreeDevice device;
         FrameSolver solver(scene, device, solverSettings(e, 0.12f, 6000));
         for (int f = 0; f < a.frames; ++f) {
-            FrameWork w;
+            FrameTiming w;
             results[threads - 1].push_back(solver.solve(localsAt(scene, mover, a.offset(f)), w).radiosity);
         }
     }
@@ -211,7 +212,7 @@ TEST(Incremental, FramesWhereNothingRelevantMovesChangeNothing) {
         FrameSolver solver(scene, device, solverSettings(e, 0.12f, 6000));
         std::vector<Vec3f> previous;
         for (int f = 0; f < a.frames; ++f) {
-            FrameWork w;
+            FrameTiming w;
             const VertexRadiosity& r = solver.solve(localsAt(scene, mover, a.offset(f)), w);
             if (f == 1) {  // the pose of frame 0 again
                 EXPECT_EQ(w.pathsRetraced, 0u);
@@ -245,7 +246,7 @@ TEST(Incremental, NoDriftOverTenThousandFrames) {
         Scene scene = prepare(a, mover);
         EmbreeDevice device;
         FrameSolver solver(scene, device, solverSettings(e, 0.15f, 400));
-        FrameWork w;
+        FrameTiming w;
         for (int f = 0; f < a.frames; ++f) solver.solve(localsAt(scene, mover, a.offset(f)), w);
         const std::vector<Vec3f> last = solver.solve(localsAt(scene, mover, a.offset(a.frames - 1)), w).radiosity;
         int freshMover = -1;

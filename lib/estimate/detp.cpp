@@ -74,11 +74,16 @@ constexpr double kMomentScale = 1048576.0;  // 2^20
 constexpr double kMaxFitCondition = 1e4;
 }  // namespace
 
+int32_t DetpVertexSums::momentOf(double coordinate) { return int32_t(std::llround(coordinate * kMomentScale)); }
+
 void DetpVertexSums::add(const Vec3f& phi, const DiscCrossing& at, const PowerQuantizer& q, bool moments, int sign) {
+    add(phi, moments ? momentOf(at.x) : 0, moments ? momentOf(at.y) : 0, q, moments, sign);
+}
+
+void DetpVertexSums::add(const Vec3f& phi, int32_t qx, int32_t qy, const PowerQuantizer& q, bool moments, int sign) {
     if (sign > 0) power.add(phi, q);
     else power.subtract(phi, q);
     if (!moments) return;
-    const int64_t qx = std::llround(at.x * kMomentScale), qy = std::llround(at.y * kMomentScale);
     for (int c = 0; c < 3; ++c) {
         const int64_t p = sign * q.quantize(phi[c]);
         x[c] += Int128(p) * qx;
@@ -201,16 +206,17 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
 struct DetpDiscs::Crossed : CrossedDisc {};
 
 DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule,
-                     const DiscRegions* regions, const SceneBvh* bvh)
-    : device_(device), scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh), staticDiscs_(device), dynamicDiscs_(device) {
+                     const DiscRegions* regions, const SceneBvh* bvh, const std::vector<uint8_t>* refitted)
+    : device_(device), scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh),
+      refitted_(refitted ? *refitted : scene.vertexDynamic), staticDiscs_(device), dynamicDiscs_(device) {
+    refitted_.resize(scene.vertexCount(), 0);
     const float eps = scene.sceneEpsilon();
     rayExtension_ = 1e-4f * radius + eps;
     // Enlarged discs make Embree's float test a superset of the exact one; the filter decides.
     searchRadius_ = radius * (1 + 1e-3f) + eps;
     // Every disc lies within r of a vertex, and every vertex inside the animation's bounds.
     escapeBounds_ = scene.animationBounds.expanded(radius + 2 * rayExtension_);
-    for (uint32_t v = 0; v < scene.vertexCount(); ++v)
-        (scene.vertexDynamic.size() > v && scene.vertexDynamic[v] ? dynamic_ : static_).vertices.push_back(v);
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v) (refitted_[v] ? dynamic_ : static_).vertices.push_back(v);
     addPart(device, staticDiscs_.get(), static_, RTC_BUILD_QUALITY_HIGH);
     addPart(device, dynamicDiscs_.get(), dynamic_, RTC_BUILD_QUALITY_REFIT);
     device.checkError("building the DETP disc BVH");
@@ -304,17 +310,6 @@ void DetpDiscs::crossingsIn(const Segment& s, std::initializer_list<std::pair<RT
             out.push_back(Crossed{c});
 }
 
-void DetpDiscs::recompute(const std::vector<Segment>& segments, const PowerQuantizer& q,
-                          const std::vector<uint32_t>& vertices, std::vector<DetpVertexSums>& sums) const {
-    for (uint32_t v : vertices) sums[v] = DetpVertexSums();
-    if (vertices.empty()) return;
-    EmbreeScene bvh(device_);
-    Part part;
-    part.vertices = vertices;
-    addPart(device_, bvh.get(), part, RTC_BUILD_QUALITY_MEDIUM);
-    addCrossings(segments, {{bvh.get(), &part}}, nullptr, +1, q, sums, nullptr);
-}
-
 std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, const std::vector<uint32_t>& order,
                                             DetpQueryStats* stats) const {
     const size_t vertices = scene_.vertexCount();
@@ -354,37 +349,26 @@ std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vecto
     return toIrradiance(sums(cache, order, stats), regions_, radius_, rule_, PowerQuantizer(cache.maxPhotonPower));
 }
 
-void DetpDiscs::accumulate(const std::vector<Segment>& segments, const PowerQuantizer& q, int sign,
-                           const std::vector<uint8_t>& skip, std::vector<DetpVertexSums>& sums,
-                           std::vector<uint32_t>& changed) const {
-    addCrossings(segments, {{staticDiscs_.get(), &static_}, {dynamicDiscs_.get(), &dynamic_}}, &skip, sign, q, sums, &changed);
-}
-
-void DetpDiscs::addCrossings(const std::vector<Segment>& segments, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
-                             const std::vector<uint8_t>* skip, int sign, const PowerQuantizer& q,
-                             std::vector<DetpVertexSums>& sums, std::vector<uint32_t>* changed) const {
-    const bool moments = rule_ == DetpBoundary::Linear;
-    // Crossings are found in parallel and applied in one thread: few segments change per frame,
-    // and a per-thread copy of every vertex's sums would cost more than the work.
-    struct Hit {
-        uint32_t segment;
-        Crossed at;
-    };
-    tbb::enumerable_thread_specific<std::vector<Hit>> perThread;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        auto& hits = perThread.local();
+void DetpDiscs::findCrossings(const std::vector<Segment>& segments, Discs which, std::vector<SegmentCrossing>& out) const {
+    // Fixed chunks, concatenated in order: the list does not depend on the schedule.
+    constexpr size_t kChunk = 256;
+    const size_t chunks = (segments.size() + kChunk - 1) / kChunk;
+    std::vector<std::vector<SegmentCrossing>> found(chunks);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks), [&](const tbb::blocked_range<size_t>& r) {
         std::vector<Crossed> crossed;
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            crossingsIn(segments[i], bvhs, crossed);
-            for (const Crossed& c : crossed)
-                if (!skip || !(*skip)[c.vertex]) hits.push_back({uint32_t(i), c});
-        }
+        for (size_t c = r.begin(); c != r.end(); ++c)
+            for (size_t i = c * kChunk; i < std::min(segments.size(), (c + 1) * kChunk); ++i) {
+                if (which == Discs::Refitted) crossingsIn(segments[i], {{dynamicDiscs_.get(), &dynamic_}}, crossed);
+                else if (which == Discs::Fixed) crossingsIn(segments[i], {{staticDiscs_.get(), &static_}}, crossed);
+                else crossings(segments[i], crossed);
+                for (const Crossed& x : crossed) found[c].push_back({uint32_t(i), x.vertex, x.at});
+            }
     });
-    for (const auto& hits : perThread)
-        for (const Hit& h : hits) {
-            sums[h.at.vertex].add(segments[h.segment].power, h.at.at, q, moments, sign);
-            if (changed) changed->push_back(h.at.vertex);
-        }
+    out.clear();
+    size_t total = 0;
+    for (const auto& f : found) total += f.size();
+    out.reserve(total);
+    for (const auto& f : found) out.insert(out.end(), f.begin(), f.end());
 }
 
 DetpVertexSums detpVertexSums(const Scene& scene, uint32_t v, const std::vector<const Segment*>& segments, float radius,

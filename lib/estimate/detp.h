@@ -60,6 +60,10 @@ struct DetpVertexSums {
     Int128 x[3] = {0, 0, 0}, y[3] = {0, 0, 0};
 
     void add(const Vec3f& phi, const DiscCrossing& at, const PowerQuantizer& q, bool moments, int sign = 1);
+    // The same with the crossing's coordinates already quantised (momentOf): what an update
+    // remembers of a crossing, so that it can leave the sums exactly as it entered them.
+    void add(const Vec3f& phi, int32_t qx, int32_t qy, const PowerQuantizer& q, bool moments, int sign);
+    static int32_t momentOf(double coordinate);
     DetpVertexSums& operator+=(const DetpVertexSums& o);
     DetpVertexSums& operator-=(const DetpVertexSums& o);
     bool operator==(const DetpVertexSums& o) const;
@@ -69,15 +73,24 @@ struct DetpVertexSums {
 Vec3f detpVertexIrradiance(const DetpVertexSums& sums, const VertexDisc* disc, float radius, DetpBoundary rule,
                            const PowerQuantizer& q);
 
+// One crossing found by DetpDiscs::findCrossings: segment i of the list crossed vertex v's disc.
+struct SegmentCrossing {
+    uint32_t segment;
+    uint32_t vertex;
+    DiscCrossing at;
+};
+
 class DetpDiscs {
 public:
-    // Builds the disc BVHs: static vertices' discs once, dynamic vertices' discs refitted by
-    // updateDynamic. regions (and bvh, the scene's triangles) may be null for the paper rule;
-    // both are read at query time, so they must hold the pose being queried.
+    // Builds the disc BVHs: the discs that never move once, the others (`refitted`, per scene
+    // vertex; the dynamic vertices when null) refitted by updateDynamic. An incremental update
+    // puts there every vertex a move can ever touch, so that the other discs' crossings never
+    // change and can be remembered. regions (and bvh, the scene's triangles) may be null for the
+    // paper rule; both are read at query time, so they must hold the pose being queried.
     DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule, const DiscRegions* regions,
-              const SceneBvh* bvh);
+              const SceneBvh* bvh, const std::vector<uint8_t>* refitted = nullptr);
 
-    // Moves the dynamic vertices' discs to the scene's current pose.
+    // Moves the refitted discs to the scene's current pose.
     void updateDynamic();
 
     // Every vertex's sums from the given segments (in that order), in parallel.
@@ -86,16 +99,13 @@ public:
     // Irradiance at every vertex from the given segments (in that order).
     std::vector<Vec3f> irradiance(const RayCache& cache, const std::vector<uint32_t>& segmentOrder,
                                   DetpQueryStats* stats = nullptr) const;
-    // Adds (sign +1) or subtracts (−1) the segments' crossings to `sums`, except at vertices
-    // flagged in `skip` (those an update recomputes). Returns the vertices changed (unsorted, may
-    // repeat).
-    void accumulate(const std::vector<Segment>& segments, const PowerQuantizer& q, int sign, const std::vector<uint8_t>& skip,
-                    std::vector<DetpVertexSums>& sums, std::vector<uint32_t>& changed) const;
 
-    // Recomputes the sums of the given vertices from the given segments: a disc BVH of just
-    // those vertices, built for the call (an update's touched vertices).
-    void recompute(const std::vector<Segment>& segments, const PowerQuantizer& q, const std::vector<uint32_t>& vertices,
-                   std::vector<DetpVertexSums>& sums) const;
+    // Every crossing of the given segments with the discs of `which`, decided exactly. Found in
+    // parallel; the list is in segment order, each segment's crossings by vertex, the same for
+    // any thread count.
+    enum class Discs { All, Refitted, Fixed };
+    void findCrossings(const std::vector<Segment>& segments, Discs which, std::vector<SegmentCrossing>& out) const;
+    bool isRefitted(uint32_t vertex) const { return refitted_[vertex] != 0; }
 
 private:
     struct Crossed;
@@ -107,11 +117,6 @@ private:
     void crossings(const Segment& s, std::vector<Crossed>& out) const;
     void crossingsIn(const Segment& s, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
                      std::vector<Crossed>& out) const;
-    // Adds sign × the crossings of every segment in the given disc BVHs to `sums`, except at
-    // vertices flagged in skip (if given); appends each vertex changed to `changed` (if given).
-    void addCrossings(const std::vector<Segment>& segments, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
-                      const std::vector<uint8_t>* skip, int sign, const PowerQuantizer& q,
-                      std::vector<DetpVertexSums>& sums, std::vector<uint32_t>* changed) const;
     void addPart(const EmbreeDevice& device, RTCScene target, Part& part, RTCBuildQuality quality) const;
     void fillPart(RTCGeometry geom, const Part& part) const;
 
@@ -124,6 +129,7 @@ private:
     float rayExtension_;  // lets Embree's float tests see crossings at t* ≈ 0 and at the rule's end
     float searchRadius_;  // the discs in Embree, slightly enlarged (a superset of the exact test)
     Bounds3f escapeBounds_;  // escaping segments are traced until they leave this box
+    std::vector<uint8_t> refitted_;
     EmbreeScene staticDiscs_, dynamicDiscs_;
     Part static_, dynamic_;
 };

@@ -1,6 +1,13 @@
-// Density estimation (DESIGN §5): from the ray cache to irradiance and radiosity per vertex, by
-// impact count, photon map or DETP, with or without spatial indexes.
+// Density estimation (DESIGN §5–§6): one interface for the three estimators. Each solves a
+// frame from scratch (every vertex from every segment) and updates the previous frame's answer
+// from what a move changed (the segments retraced, the vertices and triangles moved). The
+// caller — FrameSolver, tests, benchmarks — never switches on the kind. One file per estimator:
+// impact_count_estimator.cpp, photon_map_estimator.cpp, detp_estimator.cpp.
 #pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "estimate/detp.h"
 #include "estimate/disc_regions.h"
@@ -9,6 +16,8 @@
 #include "trace/embree_device.h"
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
+#include "trace/tracked_paths.h"
+#include "util/frame_timing.h"
 
 namespace qsgi {
 
@@ -30,14 +39,65 @@ struct EstimatorSettings {
 // Whether the estimator needs disc regions, and whether with the photon map's coverage.
 bool needsDiscRegions(const EstimatorSettings& settings);
 DiscRegions makeDiscRegions(const EstimatorSettings& settings);
+const char* estimatorName(EstimatorKind kind);
 
-// Computes irradiance and radiosity at every vertex of the scene's current pose. bvh holds that
-// pose. regions: the disc regions of that pose (makeDiscRegions); computed here when null and
-// needed.
+// What one frame changed, as an update reads it (DESIGN §6 steps 2–4). The scene, its BVH and
+// the disc regions already hold the new pose.
+struct FrameChange {
+    const std::vector<Segment>& removed;        // old tails, as they were cached before the move
+    const std::vector<Segment>& added;          // new tails
+    const std::vector<uint8_t>& vertexMoved;    // per scene vertex
+    const std::vector<uint8_t>& triangleMoved;  // per scene triangle
+    // Vertices whose disc moved or whose disc regions the move touched (sorted): they are
+    // recomputed, every other vertex is updated.
+    const std::vector<uint32_t>& touched;
+    const TrackedPaths& tracked;  // every tracked segment after the change
+};
+
+// Everything an estimator reads besides the segments; the references outlive it.
+struct EstimatorContext {
+    const Scene& scene;
+    const SceneBvh& bvh;  // the scene's triangles in the current pose
+    const EmbreeDevice& device;
+    const DiscRegions* regions;  // null when the estimator needs none (needsDiscRegions)
+};
+
+class Estimator {
+public:
+    static std::unique_ptr<Estimator> create(const EstimatorSettings& settings, const EstimatorContext& context);
+    virtual ~Estimator() = default;
+
+    // Every vertex's irradiance and radiosity from every segment of the cache (current pose).
+    virtual void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) = 0;
+
+    // Incremental updates. Whether this estimator has one (otherwise every frame is solved from
+    // scratch, and `why` names the reason for timing.json).
+    virtual bool canUpdate(std::string& why) const {
+        why.clear();
+        return true;
+    }
+    // How far past its impact a segment counts (DETP: r; the others count impacts only): the
+    // envelope's margin and the tracked-segment grid follow from it. Paths that never meet the
+    // envelope stay folded into the state solve() left.
+    virtual float reach() const = 0;
+    // Called after solve() and the tracked paths are known, before the first update.
+    virtual void prepareUpdates(const TrackedPaths& tracked, FrameTiming& stats) = 0;
+    // The previous frame's answer in `out` becomes this frame's.
+    virtual void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) = 0;
+    // Bytes of incremental state (remembered crossings, indexes), apart from the tracked paths.
+    virtual size_t stateBytes() const { return 0; }
+};
+
+// The estimators, for Estimator::create.
+std::unique_ptr<Estimator> makeImpactCountEstimator(const EstimatorSettings& settings, const EstimatorContext& context);
+std::unique_ptr<Estimator> makePhotonMapEstimator(const EstimatorSettings& settings, const EstimatorContext& context);
+std::unique_ptr<Estimator> makeDetpEstimator(const EstimatorSettings& settings, const EstimatorContext& context);
+
+// Irradiance and radiosity at every vertex of the scene's current pose, from scratch. bvh holds
+// that pose. regions: the disc regions of that pose (makeDiscRegions); computed here when null
+// and needed.
 VertexRadiosity estimateVertexRadiosity(const Scene& scene, const SceneBvh& bvh, const RayCache& cache,
                                         const EstimatorSettings& settings, const EmbreeDevice& device,
                                         const DiscRegions* regions = nullptr);
-
-const char* estimatorName(EstimatorKind kind);
 
 }  // namespace qsgi

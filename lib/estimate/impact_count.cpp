@@ -2,7 +2,26 @@
 
 namespace qsgi {
 
-ImpactCount::ImpactCount(const Scene& scene) : sums_(scene.triangleCount()) { updateGeometry(scene); }
+ImpactCount::ImpactCount(const Scene& scene) : sums_(scene.triangleCount()) {
+    updateGeometry(scene);
+    vertexTrianglesBegin_.assign(scene.vertexCount() + 1, 0);
+    for (const Triangle& t : scene.triangles)
+        for (uint32_t v : t.v) ++vertexTrianglesBegin_[v + 1];
+    for (size_t v = 0; v < scene.vertexCount(); ++v) vertexTrianglesBegin_[v + 1] += vertexTrianglesBegin_[v];
+    vertexTriangles_.resize(vertexTrianglesBegin_.back());
+    std::vector<uint32_t> fill(vertexTrianglesBegin_.begin(), vertexTrianglesBegin_.end() - 1);
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t)
+        for (uint32_t v : scene.triangles[t].v) vertexTriangles_[fill[v]++] = t;
+}
+
+void ImpactCount::updateGeometry(const Scene& scene, const std::vector<uint32_t>& triangles) {
+    for (uint32_t t : triangles) {
+        const bool wasDegenerate = !(area_[t] > 0);
+        frontNormal_[t] = frontFaceNormal(scene.positions, scene.normals, scene.triangles[t]);
+        area_[t] = scene.triangleArea(t);
+        degenerate_ += uint32_t(!(area_[t] > 0)) - uint32_t(wasDegenerate);
+    }
+}
 
 void ImpactCount::updateGeometry(const Scene& scene) {
     const size_t n = scene.triangleCount();
@@ -34,23 +53,30 @@ void ImpactCount::subtract(const Segment& s, const PowerQuantizer& q) {
     if (counts(s)) sums_[s.triangle].subtract(s.power, q);
 }
 
-VertexRadiosity ImpactCount::estimate(const Scene& scene, const PowerQuantizer& q) const {
-    std::vector<Vec3d> sum(scene.vertexCount(), Vec3d(0.0));
-    std::vector<uint32_t> count(scene.vertexCount(), 0);
-    for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
+Vec3f ImpactCount::vertexIrradiance(uint32_t v, const PowerQuantizer& q) const {
+    Vec3d sum(0.0);
+    uint32_t count = 0;
+    for (uint32_t i = vertexTrianglesBegin_[v]; i < vertexTrianglesBegin_[v + 1]; ++i) {
+        const uint32_t t = vertexTriangles_[i];
         if (!(area_[t] > 0)) continue;
-        const Vec3d e = sums_[t].watts(q) / double(area_[t]);
-        for (uint32_t v : scene.triangles[t].v) {
-            sum[v] += e;
-            ++count[v];
-        }
+        sum += sums_[t].watts(q) / double(area_[t]);
+        ++count;
     }
+    return count ? Vec3f(sum / double(count)) : Vec3f(0.0f);
+}
+
+VertexRadiosity ImpactCount::estimate(const Scene& scene, const PowerQuantizer& q) const {
     VertexRadiosity out;
     out.irradiance.resize(scene.vertexCount());
-    for (size_t v = 0; v < scene.vertexCount(); ++v)
-        out.irradiance[v] = count[v] ? Vec3f(sum[v] / double(count[v])) : Vec3f(0.0f);
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v) out.irradiance[v] = vertexIrradiance(v, q);
     computeRadiosity(scene, out);
     return out;
+}
+
+void ImpactCount::estimateAt(const Scene& scene, const PowerQuantizer& q, const std::vector<uint32_t>& vertices,
+                             VertexRadiosity& out) const {
+    for (uint32_t v : vertices) out.irradiance[v] = vertexIrradiance(v, q);
+    computeRadiosity(scene, out);
 }
 
 }  // namespace qsgi

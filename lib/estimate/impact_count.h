@@ -22,19 +22,27 @@ public:
     void add(const Segment& s, const PowerQuantizer& q);
     void subtract(const Segment& s, const PowerQuantizer& q);
 
-    // Triangle areas and facing follow the scene's current pose.
+    // Triangle areas and facing follow the scene's current pose (all, or the given triangles).
     void updateGeometry(const Scene& scene);
+    void updateGeometry(const Scene& scene, const std::vector<uint32_t>& triangles);
     VertexRadiosity estimate(const Scene& scene, const PowerQuantizer& q) const;
+    // The given vertices' irradiance, and every vertex's radiosity, in `out` (an update).
+    void estimateAt(const Scene& scene, const PowerQuantizer& q, const std::vector<uint32_t>& vertices,
+                    VertexRadiosity& out) const;
 
     uint32_t degenerateTriangles() const { return degenerate_; }
     const std::vector<PowerSum>& triangleSums() const { return sums_; }
 
 private:
     bool counts(const Segment& s) const;
+    Vec3f vertexIrradiance(uint32_t v, const PowerQuantizer& q) const;
 
     std::vector<PowerSum> sums_;
     std::vector<Vec3f> frontNormal_;  // geometric normal flipped to the vertex normals' side
     std::vector<float> area_;
+    // The triangles around each vertex, in increasing order (CSR): a vertex's mean is summed in
+    // the order a whole-scene pass sums it, so an update gives the same bits.
+    std::vector<uint32_t> vertexTrianglesBegin_, vertexTriangles_;
     uint32_t degenerate_ = 0;
 };
 

@@ -4,26 +4,126 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include "estimate/own_surface.h"
 
 namespace qsgi {
 
+namespace {
+constexpr float kNeverEstimated = std::numeric_limits<float>::infinity();
+constexpr float kNoBall = -1.0f;
+}  // namespace
+
+PhotonMap::Impact PhotonMap::impactOf(const Segment& s) {
+    return Impact{s.impactPoint(), s.direction, s.power, s.triangle, keyOf(s)};
+}
+
 PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh)
-    : cache_(cache), index_(cache), frontNormals_(scene.frontFaceNormals()), bvh_(bvh), quantizer_(cache.maxPhotonPower) {}
+    : frontNormals_(scene.frontFaceNormals()), bvh_(bvh), quantizer_(cache.maxPhotonPower) {
+    for (const Segment& s : cache.segments)
+        if (s.hasImpact()) impacts_.push_back(impactOf(s));
+    rebuildBig();
+}
+
+PhotonMap::~PhotonMap() = default;
+
+// Incremental update
+
+void PhotonMap::rebuildBig() {
+    if (bigRemoved_ > 0) {
+        size_t live = 0;
+        for (size_t i = 0; i < impacts_.size(); ++i)
+            if (i >= bigCount_ || !bigDead_[i]) impacts_[live++] = impacts_[i];
+        impacts_.resize(live);
+    }
+    bigCount_ = impacts_.size();
+    bigDead_.assign(bigCount_, 0);
+    bigRemoved_ = 0;
+    bigKeys_.resize(bigCount_);
+    for (size_t i = 0; i < bigCount_; ++i) bigKeys_[i] = {impacts_[i].key, uint32_t(i)};
+    // A cache traced in one piece comes sorted already.
+    if (!std::is_sorted(bigKeys_.begin(), bigKeys_.end())) std::sort(bigKeys_.begin(), bigKeys_.end());
+    const auto same = [](const auto& a, const auto& b) { return a.first == b.first; };
+    if (std::adjacent_find(bigKeys_.begin(), bigKeys_.end(), same) != bigKeys_.end())
+        throw std::logic_error("PhotonMap: two impacts with the same (path, bounce)");
+    smallSlots_.clear();
+    small_.reset();
+    smallStale_ = false;
+    std::vector<Vec3f> points(bigCount_);
+    for (size_t i = 0; i < bigCount_; ++i) points[i] = impacts_[i].point;
+    big_ = std::make_unique<PointIndex>(std::move(points));
+}
+
+void PhotonMap::rebuildSmall() {
+    std::vector<Vec3f> points;
+    points.reserve(impacts_.size() - bigCount_);
+    for (size_t i = bigCount_; i < impacts_.size(); ++i) points.push_back(impacts_[i].point);
+    small_ = points.empty() ? nullptr : std::make_unique<PointIndex>(std::move(points));
+    smallStale_ = false;
+}
+
+int64_t PhotonMap::bigSlot(uint64_t key) const {
+    const auto it = std::lower_bound(bigKeys_.begin(), bigKeys_.end(), std::pair<uint64_t, uint32_t>(key, 0));
+    if (it == bigKeys_.end() || it->first != key || bigDead_[it->second]) return -1;
+    return int64_t(it->second);
+}
+
+void PhotonMap::removeImpact(uint64_t key) {
+    if (const auto it = smallSlots_.find(key); it != smallSlots_.end()) {
+        // The added part is re-indexed at every update, so it stays packed: the last one fills the hole.
+        const uint32_t slot = it->second;
+        smallSlots_.erase(it);
+        if (slot + 1 != impacts_.size()) {
+            impacts_[slot] = impacts_.back();
+            smallSlots_[impacts_[slot].key] = slot;
+        }
+        impacts_.pop_back();
+        smallStale_ = true;
+        return;
+    }
+    const int64_t slot = bigSlot(key);
+    if (slot < 0) throw std::logic_error("PhotonMap::update: a removed impact is not in the map");
+    bigDead_[size_t(slot)] = 1;
+    ++bigRemoved_;
+    big_->remove(size_t(slot));
+}
+
+void PhotonMap::addImpact(const Segment& s) {
+    const uint64_t key = keyOf(s);
+    if (bigSlot(key) >= 0 || !smallSlots_.emplace(key, uint32_t(impacts_.size())).second)
+        throw std::logic_error("PhotonMap::update: an added impact is already in the map");
+    impacts_.push_back(impactOf(s));
+    smallStale_ = true;
+}
+
+void PhotonMap::update(const std::vector<Segment>& removed, const std::vector<Segment>& added, const Scene& scene) {
+    for (const Segment& s : removed)
+        if (s.hasImpact()) removeImpact(keyOf(s));
+    for (const Segment& s : added)
+        if (s.hasImpact()) addImpact(s);
+    frontNormals_ = scene.frontFaceNormals();
+    // Queries pay for the small tree's size and the big tree's dead points; rebuilding costs all
+    // impacts. Past a quarter added, or more dead than live, the big tree is rebuilt.
+    const size_t bigLive = bigCount_ - bigRemoved_, addedCount = impacts_.size() - bigCount_;
+    if (addedCount > bigLive / 4 || bigRemoved_ > bigLive) rebuildBig();
+    else if (smallStale_) rebuildSmall();
+}
+
+// Estimates
 
 PhotonMap::VertexFilter PhotonMap::filterFor(const Scene& scene, const DiscRegions* regions, size_t v) const {
     const VertexDisc* disc = regions && !(*regions)[v].fallback ? &(*regions)[v] : nullptr;
     return VertexFilter{Vec3d(scene.positions[v]), Vec3d(scene.normals[v]), disc, regions ? regions->radius() : 0.0f};
 }
 
-bool PhotonMap::counts(const VertexFilter& f, uint32_t impact) const {
-    const Segment& s = segmentOf(impact);
+bool PhotonMap::counts(const VertexFilter& f, const Impact& impact) const {
     const Vec3f normal(f.normal);
-    if (!(dot(s.direction, normal) < 0)) return false;
+    if (!(dot(impact.direction, normal) < 0)) return false;
     if (!f.disc) return true;
-    if (!(dot(frontNormals_[s.triangle], normal) > kOwnSurfaceCos)) return false;
-    const Vec3d offset = Vec3d(index_.point(impact)) - f.position;
+    if (!(dot(frontNormals_[impact.triangle], normal) > kOwnSurfaceCos)) return false;
+    const Vec3d offset = Vec3d(impact.point) - f.position;
     const double height = dot(offset, f.normal);
     if (!(height <= double(f.disc->epsAbove) && height >= -double(f.disc->epsBelow))) return false;
     // Only where light can arrive from v's side: not behind a wall beside v, not under a box.
@@ -42,7 +142,7 @@ Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const Verte
     const bool full = found == size_t(k) && k > 1;
     const size_t summed = full ? found - 1 : found;
     PowerSum sum;
-    for (size_t i = 0; i < summed; ++i) sum.add(segmentOf(sortedFront[i].impact).power, quantizer_);
+    for (size_t i = 0; i < summed; ++i) sum.add(impacts_[sortedFront[i].impact].power, quantizer_);
     double r = full ? std::sqrt(double(sortedFront[found - 1].distanceSquared)) : double(radius);
     if (!(r > 0)) r = double(radius);  // k coincident impacts: no finite density to report
     // The part of the r disc that surfaces facing n_v cover (all of it without regions).
@@ -54,42 +154,81 @@ Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const Verte
     return Vec3f(sum.watts(quantizer_) / area);
 }
 
+void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
+                           const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) const {
+    if (out.size() != scene.vertexCount()) out.resize(scene.vertexCount(), Vec3f(0.0f));
+    if (ballsSquared_.size() != scene.vertexCount()) ballsSquared_.assign(scene.vertexCount(), kNeverEstimated);
+    const float radiusSquared = radius * radius;
+    const size_t bigLive = big_ ? big_->liveSize() : 0, smallLive = small_ ? small_->liveSize() : 0;
+    const size_t most = std::max(bigLive, smallLive);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<size_t> indices;
+        std::vector<float> d2;
+        std::vector<std::pair<float, uint32_t>> candidates;  // distance², slot
+        std::vector<Neighbour> front;
+        for (size_t q = r.begin(); q != r.end(); ++q) {
+            const uint32_t v = vertices[q];
+            if (k <= 0) {
+                out[v] = Vec3f(0.0f);
+                ballsSquared_[v] = kNoBall;
+                continue;
+            }
+            const Vec3f& p = scene.positions[v];
+            const VertexFilter filter = filterFor(scene, regions, v);
+            // Impacts that do not count are skipped, so ask the trees for more neighbours until k
+            // counted ones are found or the candidates run past the radius. Distances are
+            // recomputed as bruteForce computes them.
+            size_t want = std::min(most, 2 * size_t(k));
+            while (true) {
+                candidates.clear();
+                // Every live impact nearer than `complete` is among the candidates; beyond it a
+                // tree may hold impacts it did not return (ties with its farthest one included).
+                float complete = std::numeric_limits<float>::infinity();
+                const auto ask = [&](const PointIndex* tree, size_t live, size_t firstSlot) {
+                    const size_t n = std::min(want, live);
+                    if (n == 0) return;
+                    tree->nearest(p, n, indices, d2);
+                    float farthest = 0;
+                    for (size_t i = 0; i < indices.size(); ++i) {
+                        const uint32_t slot = uint32_t(firstSlot + indices[i]);
+                        const float dd = PointIndex::distanceSquared(p, impacts_[slot].point);
+                        farthest = std::max(farthest, dd);
+                        candidates.emplace_back(dd, slot);
+                    }
+                    if (n < live) complete = std::min(complete, farthest);
+                };
+                ask(big_.get(), bigLive, 0);
+                ask(small_.get(), smallLive, bigCount_);
+                // Only the candidates nearer than `complete` are tested: past it the k nearest
+                // could be missing an impact, and a sparse tree's far candidates cost tests for
+                // nothing.
+                const bool all = want >= most;
+                front.clear();
+                for (const auto& [dd, slot] : candidates)
+                    if ((all || dd < complete) && dd <= radiusSquared && counts(filter, impacts_[slot]))
+                        front.push_back({dd, impacts_[slot].key, slot});
+                if (all || complete > radiusSquared || front.size() >= size_t(k)) break;
+                want = std::min(most, want * 4);
+            }
+            const size_t keep = std::min(front.size(), size_t(k));
+            std::partial_sort(front.begin(), front.begin() + keep, front.end());
+            front.resize(keep);
+            out[v] = estimate(front, filter.disc, radius, k);
+            ballsSquared_[v] = keep == size_t(k) ? front[keep - 1].distanceSquared : radiusSquared;
+        }
+    });
+}
+
 std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, const DiscRegions* regions, float radius, int k,
                                          const std::vector<uint32_t>& order) const {
     std::vector<Vec3f> out(scene.vertexCount(), Vec3f(0.0f));
-    if (index_.size() == 0 || k <= 0) return out;
-    const float radiusSquared = radius * radius;
-    const size_t n = index_.size();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<size_t> indices;
-        std::vector<float> d2;
-        std::vector<Neighbour> front;
-        for (size_t q = r.begin(); q != r.end(); ++q) {
-            const uint32_t v = order[q];
-            const VertexFilter filter = filterFor(scene, regions, v);
-            // Impacts that do not count are skipped, so ask the tree for more neighbours until k
-            // counted ones are found or the candidates run past the radius.
-            size_t want = std::min(n, size_t(2 * k));
-            // Distances are recomputed as bruteForce computes them, and the search grows until no
-            // impact beyond the candidates can tie with the k-th counted one.
-            while (true) {
-                index_.nearest(scene.positions[v], want, indices, d2);
-                front.clear();
-                float farthest = 0;
-                for (size_t i = 0; i < want; ++i) {
-                    const float dd = PointIndex::distanceSquared(scene.positions[v], index_.point(indices[i]));
-                    farthest = std::max(farthest, dd);
-                    if (dd <= radiusSquared && counts(filter, uint32_t(indices[i]))) front.push_back(neighbour(dd, uint32_t(indices[i])));
-                }
-                std::sort(front.begin(), front.end());
-                if (want == n || farthest > radiusSquared) break;
-                if (front.size() >= size_t(k) && farthest > front[size_t(k) - 1].distanceSquared) break;
-                want = std::min(n, want * 4);
-            }
-            out[v] = estimate(front, filter.disc, radius, k);
-        }
-    });
+    estimateAt(scene, regions, radius, k, order, out);
     return out;
+}
+
+void PhotonMap::irradianceAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
+                             const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) {
+    estimateAt(scene, regions, radius, k, vertices, out);
 }
 
 std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* regions, float radius, int k) const {
@@ -101,9 +240,10 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
         for (size_t v = r.begin(); v != r.end(); ++v) {
             front.clear();
             const VertexFilter filter = filterFor(scene, regions, v);
-            for (size_t i = 0; i < index_.size(); ++i) {
-                const float d2 = PointIndex::distanceSquared(scene.positions[v], index_.point(i));
-                if (d2 <= radiusSquared && counts(filter, uint32_t(i))) front.push_back(neighbour(d2, uint32_t(i)));
+            for (size_t i = 0; i < impacts_.size(); ++i) {
+                if (i < bigCount_ && bigDead_[i]) continue;
+                const float d2 = PointIndex::distanceSquared(scene.positions[v], impacts_[i].point);
+                if (d2 <= radiusSquared && counts(filter, impacts_[i])) front.push_back({d2, impacts_[i].key, uint32_t(i)});
             }
             const size_t keep = std::min(front.size(), size_t(k));
             std::partial_sort(front.begin(), front.begin() + keep, front.end());
@@ -112,6 +252,29 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
         }
     });
     return out;
+}
+
+// Which estimates a change can alter
+
+std::vector<uint32_t> PhotonMap::ballsHolding(const std::vector<Vec3f>& positions, const std::vector<Segment>& removed,
+                                              const std::vector<Segment>& added) const {
+    std::vector<Vec3f> changed;
+    for (const auto* segments : {&removed, &added})
+        for (const Segment& s : *segments)
+            if (s.hasImpact()) changed.push_back(s.impactPoint());
+    if (changed.empty()) return {};
+    const PointIndex index(std::move(changed));
+    std::vector<uint8_t> holds(positions.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, positions.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            const float ball = v < ballsSquared_.size() ? ballsSquared_[v] : kNeverEstimated;
+            holds[v] = ball == kNeverEstimated || index.anyWithin(positions[v], ball);
+        }
+    });
+    std::vector<uint32_t> vertices;
+    for (size_t v = 0; v < holds.size(); ++v)
+        if (holds[v]) vertices.push_back(uint32_t(v));
+    return vertices;
 }
 
 }  // namespace qsgi

@@ -8,61 +8,120 @@
 // k/(k−1); see estimate(). With fewer than k inside `radius`, all of them over the covered part
 // of the radius disc. Without regions (the `paper` ablation, and vertices whose own surface is
 // empty) the textbook rule: front-facing impacts over π r_k².
-// The ImpactIndex kd-tree answers the queries; bruteForce() is the index-free reference that
-// must give the same answers.
+//
+// The map owns a copy of its impacts and follows a changing photon set (DESIGN §6.4): update()
+// takes a frame's removed and added segments, and ballsHolding() names the vertices whose last
+// estimate such a change can alter, so irradianceAt() recomputes only those. Two kd-trees answer
+// the queries: a big one, built rarely, whose removed impacts are marked and skipped, and a small
+// one over the impacts added since, rebuilt at each update. Every answer is bit-identical to a
+// map built from scratch over the same impacts, and to bruteForce(), the index-free reference.
 #pragma once
 
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "estimate/disc_regions.h"
 #include "estimate/fixed_point_power.h"
-#include "estimate/impact_index.h"
+#include "estimate/point_index.h"
 #include "scene/scene.h"
+#include "trace/ray_cache.h"
 
 namespace qsgi {
 
 class PhotonMap {
 public:
-    // Builds the kd-tree once per photon set; keeps a reference to the cache.
-    // bvh: the scene's triangles in the current pose, to decide impacts in mixed cells.
+    // Copies the impacts of the cache's segments (their (path, bounce) must be unique) and builds
+    // the kd-tree. bvh: the scene's triangles in the current pose, to decide impacts in mixed
+    // cells; it must outlive the map (a refit in place is fine).
     PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh);
+    ~PhotonMap();
+
+    // One frame's change of the photon set: the impacts of `removed` (found by (path, bounce);
+    // they must be in the map) leave, those of `added` (not yet in it) enter; segments without an
+    // impact are ignored. scene: the new pose, for the triangles' front normals. Costs the
+    // changed impacts, plus now and then a rebuild of the big tree (decided from counts alone).
+    void update(const std::vector<Segment>& removed, const std::vector<Segment>& added, const Scene& scene);
 
     // Irradiance at every vertex, queries in `order` (a permutation of the vertices), in parallel.
     // regions: with coverage, for the scene's current pose; null for the textbook rule.
+    // Records each vertex's ball for ballsHolding(), so calls on one map must not overlap.
     std::vector<Vec3f> irradiance(const Scene& scene, const DiscRegions* regions, float radius, int k,
                                   const std::vector<uint32_t>& order) const;
-    // The same answers without an index: every vertex against every impact.
+    // The same for the given vertices only, in that order: writes out[v] (out is resized to the
+    // vertex count if needed; other entries are kept) and records their balls.
+    void irradianceAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
+                      const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out);
+    // The same answers without an index: every vertex against every impact. Records nothing.
     std::vector<Vec3f> bruteForce(const Scene& scene, const DiscRegions* regions, float radius, int k) const;
 
+    // The vertices (sorted) whose ball recorded by the last estimate holds an impact of `removed`
+    // or `added`: r_k² ≥ its distance², where r_k is the k-th counted neighbour's distance, or the
+    // search radius when fewer were found. Only their estimates can change with these impacts.
+    // positions: the vertices where they were estimated. A vertex never estimated holds every
+    // impact. Thread-safe with other const calls.
+    std::vector<uint32_t> ballsHolding(const std::vector<Vec3f>& positions, const std::vector<Segment>& removed,
+                                       const std::vector<Segment>& added) const;
+
+    size_t size() const { return impacts_.size() - bigRemoved_; }  // live impacts
+
 private:
-    // Equal distances are ordered by (path, bounce): the k nearest are the same set whatever
-    // order the cache holds the impacts in (an incremental update reorders it).
+    struct Impact {
+        Vec3f point;  // Segment::impactPoint(), the same bits
+        Vec3f direction;
+        Vec3f power;
+        uint32_t triangle;
+        uint64_t key;  // path << 16 | bounce: the order of equal distances
+    };
+    static uint64_t keyOf(const Segment& s) { return uint64_t(s.path) << 16 | s.bounce; }
+    static Impact impactOf(const Segment& s);
+
+    // Equal distances are ordered by (path, bounce), never by where the impacts are stored: the k
+    // nearest are the same set whatever order the cache holds them in or updates left them in.
     struct Neighbour {
         float distanceSquared;
-        uint64_t pathBounce;
+        uint64_t key;
         uint32_t impact;
         bool operator<(const Neighbour& o) const {
-            return distanceSquared < o.distanceSquared || (distanceSquared == o.distanceSquared && pathBounce < o.pathBounce);
+            return distanceSquared < o.distanceSquared || (distanceSquared == o.distanceSquared && key < o.key);
         }
     };
-    Neighbour neighbour(float distanceSquared, uint32_t impact) const {
-        const Segment& s = segmentOf(impact);
-        return {distanceSquared, uint64_t(s.path) << 16 | s.bounce, impact};
-    }
-    // Whether impact i counts for vertex v (front side, and v's own band with regions).
+    // Whether an impact counts for vertex v (front side, and v's own band with regions).
     struct VertexFilter {
         Vec3d position, normal;
         const VertexDisc* disc;  // null: front side only
         float radius;            // the regions' disc radius
     };
     VertexFilter filterFor(const Scene& scene, const DiscRegions* regions, size_t v) const;
-    bool counts(const VertexFilter& f, uint32_t impact) const;
+    bool counts(const VertexFilter& f, const Impact& impact) const;
     // E from the counted neighbours, nearest first.
     Vec3f estimate(const std::vector<Neighbour>& sortedCounted, const VertexDisc* disc, float radius, int k) const;
-    const Segment& segmentOf(uint32_t impact) const { return cache_.segments[index_.segment(impact)]; }
+    void estimateAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
+                    const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) const;
 
-    const RayCache& cache_;
-    ImpactIndex index_;
+    // Slot of the live impact with this key in the big tree, or -1.
+    int64_t bigSlot(uint64_t key) const;
+    void removeImpact(uint64_t key);
+    void addImpact(const Segment& s);
+    void rebuildBig();    // every live impact into the big tree; the small one empties
+    void rebuildSmall();  // the small tree over the impacts added since rebuildBig()
+
+    // [0, bigCount_): the big tree's points, tree index = slot; then the added ones, small tree
+    // index = slot − bigCount_. Removed slots of the big part stay until the next rebuildBig().
+    std::vector<Impact> impacts_;
+    size_t bigCount_ = 0;
+    std::vector<uint8_t> bigDead_;                       // per big slot
+    size_t bigRemoved_ = 0;                              // dead big slots
+    std::vector<std::pair<uint64_t, uint32_t>> bigKeys_;  // (key, big slot), sorted
+    std::unordered_map<uint64_t, uint32_t> smallSlots_;   // key → slot of an added impact
+    std::unique_ptr<PointIndex> big_, small_;
+    bool smallStale_ = false;
+
+    // Per vertex, r_k² of its last estimate; +inf: never estimated; < 0: no ball (k ≤ 0).
+    // irradiance() is const for its one-shot callers; recording changes none of its answers.
+    mutable std::vector<float> ballsSquared_;
+
     std::vector<Vec3f> frontNormals_;
     const SceneBvh* bvh_;  // of the impacted triangles, for the 45° test
     PowerQuantizer quantizer_;

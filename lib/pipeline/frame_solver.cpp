@@ -1,11 +1,11 @@
 #include "pipeline/frame_solver.h"
 
-#include <tbb/parallel_for.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cstring>
 
-#include "estimate/morton_order.h"
 #include "util/stopwatch.h"
 
 namespace qsgi {
@@ -19,19 +19,31 @@ TraceSettings aimedAtEstimator(TraceSettings trace, const EstimatorSettings& e) 
     return trace;
 }
 
+// The update's price against a from-scratch frame's, in shares of the whole. A retraced segment
+// costs about what tracing and estimating it costs from scratch, and its removal about as much
+// again at most; a retraced path's tail is about two segments from the one that hit the mover.
+// A recomputed vertex gathers the segments around its disc, which costs a few times a vertex's
+// share of a full pass. Past this share of a full frame the update is not worth it.
+constexpr double kSegmentsPerListedImpact = 2.0;
+constexpr double kRemoveAndAdd = 2.0;
+constexpr double kRecomputedVertex = 3.0;
+constexpr double kWorthUpdatingBelow = 0.8;
+
 }  // namespace
 
 FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings)
-    : scene_(scene), device_(device), settings_(settings), bvh_(device, scene),
+    : scene_(scene), settings_(settings), bvh_(device, scene),
       tracer_(scene, bvh_, aimedAtEstimator(settings.trace, settings.estimator)) {
     if (needsDiscRegions(settings_.estimator)) regions_.emplace(makeDiscRegions(settings_.estimator));
+    estimator_ = Estimator::create(settings_.estimator, EstimatorContext{scene_, bvh_, device, regions()});
 }
 
 FrameSolver::~FrameSolver() = default;
 
-bool FrameSolver::updatesSums() const {
-    const EstimatorSettings& e = settings_.estimator;
-    return e.kind == EstimatorKind::ImpactCount || (e.kind == EstimatorKind::Detp && e.detpIndex == DetpIndex::Embree);
+void FrameSolver::reset() {
+    solved_ = regionsValid_ = false;
+    tracked_.reset();
+    lastCache_.reset();
 }
 
 FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
@@ -41,14 +53,15 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     for (const MeshInstance& inst : scene_.instances)
         if (inst.vertexCount > 0 && scene_.vertexDynamic[inst.firstVertex])
             std::copy_n(scene_.positions.begin() + inst.firstVertex, inst.vertexCount, previousPositions_.begin() + inst.firstVertex);
-    change.any = scene_.applyPose(target, &change.instances);
+    std::vector<uint32_t> instances;
+    change.any = scene_.applyPose(target, &instances);
     // Moved is decided per vertex and triangle: an instance re-placed by a transform that leaves
     // some of its vertices where they were (a paused mover, a mesh deforming in one region)
     // moves nothing there. The bounds that later steps search are those of the moved triangles,
     // before and after: for a rigid mover its whole bounds, for a deforming mesh its moved region.
     change.vertexMoved.assign(scene_.vertexCount(), 0);
     change.triangleMoved.assign(scene_.triangleCount(), 0);
-    for (uint32_t i : change.instances) {
+    for (uint32_t i : instances) {
         const MeshInstance& inst = scene_.instances[i];
         for (uint32_t v = inst.firstVertex; v < inst.firstVertex + inst.vertexCount; ++v)
             change.vertexMoved[v] = std::memcmp(&previousPositions_[v], &scene_.positions[v], sizeof(Vec3f)) != 0;
@@ -56,6 +69,7 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
         for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t) {
             for (uint32_t v : scene_.triangles[t].v) change.triangleMoved[t] |= change.vertexMoved[v];
             if (!change.triangleMoved[t]) continue;
+            change.movedTriangles.push_back(t);
             for (uint32_t v : scene_.triangles[t].v) {
                 before.extend(previousPositions_[v]);
                 after.extend(scene_.positions[v]);
@@ -66,6 +80,7 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
         change.bounds.push_back(after);
         change.newBounds.push_back(after);
     }
+    std::sort(change.movedTriangles.begin(), change.movedTriangles.end());
     if (change.any) bvh_.updateDynamic(scene_);
     return change;
 }
@@ -78,221 +93,137 @@ std::vector<uint32_t> FrameSolver::touchedVertices(const PoseChange& change) con
     return moved;
 }
 
-void FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameWork& work) {
+void FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats) {
     if (!regions_) return;
     Stopwatch clock;
     if (!regionsValid_) {
         regions_->computeAll(scene_, bvh_);
-        work.discRegionsUpdated = scene_.vertexCount();
+        stats.discRegionsUpdated = scene_.vertexCount();
         regionsValid_ = true;
     } else if (touched) {
         regions_->recompute(scene_, bvh_, *touched);
-        work.discRegionsUpdated = touched->size();
+        stats.discRegionsUpdated = touched->size();
     }
-    work.discRegionsSeconds = clock.seconds();
+    stats.discRegionsSeconds = clock.seconds();
 }
 
-const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameWork& work) {
-    work = FrameWork();
+bool FrameSolver::changeTooLarge(const PoseChange& change, size_t touched) const {
+    // Segments that impacted a moved triangle: listed per triangle once tracking, counted in the
+    // last frame's cache before (a scan, far cheaper than either way of computing the frame).
+    uint64_t listed = 0, segments = 0;
+    if (tracked_) {
+        listed = tracked_->segmentsListedOn(change.movedTriangles);
+        segments = foldedSegments_ + tracked_->trackedSegments();
+    } else {
+        const std::vector<Segment>& all = lastCache_->segments;
+        segments = all.size();
+        listed = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, all.size(), 1 << 16), uint64_t(0),
+            [&](const tbb::blocked_range<size_t>& r, uint64_t n) {
+                for (size_t i = r.begin(); i != r.end(); ++i)
+                    n += all[i].hasImpact() && all[i].impactDynamic && change.triangleMoved[all[i].triangle];
+                return n;
+            },
+            [](uint64_t a, uint64_t b) { return a + b; });
+    }
+    const double segmentShare = double(listed) * kSegmentsPerListedImpact * kRemoveAndAdd / double(std::max<uint64_t>(segments, 1));
+    const double vertexShare = double(touched) * kRecomputedVertex / double(std::max<size_t>(scene_.vertexCount(), 1));
+    return segmentShare + vertexShare > kWorthUpdatingBelow;
+}
+
+const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats) {
+    stats = FrameTiming();
     const PoseChange change = pose(target);
-    if (!solved_ || settings_.fullRecompute) {
-        Stopwatch clock;
-        const std::vector<uint32_t> touched = regionsValid_ && change.any ? touchedVertices(change) : std::vector<uint32_t>();
-        updateRegions(regionsValid_ && change.any ? &touched : nullptr, work);
-        const double regionSeconds = clock.seconds();
-        solveFromScratch(work);
-        work.estimationSeconds += regionSeconds;
+    Stopwatch clock;
+    const bool firstTime = !regionsValid_;
+    const std::vector<uint32_t> touched = !firstTime && change.any ? touchedVertices(change) : std::vector<uint32_t>();
+    updateRegions(firstTime ? nullptr : &touched, stats);
+    const double regionSeconds = clock.seconds();
+
+    std::string why;
+    if (!solved_) why = "first-frame";
+    else if (settings_.fullRecompute) why = "full-recompute";
+    else if (!estimator_->canUpdate(why)) {
+    } else if (change.any && !settings_.alwaysUpdate && changeTooLarge(change, touched.size())) why = "change-too-large";
+    if (!why.empty()) {
+        solveFromScratch(stats);
+        // After the first frame the tracking state is made at once, so that the frames after it
+        // pay only their updates; after a fallback, only once a frame updates again.
+        std::string noUpdate;
+        if (why == "first-frame" && !settings_.fullRecompute && estimator_->canUpdate(noUpdate)) startTracking(stats);
+        stats.fromScratchReason = solved_ ? why : "";
         solved_ = true;
     } else {
-        solveIncrementally(change, work);
+        stats.fromScratch = false;
+        if (!tracked_) startTracking(stats);
+        // Nothing moved: no path changes, no vertex changes.
+        if (change.any) solveIncrementally(change, touched, stats);
     }
+    stats.estimationSeconds += regionSeconds;
     if (tracked_) {
-        work.trackedPaths = tracked_->trackedPaths();
-        work.trackedSegments = tracked_->trackedSegments();
-        work.trackedBytes = tracked_->bytes();
-        work.segments = foldedSegments_ + tracked_->trackedSegments();
+        stats.trackedPaths = tracked_->trackedPaths();
+        stats.trackedSegments = tracked_->trackedSegments();
+        stats.trackedBytes = tracked_->bytes();
+        stats.segments = foldedSegments_ + tracked_->trackedSegments();
+    }
+    stats.estimatorStateBytes = estimator_->stateBytes();
+    if (regions_) {
+        stats.ownSurfaceFallbacks = regions_->fallbackVertices();
+        stats.buriedVertices = regions_->buriedVertices();
     }
     return result_;
 }
 
-void FrameSolver::solveFromScratch(FrameWork& work) {
-    work.fromScratch = true;
+void FrameSolver::solveFromScratch(FrameTiming& stats) {
+    stats.fromScratch = true;
+    tracked_.reset();
+    lastCache_.reset();
     Stopwatch clock;
-    const RayCache cache = tracer_.traceAll();
-    work.photonSeconds = clock.seconds();
-    work.segments = cache.segments.size();
-    work.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
-    work.pathsRetraced = cache.pathCount();
-    work.segmentsAdded = cache.segments.size();
-    maxPhotonPower_ = cache.maxPhotonPower;
+    RayCache cache = tracer_.traceAll();
+    stats.photonSimulationSeconds = clock.seconds();
+    stats.segments = cache.segments.size();
+    stats.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
+    stats.pathsRetraced = cache.pathCount();
+    stats.segmentsAdded = cache.segments.size();
 
     clock.restart();
-    const EstimatorSettings& e = settings_.estimator;
-    const PowerQuantizer q(cache.maxPhotonPower);
-    if (e.kind == EstimatorKind::ImpactCount) {
-        impactCount_.emplace(scene_);
-        impactCount_->accumulate(cache);
-        result_ = impactCount_->estimate(scene_, q);
-    } else if (updatesSums()) {
-        if (e.useIndex) {
-            if (!discs_) discs_ = std::make_unique<DetpDiscs>(device_, scene_, e.radius, e.boundary, regions(), &bvh_);
-            discs_->updateDynamic();
-            detpSums_ = discs_->sums(cache, e.sortQueries ? segmentMortonOrder(cache) : inputOrder(cache.segments.size()));
-        } else {
-            std::vector<const Segment*> all(cache.segments.size());
-            for (size_t i = 0; i < all.size(); ++i) all[i] = &cache.segments[i];
-            detpSums_.assign(scene_.vertexCount(), DetpVertexSums());
-            detpBruteForceSums(inputOrder(scene_.vertexCount()), all, q);
-        }
-        result_.irradiance.resize(scene_.vertexCount());
-        for (uint32_t v = 0; v < scene_.vertexCount(); ++v) result_.irradiance[v] = detpIrradiance(v, q);
-        computeRadiosity(scene_, result_);
-    } else {
-        result_ = estimateVertexRadiosity(scene_, bvh_, cache, e, device_, regions());
-    }
-    work.estimationSeconds = clock.seconds();
-    work.verticesUpdated = scene_.vertexCount();
+    estimator_->solve(cache, result_, stats);
+    stats.estimationSeconds = clock.seconds();
+    if (!settings_.fullRecompute) lastCache_ = std::move(cache);
+}
 
-    if (settings_.fullRecompute) return;
-    // The incremental state: paths that meet the envelope are tracked, the rest folded into the
-    // sums just computed (estimators that re-estimate from every segment track everything).
-    const bool discs = e.kind != EstimatorKind::ImpactCount;
-    const float margin = envelopeMargin(discs, e.radius, scene_.sceneEpsilon());
-    // The photon map keeps the untracked segments (they never change) to re-estimate from.
-    const bool sums = updatesSums();
-    const Envelope envelope = settings_.useEnvelope ? Envelope::ofAnimation(scene_, sums ? margin : scene_.sceneEpsilon())
-                                                    : Envelope::everything();
+void FrameSolver::startTracking(FrameTiming& stats) {
+    // Paths that meet the envelope are tracked, the rest stay folded into the estimator's state.
+    Stopwatch clock;
+    const RayCache& cache = *lastCache_;
+    const float reach = estimator_->reach();
+    const float margin = envelopeMargin(reach > 0, reach, scene_.sceneEpsilon());
+    const Envelope envelope = settings_.useEnvelope ? Envelope::ofAnimation(scene_, margin) : Envelope::everything();
     const Bounds3f gridBounds = envelope.isEverything() ? scene_.animationBounds.expanded(margin) : envelope.bounds();
     // Cells a few discs across, no more than 32 along an axis (16 for the whole scene): queries
-    // ask about objects' bounds, and finer cells cost more to fill than they save.
-    const float cellSize = std::max(discs ? 4 * e.radius : 0.0f, gridBounds.extent() / (envelope.isEverything() ? 16 : 32));
-    staticSegments_.clear();
-    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, sums && discs ? e.radius : 0.0f, gridBounds, cellSize,
-                                              sums ? nullptr : &staticSegments_);
+    // ask about objects' bounds and discs, and finer cells cost more to fill than they save.
+    const float cellSize = std::max(4 * reach, gridBounds.extent() / (envelope.isEverything() ? 16 : 32));
+    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize);
     foldedSegments_ = cache.segments.size() - tracked_->trackedSegments();
+    stats.photonSimulationSeconds += clock.seconds();
+    clock.restart();
+    estimator_->prepareUpdates(*tracked_, stats);
+    stats.estimationSeconds += clock.seconds();
+    lastCache_.reset();
 }
 
-Vec3f FrameSolver::detpIrradiance(uint32_t v, const PowerQuantizer& q) const {
-    const EstimatorSettings& e = settings_.estimator;
-    return detpVertexIrradiance(detpSums_[v], regions_ ? &(*regions_)[v] : nullptr, e.radius, e.boundary, q);
-}
-
-void FrameSolver::detpBruteForceSums(const std::vector<uint32_t>& vertices, const std::vector<const Segment*>& segments,
-                                     const PowerQuantizer& q) {
-    const EstimatorSettings& e = settings_.estimator;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i)
-            detpSums_[vertices[i]] = detpVertexSums(scene_, vertices[i], segments, e.radius, e.boundary, regions(), &bvh_, q);
-    });
-}
-
-void FrameSolver::solveIncrementally(const PoseChange& change, FrameWork& work) {
-    if (!change.any) return;  // nothing moved: no path changes, no vertex changes
-    PathChanges changes;
-    const std::vector<AffectedPath> affected =
-        tracked_->findAffected(change.triangleMoved, change.newBounds, bvh_, settings_.gridForBlocking, changes);
-    tracked_->retrace(affected, tracer_, changes);
-    work.findSeconds = changes.findSeconds;
-    work.retraceSeconds = changes.retraceSeconds;
-    work.photonSeconds = changes.findSeconds + changes.retraceSeconds;
-    work.pathsRetraced = changes.pathsRetraced;
-    work.affectedByImpact = changes.affectedByImpact;
-    work.affectedByBlocking = changes.affectedByBlocking;
-    work.blockingCandidates = changes.blockingCandidates;
-    work.segmentsRemoved = changes.removed.size();
-    work.segmentsAdded = changes.added.size();
-
+void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats) {
     Stopwatch clock;
-    // Vertices whose disc moved or whose regions the move touched.
-    const std::vector<uint32_t> touched = touchedVertices(change);
-    updateRegions(&touched, work);
-    const EstimatorSettings& e = settings_.estimator;
-    const PowerQuantizer q(maxPhotonPower_);
-    if (e.kind == EstimatorKind::ImpactCount) {
-        // Old segments leave with the facing they were counted with, before the triangles move.
-        for (const Segment& s : changes.removed) impactCount_->subtract(s, q);
-        impactCount_->updateGeometry(scene_);
-        for (const Segment& s : changes.added) impactCount_->add(s, q);
-        result_ = impactCount_->estimate(scene_, q);
-        std::vector<uint8_t> updated(scene_.vertexCount(), 0);
-        auto mark = [&](uint32_t t) {
-            for (uint32_t v : scene_.triangles[t].v) updated[v] = 1;
-        };
-        for (const auto* list : {&changes.removed, &changes.added})
-            for (const Segment& s : *list)
-                if (s.hasImpact()) mark(s.triangle);
-        for (uint32_t t = 0; t < scene_.triangleCount(); ++t)
-            if (change.triangleMoved[t]) mark(t);
-        work.verticesUpdated = uint64_t(std::count(updated.begin(), updated.end(), uint8_t(1)));
-    } else if (updatesSums()) {
-        // Vertices whose disc moved or whose regions the move touched are recomputed from the
-        // tracked segments near them; every other vertex takes + new − old.
-        const std::vector<uint32_t>& recompute = touched;
-        std::vector<uint8_t> skip(scene_.vertexCount(), 0);
-        for (uint32_t v : recompute) skip[v] = 1;
-        std::vector<uint32_t> changed;
-        if (e.useIndex) {
-            discs_->updateDynamic();
-            discs_->accumulate(changes.removed, q, -1, skip, detpSums_, changed);
-            discs_->accumulate(changes.added, q, +1, skip, detpSums_, changed);
-        } else {
-            // Index-free (--no-ray-cache): every changed segment against every disc.
-            std::vector<const Segment*> removed, added;
-            for (const Segment& s : changes.removed) removed.push_back(&s);
-            for (const Segment& s : changes.added) added.push_back(&s);
-            std::vector<uint8_t> touched(scene_.vertexCount(), 0);
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, scene_.vertexCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t v = r.begin(); v != r.end(); ++v) {
-                    if (skip[v]) continue;
-                    const DetpVertexSums delta = detpVertexSums(scene_, uint32_t(v), added, e.radius, e.boundary, regions(), &bvh_, q);
-                    const DetpVertexSums gone = detpVertexSums(scene_, uint32_t(v), removed, e.radius, e.boundary, regions(), &bvh_, q);
-                    if (delta == DetpVertexSums() && gone == DetpVertexSums()) continue;
-                    detpSums_[v] += delta;
-                    detpSums_[v] -= gone;
-                    touched[v] = 1;
-                }
-            });
-            for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
-                if (touched[v]) changed.push_back(v);
-        }
-        Stopwatch recomputeClock;
-        for (uint32_t v : recompute) detpSums_[v] = DetpVertexSums();
-        if (e.useIndex) {
-            // The tracked segments near any recomputed disc, gathered once from the grid (every
-            // such disc lies within the envelope margin of a moved object's old or new bounds),
-            // then traced through the disc BVH counting only the recomputed vertices.
-            const float margin = envelopeMargin(true, e.radius, scene_.sceneEpsilon());
-            std::vector<const Segment*> near;
-            for (const Bounds3f& b : change.bounds) tracked_->segmentsNear(b.expanded(margin), near);
-            std::sort(near.begin(), near.end());
-            near.erase(std::unique(near.begin(), near.end()), near.end());
-            std::vector<Segment> segments(near.size());
-            for (size_t i = 0; i < near.size(); ++i) segments[i] = *near[i];
-            discs_->recompute(segments, q, recompute, detpSums_);
-        } else {
-            std::vector<const Segment*> all;
-            tracked_->allSegments(all);
-            detpBruteForceSums(recompute, all, q);
-        }
-        work.recomputeSeconds = recomputeClock.seconds();
-        work.verticesRecomputed = recompute.size();
-        changed.insert(changed.end(), recompute.begin(), recompute.end());
-        std::sort(changed.begin(), changed.end());
-        changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-        for (uint32_t v : changed) result_.irradiance[v] = detpIrradiance(v, q);
-        computeRadiosity(scene_, result_);
-        work.verticesUpdated = changed.size();
-    } else {
-        // The photon map's k nearest neighbours cannot be folded (DESIGN §6.5): re-estimate from
-        // every segment, the untracked ones kept as they were.
-        RayCache all;
-        all.maxPhotonPower = maxPhotonPower_;
-        all.segments = staticSegments_;
-        tracked_->appendAll(all.segments);
-        result_ = estimateVertexRadiosity(scene_, bvh_, all, e, device_, regions());
-        work.verticesUpdated = scene_.vertexCount();
-    }
-    work.estimationSeconds = clock.seconds();
+    const std::vector<AffectedPath> affected =
+        tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.gridForBlocking, stats);
+    PathChanges changes;
+    tracked_->retrace(affected, tracer_, changes, stats);
+    stats.photonSimulationSeconds += clock.seconds();
+
+    clock.restart();
+    const FrameChange frameChange{changes.removed, changes.added, change.vertexMoved, change.triangleMoved, touched, *tracked_};
+    estimator_->update(frameChange, result_, stats);
+    stats.estimationSeconds += clock.seconds();
 }
 
 }  // namespace qsgi

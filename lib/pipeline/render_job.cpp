@@ -258,6 +258,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     solverSettings.estimator = settings_.estimator;
     solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces, EmissionAim{settings_.aimEmission, 0}};
     solverSettings.fullRecompute = settings_.fullRecompute;
+    solverSettings.alwaysUpdate = settings_.alwaysUpdate;
     solverSettings.useEnvelope = settings_.useEnvelope;
     solverSettings.gridForBlocking = settings_.blockingGrid;
     // Built in the rest pose, before any frame: every run refits the same BVHs (DESIGN §6.0).
@@ -276,43 +277,20 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
             exposure = automaticExposure(renderRadiosityImage(scene_, bvh, result, cameraAt(0), imageSettings));
     };
     if (start > 0) {
-        FrameWork work;
-        fixPreviews(solver.solve(animation_.poseAt(0), work), solver.bvh());
+        FrameTiming ignored;
+        fixPreviews(solver.solve(animation_.poseAt(0), ignored), solver.bvh());
         solver.reset();
     }
 
     const int count = last_ - start + 1;
     for (int frame = start; frame <= last_; ++frame) {
         Stopwatch frameClock;
-        FrameWork work;
-        const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), work);
-        if (!tonemap) fixPreviews(result, solver.bvh());
         FrameTiming timing;
+        const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), timing);
         timing.frame = frame;
-        timing.fromScratch = work.fromScratch;
-        timing.photonSimulationSeconds = work.photonSeconds;
-        timing.findAffectedSeconds = work.findSeconds;
-        timing.retraceSeconds = work.retraceSeconds;
-        timing.estimationSeconds = work.estimationSeconds;
-        timing.segments = work.segments;
-        timing.photonsMissingScene = work.photonsMissingScene;
-        timing.pathsRetraced = work.pathsRetraced;
-        timing.pathsAffectedByImpact = work.affectedByImpact;
-        timing.pathsAffectedByBlocking = work.affectedByBlocking;
-        timing.segmentsRemoved = work.segmentsRemoved;
-        timing.segmentsAdded = work.segmentsAdded;
-        timing.verticesUpdated = work.verticesUpdated;
-        timing.recomputeSeconds = work.recomputeSeconds;
-        timing.verticesRecomputed = work.verticesRecomputed;
-        timing.trackedPaths = work.trackedPaths;
-        timing.trackedSegments = work.trackedSegments;
-        timing.trackedBytes = work.trackedBytes;
-        timing.discRegionsSeconds = work.discRegionsSeconds;
-        timing.discRegionsUpdated = work.discRegionsUpdated;
-        timing.ownSurfaceFallbacks = solver.ownSurfaceFallbacks();
-        timing.buriedVertices = solver.buriedVertices();
+        if (!tonemap) fixPreviews(result, solver.bvh());
         if (frame == start) {
-            log.photonsMissingScene = work.photonsMissingScene;
+            log.photonsMissingScene = timing.photonsMissingScene;
             log.emittedFraction = solver.emittedFraction();
             log.emissionMeasured = true;
         }

@@ -136,7 +136,7 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
 }
 
 const std::vector<std::string> kConfigKeys = {
-    "scene", "animation", "fps", "out", "estimator", "radius", "k", "ray_cache", "sort_queries", "full_recompute",
+    "scene", "animation", "fps", "out", "estimator", "radius", "k", "ray_cache", "sort_queries", "full_recompute", "always_update",
     "envelope", "aim_emission", "blocking_grid", "detp_index", "detp_boundary", "photons", "seed", "max_bounces", "threads",
     "frames", "lights", "width", "height", "spp", "exr", "exr_half", "png", "gltf_out", "exposure", "camera"};
 
@@ -185,13 +185,14 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
             s.radiusGiven = true;
         } else if (key == "k") s.estimator.k = int(checkedInteger(jsonInteger(v, path, key), 1, kMaxK, path, key));
         else if (key == "ray_cache" || key == "sort_queries" || key == "full_recompute" || key == "envelope" ||
-                 key == "aim_emission" || key == "blocking_grid") {
+                 key == "aim_emission" || key == "blocking_grid" || key == "always_update") {
             if (!v.is_boolean()) throw InputError(path, key, "must be true or false");
             bool& target = key == "ray_cache" ? s.estimator.useIndex
                            : key == "sort_queries" ? s.estimator.sortQueries
                            : key == "full_recompute" ? s.fullRecompute
                            : key == "envelope"       ? s.useEnvelope
                            : key == "aim_emission"   ? s.aimEmission
+                           : key == "always_update"  ? s.alwaysUpdate
                                                      : s.blockingGrid;
             target = v.get<bool>();
         } else if (key == "detp_index") s.estimator.detpIndex = parseDetpIndex(str(), path);

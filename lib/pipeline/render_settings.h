@@ -32,6 +32,7 @@ struct RenderSettings {
     uint32_t maxBounces = 32;
     int threads = 0;  // 0: all cores
     bool fullRecompute = false;  // every frame from scratch instead of the incremental update
+    bool alwaysUpdate = false;   // update even frames whose change would cost more than recomputing them
     bool useEnvelope = true;     // fold paths that never meet the moving geometry's envelope
     bool aimEmission = true;     // projection maps: lights emit only toward the scene
     bool blockingGrid = true;    // find blocked segments through the grid (false: test every tracked one)

@@ -26,6 +26,12 @@ bool SegmentGrid::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
 }
 
 void SegmentGrid::insert(const Vec3f& origin, const Vec3f& direction, double end, const SegmentRef& ref) {
+    std::vector<uint32_t> cells;
+    cellsOf(origin, direction, end, cells);
+    insertInto(cells.data(), cells.size(), ref);
+}
+
+void SegmentGrid::cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const {
     double t0 = 0, t1 = end;
     if (cells_.empty() || !bounds_.clip(origin, direction, t0, t1)) return;
     // Pieces no longer than the smallest cell edge, each listed in every cell its (slightly
@@ -53,8 +59,7 @@ void SegmentGrid::insert(const Vec3f& origin, const Vec3f& direction, double end
                     if (nowCount < 8) now[nowCount++] = c;
                     // Consecutive pieces share cells: list the segment once per cell it enters.
                     if (std::find(last, last + lastCount, c) != last + lastCount) continue;
-                    cells_[c].push_back(ref);
-                    ++entries_;
+                    cells.push_back(uint32_t(c));
                 }
         std::copy(now, now + nowCount, last);
         lastCount = nowCount;

@@ -31,6 +31,13 @@ public:
 
     // Lists the part [0, end] of the ray o + t·d (end may be infinite) in every cell it passes.
     void insert(const Vec3f& origin, const Vec3f& direction, double end, const SegmentRef& ref);
+    // The two halves of insert: the cells the ray passes (appended to `cells`; read-only, so
+    // threads can find them in parallel), then listing ref in them.
+    void cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const;
+    void insertInto(const uint32_t* cells, size_t count, const SegmentRef& ref) {
+        for (size_t i = 0; i < count; ++i) cells_[cells[i]].push_back(ref);
+        entries_ += count;
+    }
     // Every entry in a cell that overlaps the box, sorted by (path, bounce) and without duplicates;
     // entries whose generation is not current (isLive) are dropped.
     template <typename IsLive>

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <tuple>
 
 #include "util/stopwatch.h"
 
@@ -48,9 +49,23 @@ double TrackedPaths::reach(const Segment& s) const {
 }
 
 void TrackedPaths::index(const Tracked& t) {
+    std::vector<uint32_t> cells;
     for (uint32_t j = 0; j < t.count; ++j) {
         const Segment& s = segments_[t.begin + j];
-        grid_.insert(s.origin, s.direction, reach(s), SegmentRef{t.path, t.generation, t.firstBounce + j});
+        cells.clear();
+        grid_.cellsOf(s.origin, s.direction, reach(s), cells);
+        indexSegment(t, j, cells.data(), cells.size());
+    }
+}
+
+void TrackedPaths::indexSegment(const Tracked& t, uint32_t j, const uint32_t* cells, size_t cellCount) {
+    const Segment& s = segments_[t.begin + j];
+    const SegmentRef ref{t.path, t.generation, t.firstBounce + j};
+    grid_.insertInto(cells, cellCount, ref);
+    if (s.hasImpact() && s.impactDynamic) {
+        if (byTriangle_.size() <= s.triangle) byTriangle_.resize(size_t(s.triangle) + 1);
+        byTriangle_[s.triangle].push_back(ref);
+        ++triangleEntries_;
     }
 }
 
@@ -64,26 +79,35 @@ const Segment* TrackedPaths::segmentOf(const SegmentRef& r) const {
     return &segments_[t.begin + (r.bounce - t.firstBounce)];
 }
 
-std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint8_t>& triangleMoved,
+uint64_t TrackedPaths::segmentsListedOn(const std::vector<uint32_t>& triangles) const {
+    uint64_t n = 0;
+    for (uint32_t t : triangles)
+        if (t < byTriangle_.size()) n += byTriangle_[t].size();
+    return n;
+}
+
+std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>& movedTriangles,
+                                                     const std::vector<uint8_t>& triangleMoved,
                                                      const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh,
-                                                     bool useGrid, PathChanges& changes) const {
+                                                     bool useGrid, FrameTiming& stats) const {
     Stopwatch clock;
     constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
-    std::vector<uint32_t> from(paths_.size(), kNone);
+    // Per affected path (by slot), the first bounce to retrace from.
+    std::vector<std::pair<uint32_t, uint32_t>> firstBounce;  // (slot, bounce)
     // (a) A segment that hit a triangle that moved: the photon would now land elsewhere.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, paths_.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            const Tracked& t = paths_[i];
-            for (uint32_t j = 0; j < t.count; ++j) {
-                const Segment& s = segments_[t.begin + j];
-                if (s.hasImpact() && s.impactDynamic && triangleMoved[s.triangle]) {
-                    from[i] = t.firstBounce + j;
-                    break;
-                }
-            }
-        }
-    });
-    for (uint32_t f : from) changes.affectedByImpact += f != kNone;
+    for (uint32_t tri : movedTriangles) {
+        if (tri >= byTriangle_.size()) continue;
+        stats.impactCandidates += byTriangle_[tri].size();
+        for (const SegmentRef& r : byTriangle_[tri])
+            if (isLive(r)) firstBounce.push_back({uint32_t(slot_[r.path]), r.bounce});
+    }
+    auto firstPerPath = [](std::vector<std::pair<uint32_t, uint32_t>>& list) {
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+                   list.end());
+    };
+    firstPerPath(firstBounce);
+    stats.pathsAffectedByImpact += firstBounce.size();
 
     // (b) A segment that a moved triangle now blocks before its impact. Only segments passing
     // through a moved object's new bounds can be; the grid lists them, the dynamic BVH decides,
@@ -117,56 +141,110 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint8_t>&
                 }
             }
     }
-    changes.blockingCandidates += candidates.size();
+    stats.blockingCandidates += candidates.size();
     std::vector<uint8_t> isBlocked(candidates.size(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) isBlocked[i] = blocked(*segmentOf(candidates[i]));
     });
-    for (size_t i = 0; i < candidates.size(); ++i) {
-        if (!isBlocked[i]) continue;
-        uint32_t& f = from[size_t(slot_[candidates[i].path])];
-        if (f == kNone) ++changes.affectedByBlocking;
-        f = std::min(f, candidates[i].bounce);
-    }
+    std::vector<std::pair<uint32_t, uint32_t>> byBlocking;
+    for (size_t i = 0; i < candidates.size(); ++i)
+        if (isBlocked[i]) byBlocking.push_back({uint32_t(slot_[candidates[i].path]), candidates[i].bounce});
+    firstPerPath(byBlocking);
 
+    // Merge: per path the earlier of the two bounces; paths in increasing id (slots are).
     std::vector<AffectedPath> affected;
-    for (size_t i = 0; i < paths_.size(); ++i)
-        if (from[i] != kNone) affected.push_back({paths_[i].path, from[i]});
-    changes.findSeconds += clock.seconds();
+    affected.reserve(firstBounce.size() + byBlocking.size());
+    size_t i = 0, j = 0;
+    while (i < firstBounce.size() || j < byBlocking.size()) {
+        uint32_t slot, bounce = kNone;
+        if (j == byBlocking.size() || (i < firstBounce.size() && firstBounce[i].first < byBlocking[j].first)) {
+            std::tie(slot, bounce) = firstBounce[i++];
+        } else if (i == firstBounce.size() || byBlocking[j].first < firstBounce[i].first) {
+            std::tie(slot, bounce) = byBlocking[j++];
+            ++stats.pathsAffectedByBlocking;
+        } else {
+            slot = firstBounce[i].first;
+            bounce = std::min(firstBounce[i++].second, byBlocking[j++].second);
+        }
+        affected.push_back({paths_[slot].path, bounce});
+    }
+    stats.findAffectedSeconds += clock.seconds();
     return affected;
 }
 
-void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes) {
+void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes,
+                           FrameTiming& stats) {
     Stopwatch clock;
-    std::vector<std::vector<Segment>> tails(affected.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, affected.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            const Tracked& t = paths_[size_t(slot_[affected[i].path])];
-            const Segment& s = segments_[t.begin + (affected[i].bounce - t.firstBounce)];
-            tracer.continuePath(s.path, s.bounce, s.origin, s.direction, s.power, 0.0f, tails[i]);
+    // New tails and the grid cells each new segment passes, found in parallel; fixed chunks of
+    // paths, so nothing depends on the schedule.
+    struct Chunk {
+        std::vector<Segment> tails;
+        std::vector<uint32_t> tailEnd;   // per path of the chunk: end of its tail in `tails`
+        std::vector<uint32_t> cells;     // per segment of the new paths (kept head, then tail), its cells
+        std::vector<uint32_t> cellsEnd;  // per such segment: end of its cells
+    };
+    constexpr size_t kChunk = 64;
+    std::vector<Chunk> chunks((affected.size() + kChunk - 1) / kChunk);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size()), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t c = r.begin(); c != r.end(); ++c) {
+            Chunk& chunk = chunks[c];
+            for (size_t i = c * kChunk; i < std::min(affected.size(), (c + 1) * kChunk); ++i) {
+                const Tracked& t = paths_[size_t(slot_[affected[i].path])];
+                const uint32_t keep = affected[i].bounce - t.firstBounce;
+                const size_t tailBegin = chunk.tails.size();
+                const Segment& s = segments_[t.begin + keep];
+                tracer.continuePath(s.path, s.bounce, s.origin, s.direction, s.power, 0.0f, chunk.tails);
+                chunk.tailEnd.push_back(uint32_t(chunk.tails.size()));
+                auto list = [&](const Segment& x) {
+                    grid_.cellsOf(x.origin, x.direction, reach(x), chunk.cells);
+                    chunk.cellsEnd.push_back(uint32_t(chunk.cells.size()));
+                };
+                for (uint32_t j = 0; j < keep; ++j) list(segments_[t.begin + j]);
+                for (size_t j = tailBegin; j < chunk.tails.size(); ++j) list(chunk.tails[j]);
+            }
         }
     });
     // Sequential and in path order, so the cache's layout is the same for any thread count.
     size_t garbage = segments_.size() - liveSegments_;
+    size_t removed = 0, added = 0, kept = 0;
     for (size_t i = 0; i < affected.size(); ++i) {
+        const Tracked& t = paths_[size_t(slot_[affected[i].path])];
+        kept += affected[i].bounce - t.firstBounce;
+        removed += t.count - (affected[i].bounce - t.firstBounce);
+    }
+    for (const Chunk& c : chunks) added += c.tails.size();
+    changes.removed.reserve(changes.removed.size() + removed);
+    changes.added.reserve(changes.added.size() + added);
+    const size_t needed = segments_.size() + added + kept;
+    if (segments_.capacity() < needed) segments_.reserve(std::max(needed, segments_.capacity() + segments_.capacity() / 2));
+    std::vector<uint32_t> cellCursor(chunks.size(), 0);  // per chunk: segments whose cells were listed
+    for (size_t i = 0; i < affected.size(); ++i) {
+        const Chunk& chunk = chunks[i / kChunk];
+        const size_t inChunk = i % kChunk;
+        const uint32_t tailBegin = inChunk ? chunk.tailEnd[inChunk - 1] : 0, tailEnd = chunk.tailEnd[inChunk];
         Tracked& t = paths_[size_t(slot_[affected[i].path])];
         const uint32_t keep = affected[i].bounce - t.firstBounce;
         changes.removed.insert(changes.removed.end(), segments_.begin() + int64_t(t.begin + keep),
                                segments_.begin() + int64_t(t.begin + t.count));
-        changes.added.insert(changes.added.end(), tails[i].begin(), tails[i].end());
-        // The kept head goes through a copy: inserting a vector's own range into it is undefined.
-        const std::vector<Segment> head(segments_.begin() + int64_t(t.begin), segments_.begin() + int64_t(t.begin + keep));
+        changes.added.insert(changes.added.end(), chunk.tails.begin() + tailBegin, chunk.tails.begin() + tailEnd);
+        // The kept head is copied by index: segments_ has room reserved, so nothing moves.
         const uint64_t begin = segments_.size();
-        segments_.insert(segments_.end(), head.begin(), head.end());
-        segments_.insert(segments_.end(), tails[i].begin(), tails[i].end());
+        for (uint32_t j = 0; j < keep; ++j) segments_.push_back(segments_[t.begin + j]);
+        segments_.insert(segments_.end(), chunk.tails.begin() + tailBegin, chunk.tails.begin() + tailEnd);
         garbage += t.count;
-        liveSegments_ += keep + tails[i].size() - t.count;
+        liveSegments_ = liveSegments_ + keep + (tailEnd - tailBegin) - t.count;
         t.begin = begin;
-        t.count = uint32_t(keep + tails[i].size());
+        t.count = keep + (tailEnd - tailBegin);
         ++t.generation;
-        index(t);
+        // The whole path under its new generation, with the cells found above.
+        for (uint32_t j = 0; j < t.count; ++j, ++cellCursor[i / kChunk]) {
+            const uint32_t n = cellCursor[i / kChunk], from = n ? chunk.cellsEnd[n - 1] : 0;
+            indexSegment(t, j, chunk.cells.data() + from, chunk.cellsEnd[n] - from);
+        }
     }
-    changes.pathsRetraced += affected.size();
+    stats.pathsRetraced += affected.size();
+    stats.segmentsRemoved += removed;
+    stats.segmentsAdded += added;
     // Retraced paths leave their old segments behind; compact once they are half the store.
     if (garbage > liveSegments_) {
         std::vector<Segment> compact;
@@ -177,9 +255,15 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
             t.begin = begin;
         }
         segments_.swap(compact);
-        grid_.sweep([&](const SegmentRef& r) { return isLive(r); });
+        auto live = [&](const SegmentRef& r) { return isLive(r); };
+        grid_.sweep(live);
+        triangleEntries_ = 0;
+        for (auto& list : byTriangle_) {
+            list.erase(std::remove_if(list.begin(), list.end(), [&](const SegmentRef& r) { return !live(r); }), list.end());
+            triangleEntries_ += list.size();
+        }
     }
-    changes.retraceSeconds += clock.seconds();
+    stats.retraceSeconds += clock.seconds();
 }
 
 void TrackedPaths::segmentsNear(const Bounds3f& box, std::vector<const Segment*>& out) const {
@@ -199,8 +283,10 @@ void TrackedPaths::allSegments(std::vector<const Segment*>& out) const {
 }
 
 size_t TrackedPaths::bytes() const {
+    size_t listed = byTriangle_.capacity() * sizeof(byTriangle_[0]);
+    for (const auto& list : byTriangle_) listed += list.capacity() * sizeof(SegmentRef);
     return segments_.capacity() * sizeof(Segment) + paths_.capacity() * sizeof(Tracked) + slot_.capacity() * sizeof(int32_t) +
-           grid_.bytes();
+           grid_.bytes() + listed;
 }
 
 }  // namespace qsgi

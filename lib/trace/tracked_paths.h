@@ -12,6 +12,7 @@
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
 #include "trace/segment_grid.h"
+#include "util/frame_timing.h"
 
 namespace qsgi {
 
@@ -21,13 +22,9 @@ struct AffectedPath {
     uint32_t bounce;
 };
 
-// What one frame's update changed, for the estimators and timing.json.
+// The segments one frame's retrace exchanged: old tails and new tails, in path order.
 struct PathChanges {
-    std::vector<Segment> removed, added;  // old tails and new tails, path order
-    uint64_t pathsRetraced = 0;
-    uint64_t affectedByImpact = 0, affectedByBlocking = 0;  // (a) and (b) of DESIGN §6 step 2
-    uint64_t blockingCandidates = 0;                         // segments the grid handed to the exact test
-    double findSeconds = 0, retraceSeconds = 0;
+    std::vector<Segment> removed, added;
 };
 
 class TrackedPaths {
@@ -39,18 +36,29 @@ public:
     TrackedPaths(const RayCache& cache, const Envelope& envelope, float extension, const Bounds3f& gridBounds,
                  float cellSize, std::vector<Segment>* untracked = nullptr);
 
-    // The paths the move from the previous pose to the current one affects. triangleMoved: per
-    // scene triangle, whether any of its vertices moved; newBounds: the moved instances' bounds in
-    // the current pose; bvh: the current pose. useGrid = false tests every tracked segment (the
-    // baseline the grid is measured against).
-    std::vector<AffectedPath> findAffected(const std::vector<uint8_t>& triangleMoved, const std::vector<Bounds3f>& newBounds,
-                                           const SceneBvh& bvh, bool useGrid, PathChanges& changes) const;
+    // The paths the move from the previous pose to the current one affects. movedTriangles: the
+    // scene triangles any of whose vertices moved (sorted), triangleMoved the same as flags;
+    // newBounds: the moved triangles' bounds in the current pose; bvh: the current pose.
+    // useGrid = false tests every tracked segment (the baseline the grid is measured against).
+    // Rule (a) reads the segments listed on the moved triangles, rule (b) the grid's cells in
+    // the new bounds: neither scans the tracked segments. Counts and time go to `stats`.
+    std::vector<AffectedPath> findAffected(const std::vector<uint32_t>& movedTriangles, const std::vector<uint8_t>& triangleMoved,
+                                           const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh, bool useGrid,
+                                           FrameTiming& stats) const;
+    // Tracked segments that impacted one of the triangles (stale entries of retraced paths
+    // included): what rule (a) will read, known before any work, for the update's price.
+    uint64_t segmentsListedOn(const std::vector<uint32_t>& triangles) const;
     // Retraces the affected paths and swaps their tails in; fills changes.removed/added.
-    void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes);
+    void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes, FrameTiming& stats);
 
     // Tracked segments that pass through the box (with their extension), for the discs an update
     // recomputes. Appends pointers valid until the next retrace.
     void segmentsNear(const Bounds3f& box, std::vector<const Segment*>& out) const;
+    // The same as references (sorted, unique, live), and the segment a reference names.
+    void refsNear(const Bounds3f& box, std::vector<SegmentRef>& out) const {
+        grid_.query(box, out, [&](const SegmentRef& r) { return isLive(r); });
+    }
+    const Segment& segment(const SegmentRef& r) const { return *segmentOf(r); }
     // Every tracked segment (for estimators that rebuild from all of them).
     void appendAll(std::vector<Segment>& out) const;
     void allSegments(std::vector<const Segment*>& out) const;
@@ -70,6 +78,8 @@ private:
     const Segment* segmentOf(const SegmentRef& r) const;
     bool isLive(const SegmentRef& r) const;
     void index(const Tracked& t);
+    // Lists segment j of t in the given grid cells, and on its triangle if dynamic.
+    void indexSegment(const Tracked& t, uint32_t j, const uint32_t* cells, size_t cellCount);
     double reach(const Segment& s) const;  // how far along the ray the grid lists it
 
     Envelope envelope_;
@@ -79,6 +89,9 @@ private:
     std::vector<int32_t> slot_;      // path id -> index in paths_, −1 if untracked
     size_t liveSegments_ = 0;
     SegmentGrid grid_;
+    // Per scene triangle, the tracked segments that impacted it (dynamic triangles only): rule (a).
+    std::vector<std::vector<SegmentRef>> byTriangle_;
+    size_t triangleEntries_ = 0;
 };
 
 }  // namespace qsgi

@@ -1,0 +1,349 @@
+// DETP behind the Estimator interface (DESIGN §5–§6), with its three boundary rules. Per vertex,
+// fixed-point sums of the crossings' power (and first moments for `linear`), so an update is
+// "+ new − old" to the bit:
+//   - a removed segment leaves by the crossings remembered when it entered — no second trace
+//     through the discs — at every vertex a move can never touch (their crossings never change);
+//     the few discs a move can touch (dynamic vertices and those whose test region meets an
+//     instance's swept bounds) sit in a small refitted BVH, and removed segments are traced
+//     through that one only;
+//   - an added segment is traced through every disc once, and its crossings remembered;
+//   - a vertex the move touched (its disc moved, or its regions changed) is recomputed from the
+//     tracked segments the grid lists around its disc, each tested exactly.
+// --no-ray-cache keeps every step index-free (the reference); --detp-index flann has no update
+// (its frames are solved from scratch, and timing.json says so).
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "estimate/estimator.h"
+#include "estimate/morton_order.h"
+#include "util/stopwatch.h"
+
+namespace qsgi {
+
+namespace {
+
+class DetpEstimator final : public Estimator {
+public:
+    DetpEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
+        : settings_(settings), scene_(context.scene), bvh_(context.bvh), device_(context.device),
+          regions_(context.regions), moments_(settings.boundary == DetpBoundary::Linear) {
+        mayBeTouched_ = context.scene.vertexDynamic;
+        mayBeTouched_.resize(scene_.vertexCount(), 0);
+        if (regions_) {
+            std::vector<Bounds3f> swept;
+            for (const Bounds3f& b : scene_.sweptInstanceBounds)
+                if (!b.empty()) swept.push_back(b);
+            for (uint32_t v : regions_->touchedBy(scene_, swept, mayBeTouched_)) mayBeTouched_[v] = 1;
+        }
+    }
+
+    void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
+        quantizer_ = PowerQuantizer(cache.maxPhotonPower);
+        const EstimatorSettings& e = settings_;
+        if (!e.useIndex) {
+            std::vector<const Segment*> all(cache.segments.size());
+            for (size_t i = 0; i < all.size(); ++i) all[i] = &cache.segments[i];
+            sums_.assign(scene_.vertexCount(), DetpVertexSums());
+            bruteForceSums(allVertices(), all);
+        } else if (e.detpIndex == DetpIndex::Flann) {
+            const auto order = e.sortQueries ? mortonOrder(scene_.positions) : inputOrder(scene_.vertexCount());
+            out.irradiance = detpFlannCandidates(scene_, cache, e.radius, e.boundary, regions_, &bvh_, order);
+            computeRadiosity(scene_, out);
+            stats.verticesUpdated = scene_.vertexCount();
+            return;
+        } else {
+            discs().updateDynamic();
+            sums_ = discs_->sums(cache, e.sortQueries ? segmentMortonOrder(cache) : inputOrder(cache.segments.size()));
+        }
+        out.irradiance.resize(scene_.vertexCount());
+        for (uint32_t v = 0; v < scene_.vertexCount(); ++v) out.irradiance[v] = irradianceAt(v);
+        computeRadiosity(scene_, out);
+        stats.verticesUpdated = scene_.vertexCount();
+    }
+
+    bool canUpdate(std::string& why) const override {
+        const bool flann = settings_.useIndex && settings_.detpIndex == DetpIndex::Flann;
+        why = flann ? "estimator" : "";
+        return !flann;
+    }
+    float reach() const override { return settings_.radius; }
+
+    void prepareUpdates(const TrackedPaths& tracked, FrameTiming&) override {
+        byPath_.clear();
+        remembered_.clear();
+        rememberedMoments_.clear();
+        liveRemembered_ = 0;
+        if (!settings_.useIndex) return;  // brute force remembers nothing: it is the reference
+        std::vector<Segment> segments;
+        tracked.appendAll(segments);
+        std::vector<SegmentCrossing> found;
+        discs_->findCrossings(segments, DetpDiscs::Discs::Fixed, found);
+        size_t next = 0;
+        for (size_t i = 0; i < segments.size(); ++i) {
+            const Segment& s = segments[i];
+            if (byPath_.size() <= s.path) byPath_.resize(size_t(s.path) + 1);
+            PathCrossings& record = byPath_[s.path];
+            if (record.count == 0) record.begin = remembered_.size();
+            for (; next < found.size() && found[next].segment == i; ++next) remember(s.bounce, found[next]);
+            record.count = uint32_t(remembered_.size() - record.begin);
+        }
+        liveRemembered_ = remembered_.size();
+    }
+
+    void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
+        std::vector<uint8_t> skip(scene_.vertexCount(), 0);
+        for (uint32_t v : change.touched) {
+            // The remembered crossings are only right where no move ever reaches.
+            if (!mayBeTouched_[v])
+                throw std::logic_error("DETP update: vertex " + std::to_string(v) +
+                                       " was touched by a move but lies outside every swept instance bound");
+            skip[v] = 1;
+        }
+        std::vector<uint32_t> changed;
+        Stopwatch clock;
+        if (settings_.useIndex) updateIndexed(change, skip, changed);
+        else updateBruteForce(change, skip, changed);
+        stats.estimatorUpdateSeconds = clock.seconds();
+
+        clock.restart();
+        recompute(change.touched, change.tracked, stats);
+        stats.recomputeSeconds = clock.seconds();
+        stats.verticesRecomputed = change.touched.size();
+        changed.insert(changed.end(), change.touched.begin(), change.touched.end());
+        std::sort(changed.begin(), changed.end());
+        changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+        for (uint32_t v : changed) out.irradiance[v] = irradianceAt(v);
+        computeRadiosity(scene_, out);
+        stats.verticesUpdated = changed.size();
+    }
+
+    size_t stateBytes() const override {
+        return byPath_.capacity() * sizeof(PathCrossings) + remembered_.capacity() * sizeof(Remembered) +
+               rememberedMoments_.capacity() * sizeof(rememberedMoments_[0]) + sums_.capacity() * sizeof(DetpVertexSums) +
+               mayBeTouched_.capacity();
+    }
+
+private:
+    // A crossing of a tracked segment at a vertex no move touches: enough to subtract it again.
+    struct Remembered {
+        uint32_t vertex;
+        uint32_t bounce;  // of the segment, within its path
+    };
+    struct PathCrossings {
+        uint64_t begin = 0;  // into remembered_
+        uint32_t count = 0;  // in bounce order
+    };
+
+    DetpDiscs& discs() {
+        if (!discs_)
+            discs_ = std::make_unique<DetpDiscs>(device_, scene_, settings_.radius, settings_.boundary, regions_, &bvh_,
+                                                 &mayBeTouched_);
+        return *discs_;
+    }
+    std::vector<uint32_t> allVertices() const { return inputOrder(scene_.vertexCount()); }
+    Vec3f irradianceAt(uint32_t v) const {
+        return detpVertexIrradiance(sums_[v], regions_ ? &(*regions_)[v] : nullptr, settings_.radius, settings_.boundary,
+                                    quantizer_);
+    }
+    void remember(uint32_t bounce, const SegmentCrossing& c) {
+        remembered_.push_back({c.vertex, bounce});
+        if (moments_) rememberedMoments_.push_back({DetpVertexSums::momentOf(c.at.x), DetpVertexSums::momentOf(c.at.y)});
+    }
+    void add(uint32_t v, const Vec3f& power, const DiscCrossing& at, int sign) {
+        sums_[v].add(power, at, quantizer_, moments_, sign);
+    }
+
+    // + new − old with the disc index and the remembered crossings.
+    void updateIndexed(const FrameChange& change, const std::vector<uint8_t>& skip, std::vector<uint32_t>& changed) {
+        discs().updateDynamic();
+        const std::vector<Segment>& removed = change.removed;
+        const std::vector<Segment>& added = change.added;
+        // Removed, at the discs no move touches: by their remembered crossings.
+        for (size_t i = 0; i < removed.size();) {
+            const uint32_t path = removed[i].path, from = removed[i].bounce;
+            size_t end = i;
+            while (end < removed.size() && removed[end].path == path) ++end;
+            if (path < byPath_.size()) {
+                const PathCrossings& record = byPath_[path];
+                for (uint64_t c = record.begin; c < record.begin + record.count; ++c) {
+                    const Remembered& r = remembered_[c];
+                    if (r.bounce < from) continue;
+                    const Segment& s = removed[i + (r.bounce - from)];
+                    const int32_t qx = moments_ ? rememberedMoments_[c][0] : 0, qy = moments_ ? rememberedMoments_[c][1] : 0;
+                    sums_[r.vertex].add(s.power, qx, qy, quantizer_, moments_, -1);
+                    changed.push_back(r.vertex);
+                }
+            }
+            i = end;
+        }
+        // Removed, at the discs a move can touch: traced through those (few) again.
+        std::vector<SegmentCrossing> found;
+        discs_->findCrossings(removed, DetpDiscs::Discs::Refitted, found);
+        for (const SegmentCrossing& c : found) {
+            if (skip[c.vertex]) continue;
+            add(c.vertex, removed[c.segment].power, c.at, -1);
+            changed.push_back(c.vertex);
+        }
+        // Added: through every disc once; remembered where no move can touch.
+        discs_->findCrossings(added, DetpDiscs::Discs::All, found);
+        for (const SegmentCrossing& c : found) {
+            if (skip[c.vertex]) continue;
+            add(c.vertex, added[c.segment].power, c.at, +1);
+            changed.push_back(c.vertex);
+        }
+        rememberAdded(removed, added, found);
+    }
+
+    // The retraced paths' records: the kept head's crossings, then the new tail's.
+    void rememberAdded(const std::vector<Segment>& removed, const std::vector<Segment>& added,
+                       const std::vector<SegmentCrossing>& found) {
+        // First retraced bounce per path, in path order (both lists are in path order).
+        std::vector<std::pair<uint32_t, uint32_t>> retraced;
+        for (const auto* list : {&removed, &added})
+            for (const Segment& s : *list)
+                if (retraced.empty() || retraced.back().first != s.path) retraced.push_back({s.path, s.bounce});
+        std::sort(retraced.begin(), retraced.end());
+        retraced.erase(std::unique(retraced.begin(), retraced.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+                       retraced.end());
+        size_t a = 0, next = 0;
+        for (const auto& [path, from] : retraced) {
+            if (byPath_.size() <= path) byPath_.resize(size_t(path) + 1);
+            PathCrossings& record = byPath_[path];
+            const uint64_t begin = remembered_.size();
+            for (uint64_t c = record.begin; c < record.begin + record.count && remembered_[c].bounce < from; ++c) {
+                remembered_.push_back(remembered_[c]);
+                if (moments_) rememberedMoments_.push_back(rememberedMoments_[c]);
+            }
+            while (a < added.size() && added[a].path < path) ++a;
+            for (; a < added.size() && added[a].path == path; ++a) {
+                while (next < found.size() && found[next].segment < a) ++next;
+                for (; next < found.size() && found[next].segment == a; ++next)
+                    if (!mayBeTouched_[found[next].vertex]) remember(added[a].bounce, found[next]);
+            }
+            liveRemembered_ += remembered_.size() - begin;
+            liveRemembered_ -= record.count;
+            record.begin = begin;
+            record.count = uint32_t(remembered_.size() - begin);
+        }
+        // Retraced paths leave their old records behind; compact once they are half the store.
+        if (remembered_.size() > 2 * liveRemembered_ + 1024) compactRemembered();
+    }
+
+    void compactRemembered() {
+        std::vector<Remembered> kept;
+        std::vector<std::array<int32_t, 2>> keptMoments;
+        kept.reserve(liveRemembered_);
+        for (PathCrossings& record : byPath_) {
+            const uint64_t begin = kept.size();
+            kept.insert(kept.end(), remembered_.begin() + int64_t(record.begin), remembered_.begin() + int64_t(record.begin + record.count));
+            if (moments_)
+                keptMoments.insert(keptMoments.end(), rememberedMoments_.begin() + int64_t(record.begin),
+                                   rememberedMoments_.begin() + int64_t(record.begin + record.count));
+            record.begin = begin;
+        }
+        remembered_.swap(kept);
+        rememberedMoments_.swap(keptMoments);
+    }
+
+    // Index-free (--no-ray-cache): every changed segment against every disc.
+    void updateBruteForce(const FrameChange& change, const std::vector<uint8_t>& skip, std::vector<uint32_t>& changed) {
+        std::vector<const Segment*> removed, added;
+        for (const Segment& s : change.removed) removed.push_back(&s);
+        for (const Segment& s : change.added) added.push_back(&s);
+        std::vector<uint8_t> updated(scene_.vertexCount(), 0);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, scene_.vertexCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t v = r.begin(); v != r.end(); ++v) {
+                if (skip[v]) continue;
+                const DetpVertexSums gain = vertexSums(uint32_t(v), added);
+                const DetpVertexSums loss = vertexSums(uint32_t(v), removed);
+                if (gain == DetpVertexSums() && loss == DetpVertexSums()) continue;
+                sums_[v] += gain;
+                sums_[v] -= loss;
+                updated[v] = 1;
+            }
+        });
+        for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
+            if (updated[v]) changed.push_back(v);
+    }
+
+    // The touched vertices from scratch: only tracked segments can cross their discs (the
+    // others never meet the envelope, which holds every disc a move touches).
+    void recompute(const std::vector<uint32_t>& vertices, const TrackedPaths& tracked, FrameTiming& stats) {
+        if (vertices.empty()) return;
+        if (!settings_.useIndex) {
+            std::vector<const Segment*> all;
+            tracked.allSegments(all);
+            for (uint32_t v : vertices) sums_[v] = DetpVertexSums();
+            bruteForceSums(vertices, all);
+            stats.recomputeCandidates += uint64_t(all.size()) * vertices.size();
+            return;
+        }
+        // Per vertex, the segments the grid lists in the cells around its disc (a crossing lies
+        // within r of v, on the part of the segment the grid lists), each tested exactly.
+        const float pad = settings_.radius * 1.001f + 4 * scene_.sceneEpsilon();
+        std::vector<uint64_t> candidates(vertices.size(), 0);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<SegmentRef> near;
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const uint32_t v = vertices[i];
+                Bounds3f box;
+                box.extend(scene_.positions[v]);
+                tracked.refsNear(box.expanded(pad), near);
+                DetpVertexSums sums;
+                const VertexDisc& disc = discOf(v);
+                DiscCrossing at;
+                for (const SegmentRef& ref : near) {
+                    const Segment& s = tracked.segment(ref);
+                    if (detpCounts(s, scene_.positions[v], scene_.normals[v], disc, settings_.radius, settings_.boundary, &bvh_, at))
+                        sums.add(s.power, at, quantizer_, moments_);
+                }
+                sums_[v] = sums;
+                candidates[i] = near.size();
+            }
+        });
+        for (uint64_t c : candidates) stats.recomputeCandidates += c;
+    }
+
+    const VertexDisc& discOf(uint32_t v) const { return regions_ ? (*regions_)[v] : kPaperRuleDisc(); }
+    static const VertexDisc& kPaperRuleDisc() {
+        static const VertexDisc disc = [] {
+            VertexDisc d;
+            d.fallback = true;
+            return d;
+        }();
+        return disc;
+    }
+    DetpVertexSums vertexSums(uint32_t v, const std::vector<const Segment*>& segments) const {
+        return detpVertexSums(scene_, v, segments, settings_.radius, settings_.boundary, regions_, &bvh_, quantizer_);
+    }
+    void bruteForceSums(const std::vector<uint32_t>& vertices, const std::vector<const Segment*>& segments) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) sums_[vertices[i]] = vertexSums(vertices[i], segments);
+        });
+    }
+
+    EstimatorSettings settings_;
+    const Scene& scene_;
+    const SceneBvh& bvh_;
+    const EmbreeDevice& device_;
+    const DiscRegions* regions_;
+    bool moments_;
+    PowerQuantizer quantizer_{0.0f};
+    std::vector<uint8_t> mayBeTouched_;  // per vertex: a move can touch it (its disc is refitted)
+    std::unique_ptr<DetpDiscs> discs_;
+    std::vector<DetpVertexSums> sums_;
+    std::vector<PathCrossings> byPath_;  // per path id
+    std::vector<Remembered> remembered_;
+    std::vector<std::array<int32_t, 2>> rememberedMoments_;  // `linear`: each crossing's quantised (x, y)
+    size_t liveRemembered_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> makeDetpEstimator(const EstimatorSettings& settings, const EstimatorContext& context) {
+    return std::make_unique<DetpEstimator>(settings, context);
+}
+
+}  // namespace qsgi

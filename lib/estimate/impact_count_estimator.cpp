@@ -1,0 +1,62 @@
+// Impact count behind the Estimator interface: per-triangle fixed-point sums, so an update is
+// bookkeeping — the removed impacts leave their triangles, the added ones join theirs, and only
+// the vertices of those triangles and of moved ones are averaged again.
+#include <algorithm>
+
+#include "estimate/estimator.h"
+#include "estimate/impact_count.h"
+
+namespace qsgi {
+
+namespace {
+
+class ImpactCountEstimator final : public Estimator {
+public:
+    ImpactCountEstimator(const EstimatorContext& context) : scene_(context.scene), sums_(context.scene) {}
+
+    void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
+        quantizer_ = PowerQuantizer(cache.maxPhotonPower);
+        sums_.updateGeometry(scene_);
+        sums_.accumulate(cache);
+        out = sums_.estimate(scene_, quantizer_);
+        stats.verticesUpdated = scene_.vertexCount();
+    }
+
+    float reach() const override { return 0.0f; }  // an impact counts where it lands
+    void prepareUpdates(const TrackedPaths&, FrameTiming&) override {}
+
+    void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
+        // Old segments leave with the facing they were counted with, before the triangles move.
+        for (const Segment& s : change.removed) sums_.subtract(s, quantizer_);
+        std::vector<uint32_t> triangles;
+        for (uint32_t t = 0; t < scene_.triangleCount(); ++t)
+            if (change.triangleMoved[t]) triangles.push_back(t);
+        sums_.updateGeometry(scene_, triangles);
+        for (const Segment& s : change.added) sums_.add(s, quantizer_);
+        for (const auto* list : {&change.removed, &change.added})
+            for (const Segment& s : *list)
+                if (s.hasImpact()) triangles.push_back(s.triangle);
+        std::sort(triangles.begin(), triangles.end());
+        triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+        std::vector<uint32_t> vertices;
+        for (uint32_t t : triangles)
+            for (uint32_t v : scene_.triangles[t].v) vertices.push_back(v);
+        std::sort(vertices.begin(), vertices.end());
+        vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+        sums_.estimateAt(scene_, quantizer_, vertices, out);
+        stats.verticesUpdated = vertices.size();
+    }
+
+private:
+    const Scene& scene_;
+    ImpactCount sums_;
+    PowerQuantizer quantizer_{0.0f};
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> makeImpactCountEstimator(const EstimatorSettings&, const EstimatorContext& context) {
+    return std::make_unique<ImpactCountEstimator>(context);
+}
+
+}  // namespace qsgi

@@ -1,0 +1,83 @@
+// The photon map behind the Estimator interface (DESIGN §5, §6 step 4). Its k nearest
+// neighbours cannot be folded into sums, so the map keeps every impact in a kd-tree that an
+// update edits in place (removed impacts out, added ones in), and only the vertices whose
+// previous r_k ball holds a removed or added impact (at distance ≤ r_k: one exactly on the rim
+// can displace the k-th by the tie rule), and the vertices the move touched, are estimated
+// again. Ties are ordered by (path, bounce), so the answer does not depend on what the index
+// holds where.
+#include <algorithm>
+#include <optional>
+
+#include "estimate/estimator.h"
+#include "estimate/morton_order.h"
+#include "estimate/photon_map.h"
+
+namespace qsgi {
+
+namespace {
+
+class PhotonMapEstimator final : public Estimator {
+public:
+    PhotonMapEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
+        : settings_(settings), scene_(context.scene), bvh_(context.bvh), regions_(context.regions) {}
+
+    void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
+        map_.emplace(cache, scene_, &bvh_);
+        const EstimatorSettings& e = settings_;
+        if (e.useIndex) {
+            out.irradiance.assign(scene_.vertexCount(), Vec3f(0.0f));
+            map_->irradianceAt(scene_, regions_, e.radius, e.k, queryOrder(inputOrder(scene_.vertexCount())), out.irradiance);
+        } else {
+            out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.k);
+        }
+        computeRadiosity(scene_, out);
+        stats.verticesUpdated = scene_.vertexCount();
+    }
+
+    float reach() const override { return 0.0f; }  // impacts only
+    void prepareUpdates(const TrackedPaths&, FrameTiming&) override {}
+
+    void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
+        const EstimatorSettings& e = settings_;
+        // The balls of the previous frame that a changed impact enters or leaves.
+        std::vector<uint32_t> vertices = map_->ballsHolding(scene_.positions, change.removed, change.added);
+        vertices.insert(vertices.end(), change.touched.begin(), change.touched.end());
+        std::sort(vertices.begin(), vertices.end());
+        vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+        map_->update(change.removed, change.added, scene_);
+        if (e.useIndex) {
+            map_->irradianceAt(scene_, regions_, e.radius, e.k, queryOrder(vertices), out.irradiance);
+        } else {
+            out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.k);
+            vertices = inputOrder(scene_.vertexCount());
+        }
+        computeRadiosity(scene_, out);
+        stats.verticesUpdated = vertices.size();
+        stats.verticesRecomputed = vertices.size();
+    }
+
+private:
+    // Morton order of the given vertices (coherent queries), unless input order was asked for.
+    std::vector<uint32_t> queryOrder(const std::vector<uint32_t>& vertices) const {
+        if (!settings_.sortQueries) return vertices;
+        std::vector<Vec3f> points(vertices.size());
+        for (size_t i = 0; i < vertices.size(); ++i) points[i] = scene_.positions[vertices[i]];
+        std::vector<uint32_t> order = mortonOrder(points);
+        for (uint32_t& i : order) i = vertices[i];
+        return order;
+    }
+
+    EstimatorSettings settings_;
+    const Scene& scene_;
+    const SceneBvh& bvh_;
+    const DiscRegions* regions_;
+    std::optional<PhotonMap> map_;
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> makePhotonMapEstimator(const EstimatorSettings& settings, const EstimatorContext& context) {
+    return std::make_unique<PhotonMapEstimator>(settings, context);
+}
+
+}  // namespace qsgi

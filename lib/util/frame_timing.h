@@ -1,0 +1,80 @@
+// One frame's record in timing.json (DESIGN §7): what computing it cost and changed. Every stage
+// writes its own counters here directly (tracing, finding affected paths, the estimator's update,
+// disc regions, rendering); forEachTimingField is the one list that writing and reading (for
+// --resume) share, so a new counter is one member and one line.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace qsgi {
+
+struct FrameTiming {
+    int frame = 0;
+    bool fromScratch = true;  // computed from scratch, or by the incremental update
+    // Why a frame after the first was computed from scratch: "" (it was not), "full-recompute",
+    // "first-frame", "estimator" (the estimator has no update, e.g. --detp-index flann) or
+    // "change-too-large" (updating would cost more than recomputing, judged from counts).
+    std::string fromScratchReason;
+    double findAffectedSeconds = 0, retraceSeconds = 0;  // the parts of an update's photon time
+    double photonSimulationSeconds = 0;  // tracing (or finding and retracing) photons
+    double estimationSeconds = 0;        // density estimation, disc regions included
+    double estimatorUpdateSeconds = 0;   // of which: + new − old at the vertices that keep sums
+    double renderSeconds = 0;            // the camera view (EXR/PNG), excluding file writing
+    double writeSeconds = 0;             // PLY, EXR and PNG output
+    uint64_t segments = 0;               // segments in the ray cache after this frame
+    uint64_t photonsMissingScene = 0;    // photons whose first segment hit nothing
+    uint64_t pathsRetraced = 0;
+    uint64_t pathsAffectedByImpact = 0, pathsAffectedByBlocking = 0;  // DESIGN §6 step 2 (a), (b)
+    uint64_t impactCandidates = 0;    // (a): tracked segments listed on the moved triangles
+    uint64_t blockingCandidates = 0;  // (b): tracked segments the grid handed to the exact test
+    uint64_t trackedPaths = 0, trackedSegments = 0, trackedBytes = 0;  // what frames search (§6.5)
+    uint64_t estimatorStateBytes = 0;  // the estimator's incremental state (remembered crossings…)
+    uint64_t segmentsRemoved = 0, segmentsAdded = 0;
+    uint64_t verticesUpdated = 0;
+    double recomputeSeconds = 0;  // the vertices the move touched, from the segments near them
+    uint64_t verticesRecomputed = 0;
+    uint64_t recomputeCandidates = 0;  // (vertex, segment) pairs those recomputations tested
+    // Disc regions (DESIGN §5): time, vertices (re)computed this frame, and the vertices with an
+    // empty own surface (paper fallback) or no reachable cell (buried: E = 0).
+    double discRegionsSeconds = 0;
+    uint64_t discRegionsUpdated = 0;
+    uint64_t ownSurfaceFallbacks = 0, buriedVertices = 0;
+};
+
+template <class Timing, class Visit>
+void forEachTimingField(Timing& f, Visit&& visit) {
+    visit("frame", f.frame);
+    visit("from_scratch", f.fromScratch);
+    visit("from_scratch_reason", f.fromScratchReason);
+    visit("photon_update_s", f.photonSimulationSeconds);
+    visit("find_affected_s", f.findAffectedSeconds);
+    visit("retrace_s", f.retraceSeconds);
+    visit("paths_affected_by_impact", f.pathsAffectedByImpact);
+    visit("paths_affected_by_blocking", f.pathsAffectedByBlocking);
+    visit("impact_candidates", f.impactCandidates);
+    visit("blocking_candidates", f.blockingCandidates);
+    visit("tracked_paths", f.trackedPaths);
+    visit("tracked_segments", f.trackedSegments);
+    visit("tracked_bytes", f.trackedBytes);
+    visit("estimator_state_bytes", f.estimatorStateBytes);
+    visit("estimator_update_s", f.estimatorUpdateSeconds);
+    visit("recompute_s", f.recomputeSeconds);
+    visit("vertices_recomputed", f.verticesRecomputed);
+    visit("recompute_candidates", f.recomputeCandidates);
+    visit("estimation_s", f.estimationSeconds);
+    visit("render_s", f.renderSeconds);
+    visit("write_s", f.writeSeconds);
+    visit("segments", f.segments);
+    visit("photons_missing_scene", f.photonsMissingScene);
+    visit("paths_retraced", f.pathsRetraced);
+    visit("segments_removed", f.segmentsRemoved);
+    visit("segments_added", f.segmentsAdded);
+    visit("vertices_updated", f.verticesUpdated);
+    visit("disc_regions_s", f.discRegionsSeconds);
+    visit("disc_regions_updated", f.discRegionsUpdated);
+    visit("own_surface_fallbacks", f.ownSurfaceFallbacks);
+    visit("buried_vertices", f.buriedVertices);
+}
+
+}  // namespace qsgi
