@@ -258,6 +258,83 @@ TEST(Incremental, NoDriftOverTenThousandFrames) {
     }
 }
 
+// DETP's update subtracts a removed segment by the crossings remembered when it entered. After
+// 1,000 frames of a cube moving back and forth (every frame retracing the paths it meets, most
+// of them crossing static discs that remember them) every vertex's answer equals a fresh
+// computation of that pose to the bit, for `clip` and `linear` (which remembers moments too),
+// and the update really went through remembered crossings.
+TEST(Incremental, RememberedCrossingsLeaveNoTraceAfterAThousandFrames) {
+    AnimatedScene a{"back and forth", [] {
+                        Scene s = testscenes::boxOnFloor(12, 2, Vec3f(0.7f));
+                        testscenes::addPointLight(s, Vec3f(0.3f, 1.5f, 0.2f), Vec3f(10.0f));
+                        return s;
+                    },
+                    "Cube", [](int f) { return Vec3d(0.3 * std::sin(0.29 * f), 0.0, 0.25 * std::sin(0.17 * f)); }, 1000};
+    for (const EstimatorCase& e : {kEstimators[3], kEstimators[4]}) {
+        SCOPED_TRACE(e.name);
+        int mover = -1;
+        Scene scene = prepare(a, mover);
+        EmbreeDevice device;
+        FrameSolver solver(scene, device, solverSettings(e, 0.12f, 2000));
+        uint64_t forgotten = 0;
+        std::vector<Vec3f> last;
+        for (int f = 0; f < a.frames; ++f) {
+            FrameTiming w;
+            last = solver.solve(localsAt(scene, mover, a.offset(f)), w).irradiance;
+            forgotten += w.crossingsForgotten;
+        }
+        EXPECT_GT(forgotten, 1000u);
+        int freshMover = -1;
+        Scene fresh = prepare(a, freshMover);
+        FrameSolverSettings s = solverSettings(e, 0.12f, 2000);
+        s.fullRecompute = true;
+        FrameSolver reference(fresh, device, s);
+        FrameTiming w;
+        const std::vector<Vec3f> expected = reference.solve(localsAt(fresh, freshMover, a.offset(a.frames - 1)), w).irradiance;
+        EXPECT_TRUE(sameBits(last, expected)) << "first differing vertex " << firstDifference(last, expected);
+    }
+}
+
+// A change so large that updating would cost more than recomputing (the whole floor under the
+// light moves, so nearly every path hit a moving triangle) is computed from scratch, with the
+// bytes of --full-recompute, and logged as such; when the floor then pauses, the next frame is an
+// update again that retraces nothing (its tracking state is made only then).
+TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
+    AnimatedScene a{"moving floor", [] {
+                        Scene s = testscenes::boxOnFloor(12, 2, Vec3f(0.7f));
+                        testscenes::addPointLight(s, Vec3f(0.3f, 1.5f, 0.2f), Vec3f(10.0f));
+                        return s;
+                    },
+                    "Floor", [](int f) { return Vec3d(0.0, 0.01 * std::min(f, 3), 0.0); }, 6};
+    for (const EstimatorCase& e : {kEstimators[0], kEstimators[1], kEstimators[3]}) {
+        SCOPED_TRACE(e.name);
+        int moverA = -1, moverB = -1;
+        Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
+        EmbreeDevice device;
+        FrameSolverSettings automatic = solverSettings(e, 0.12f, 3000);
+        automatic.alwaysUpdate = false;
+        FrameSolverSettings full = automatic;
+        full.fullRecompute = true;
+        FrameSolver inc(incScene, device, automatic), ref(fullScene, device, full);
+        for (int f = 0; f < a.frames; ++f) {
+            FrameTiming wi, wf;
+            const std::vector<Vec3f> ri = inc.solve(localsAt(incScene, moverA, a.offset(f)), wi).radiosity;
+            const std::vector<Vec3f> rf = ref.solve(localsAt(fullScene, moverB, a.offset(f)), wf).radiosity;
+            EXPECT_TRUE(sameBits(ri, rf)) << "frame " << f << ": first differing vertex " << firstDifference(ri, rf);
+            if (f >= 1 && f <= 3) {  // the floor moves
+                EXPECT_TRUE(wi.fromScratch) << "frame " << f;
+                EXPECT_EQ(wi.fromScratchReason, "change-too-large") << "frame " << f;
+            }
+            if (f >= 4) {  // it pauses
+                EXPECT_FALSE(wi.fromScratch) << "frame " << f;
+                EXPECT_EQ(wi.pathsRetraced, 0u) << "frame " << f;
+                EXPECT_EQ(wi.verticesUpdated, 0u) << "frame " << f;
+            }
+            EXPECT_EQ(wf.fromScratchReason, f == 0 ? "" : "full-recompute");
+        }
+    }
+}
+
 // Equal distances are ordered by (path, bounce): the k nearest impacts are the same set whatever
 // order the cache holds them in (an incremental update reorders it).
 TEST(PhotonMapOrder, KNearestDoNotDependOnTheCacheOrder) {

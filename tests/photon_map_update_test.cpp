@@ -41,13 +41,16 @@ Scene litBoxOnFloor() {
     return s;
 }
 
-// A traced cache, the live part of it plus made-up segments, and a deterministic change per
-// round. `spread` sets how much changes: path tails leave for one path in `spread`, come back for
-// one in `spread + 2`, and one live impact in `2 * spread - 1` is copied twice (exactly: a tie;
-// shifted 1 cm along its surface: inside the neighbouring vertices' balls). And each round, beside
-// one floor vertex, a dense cluster of impacts arriving from below (they count for no floor
-// vertex) ringed by a few from above: there the added impacts' tree holds more near, uncounted
-// neighbours than a query first asks for, and the counted ones lie beyond them.
+// A traced cache, the live part of it plus made-up segments, and a deterministic change per round.
+// `spread` sets how much changes: path tails leave for one path in `spread` and come back for one
+// in `spread + 2`; one live impact in `2 * spread - 1` is copied twice (exactly, a tie; and 1 cm
+// along its surface, inside the neighbouring vertices' balls). Each round also adds, beside one
+// floor vertex:
+// - a dense cluster of impacts from below (they count for no floor vertex) ringed by a few from
+//   above: the added impacts' tree holds more near, uncounted ones than a query first asks for,
+//   and the counted ones lie beyond them;
+// - a stack of coincident impacts from above, more than a query first asks for: a tree returns an
+//   arbitrary part of a tie at its farthest distance, and the keys must decide.
 class ChangingPhotons {
 public:
     struct Change {
@@ -135,6 +138,10 @@ public:
             for (int j = -6; j <= 6; ++j) madeUp(centre + Vec3f(0.001f * float(i), 0, 0.001f * float(j)), false);
         for (int a = 0; a < 12; ++a)
             madeUp(centre + Vec3f(std::cos(0.5236f * float(a)), 0, std::sin(0.5236f * float(a))) * 0.008f, true);
+        for (int i = 0; i < 110; ++i) {
+            madeUp(centre + Vec3f(0.01f, 0, -0.03f), true);
+            c.added.back().power = power * (1.0f + 0.1f * float(i % 7));
+        }
         for (const Segment& s : c.removed) live_.erase(keyOf(s));
         for (const Segment& s : c.added) live_[keyOf(s)] = s;
         return c;
@@ -238,7 +245,7 @@ TEST(PhotonMapUpdate, RecomputingTheBallsHoldingAChangeEqualsAFullEstimate) {
         SCOPED_TRACE(e.name());
         const DiscRegions covered = f.regionsFor(e.radius);
         const DiscRegions* regions = e.regions ? &covered : nullptr;
-        ChangingPhotons photons(f.full, f.scene, 151);  // ~1 % of the impacts change per round
+        ChangingPhotons photons(f.full, f.scene, 151);  // a few per cent of the impacts change per round
         PhotonMap map(photons.liveCache(), f.scene, &f.bvh);
         std::vector<Vec3f> current = map.irradiance(f.scene, regions, e.radius, e.k, f.all);
         size_t recomputed = 0, changed = 0;
@@ -255,7 +262,7 @@ TEST(PhotonMapUpdate, RecomputingTheBallsHoldingAChangeEqualsAFullEstimate) {
             recomputed += vertices.size();
             changed += differing(before, expected);
         }
-        // The test means something: estimates changed, and far fewer were recomputed than all.
+        // The test means something: estimates changed, and fewer than half were recomputed.
         EXPECT_GT(changed, 0u);
         EXPECT_LT(recomputed, 6 * f.scene.vertexCount() / 2);
     }
@@ -266,8 +273,10 @@ TEST(PhotonMapUpdate, RecomputingTheBallsHoldingAChangeEqualsAFullEstimate) {
 TEST(PhotonMapUpdate, UpdateTakesTheFrontNormalsOfTheNewPose) {
     Fixture f;
     Scene turned = f.scene;
+    float floorY = turned.positions[0].y;
+    for (const Vec3f& p : turned.positions) floorY = std::min(floorY, p.y);
     for (size_t v = 0; v < turned.vertexCount(); ++v)
-        if (turned.positions[v].y > 0.0f) turned.normals[v] = -turned.normals[v];
+        if (turned.positions[v].y > floorY) turned.normals[v] = -turned.normals[v];
     const DiscRegions covered = f.regionsFor(0.15f);
     PhotonMap map(f.full, f.scene, &f.bvh);
     const auto before = map.irradiance(f.scene, &covered, 0.15f, 50, f.all);

@@ -310,6 +310,36 @@ void DetpDiscs::crossingsIn(const Segment& s, std::initializer_list<std::pair<RT
             out.push_back(Crossed{c});
 }
 
+void DetpDiscs::recompute(const std::vector<const Segment*>& segments, const PowerQuantizer& q,
+                          const std::vector<uint32_t>& vertices, std::vector<DetpVertexSums>& sums) const {
+    for (uint32_t v : vertices) sums[v] = DetpVertexSums();
+    if (vertices.empty() || segments.empty()) return;
+    EmbreeScene bvh(device_);
+    Part part;
+    part.vertices = vertices;
+    addPart(device_, bvh.get(), part, RTC_BUILD_QUALITY_MEDIUM);
+    // Crossings are found in parallel and applied in one thread, in segment order: integer sums
+    // make the order irrelevant to the bits, and few vertices are recomputed.
+    constexpr size_t kChunk = 256;
+    const size_t chunks = (segments.size() + kChunk - 1) / kChunk;
+    struct Hit {
+        uint32_t segment;
+        CrossedDisc at;
+    };
+    std::vector<std::vector<Hit>> found(chunks);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<Crossed> crossed;
+        for (size_t c = r.begin(); c != r.end(); ++c)
+            for (size_t i = c * kChunk; i < std::min(segments.size(), (c + 1) * kChunk); ++i) {
+                crossingsIn(*segments[i], {{bvh.get(), &part}}, crossed);
+                for (const Crossed& x : crossed) found[c].push_back({uint32_t(i), x});
+            }
+    });
+    const bool moments = rule_ == DetpBoundary::Linear;
+    for (const auto& hits : found)
+        for (const Hit& h : hits) sums[h.at.vertex].add(segments[h.segment]->power, h.at.at, q, moments);
+}
+
 std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, const std::vector<uint32_t>& order,
                                             DetpQueryStats* stats) const {
     const size_t vertices = scene_.vertexCount();

@@ -37,6 +37,7 @@ public:
                 if (!b.empty()) swept.push_back(b);
             for (uint32_t v : regions_->touchedBy(scene_, swept, mayBeTouched_)) mayBeTouched_[v] = 1;
         }
+        if (getenv("QSGI_PROFILE")) fprintf(stderr, "mayBeTouched %zu of %zu\n", size_t(std::count(mayBeTouched_.begin(), mayBeTouched_.end(), 1)), mayBeTouched_.size());
     }
 
     void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
@@ -101,9 +102,9 @@ public:
                                        " was touched by a move but lies outside every swept instance bound");
             skip[v] = 1;
         }
-        std::vector<uint32_t> changed;
+        std::vector<uint8_t> changed(scene_.vertexCount(), 0);
         Stopwatch clock;
-        if (settings_.useIndex) updateIndexed(change, skip, changed);
+        if (settings_.useIndex) stats.crossingsForgotten = updateIndexed(change, skip, changed);
         else updateBruteForce(change, skip, changed);
         stats.estimatorUpdateSeconds = clock.seconds();
 
@@ -111,12 +112,15 @@ public:
         recompute(change.touched, change.tracked, stats);
         stats.recomputeSeconds = clock.seconds();
         stats.verticesRecomputed = change.touched.size();
-        changed.insert(changed.end(), change.touched.begin(), change.touched.end());
-        std::sort(changed.begin(), changed.end());
-        changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-        for (uint32_t v : changed) out.irradiance[v] = irradianceAt(v);
+        for (uint32_t v : change.touched) changed[v] = 1;
+        uint64_t updated = 0;
+        for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
+            if (changed[v]) {
+                out.irradiance[v] = irradianceAt(v);
+                ++updated;
+            }
         computeRadiosity(scene_, out);
-        stats.verticesUpdated = changed.size();
+        stats.verticesUpdated = updated;
     }
 
     size_t stateBytes() const override {
@@ -156,7 +160,10 @@ private:
     }
 
     // + new − old with the disc index and the remembered crossings.
-    void updateIndexed(const FrameChange& change, const std::vector<uint8_t>& skip, std::vector<uint32_t>& changed) {
+    // Returns how many crossings left by being remembered.
+    uint64_t updateIndexed(const FrameChange& change, const std::vector<uint8_t>& skip, std::vector<uint8_t>& changed) {
+        uint64_t forgotten = 0;
+        Stopwatch profile;
         discs().updateDynamic();
         const std::vector<Segment>& removed = change.removed;
         const std::vector<Segment>& added = change.added;
@@ -173,27 +180,34 @@ private:
                     const Segment& s = removed[i + (r.bounce - from)];
                     const int32_t qx = moments_ ? rememberedMoments_[c][0] : 0, qy = moments_ ? rememberedMoments_[c][1] : 0;
                     sums_[r.vertex].add(s.power, qx, qy, quantizer_, moments_, -1);
-                    changed.push_back(r.vertex);
+                    ++forgotten;
+                    changed[r.vertex] = 1;
                 }
             }
             i = end;
         }
+        const double tRemembered = profile.seconds();
         // Removed, at the discs a move can touch: traced through those (few) again.
         std::vector<SegmentCrossing> found;
         discs_->findCrossings(removed, DetpDiscs::Discs::Refitted, found);
         for (const SegmentCrossing& c : found) {
             if (skip[c.vertex]) continue;
             add(c.vertex, removed[c.segment].power, c.at, -1);
-            changed.push_back(c.vertex);
+            changed[c.vertex] = 1;
         }
+        const double tRefitted = profile.seconds();
         // Added: through every disc once; remembered where no move can touch.
         discs_->findCrossings(added, DetpDiscs::Discs::All, found);
+        const double tAddFind = profile.seconds();
         for (const SegmentCrossing& c : found) {
             if (skip[c.vertex]) continue;
             add(c.vertex, added[c.segment].power, c.at, +1);
-            changed.push_back(c.vertex);
+            changed[c.vertex] = 1;
         }
+        const double tAddApply = profile.seconds();
         rememberAdded(removed, added, found);
+        if (getenv("QSGI_PROFILE")) fprintf(stderr, "detp: remembered %.3f refitted %.3f addfind %.3f addapply %.3f remember %.3f (found %zu)\n", tRemembered, tRefitted - tRemembered, tAddFind - tRefitted, tAddApply - tAddFind, profile.seconds() - tAddApply, found.size());
+        return forgotten;
     }
 
     // The retraced paths' records: the kept head's crossings, then the new tail's.
@@ -248,11 +262,10 @@ private:
     }
 
     // Index-free (--no-ray-cache): every changed segment against every disc.
-    void updateBruteForce(const FrameChange& change, const std::vector<uint8_t>& skip, std::vector<uint32_t>& changed) {
+    void updateBruteForce(const FrameChange& change, const std::vector<uint8_t>& skip, std::vector<uint8_t>& changed) {
         std::vector<const Segment*> removed, added;
         for (const Segment& s : change.removed) removed.push_back(&s);
         for (const Segment& s : change.added) added.push_back(&s);
-        std::vector<uint8_t> updated(scene_.vertexCount(), 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, scene_.vertexCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t v = r.begin(); v != r.end(); ++v) {
                 if (skip[v]) continue;
@@ -261,11 +274,9 @@ private:
                 if (gain == DetpVertexSums() && loss == DetpVertexSums()) continue;
                 sums_[v] += gain;
                 sums_[v] -= loss;
-                updated[v] = 1;
+                changed[v] = 1;
             }
         });
-        for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
-            if (updated[v]) changed.push_back(v);
     }
 
     // The touched vertices from scratch: only tracked segments can cross their discs (the
@@ -280,30 +291,22 @@ private:
             stats.recomputeCandidates += uint64_t(all.size()) * vertices.size();
             return;
         }
-        // Per vertex, the segments the grid lists in the cells around its disc (a crossing lies
-        // within r of v, on the part of the segment the grid lists), each tested exactly.
+        // The segments the grid lists in the cells around the recomputed discs (a crossing lies
+        // within r of v, on the part of a segment the grid lists), traced once through a BVH of
+        // those discs alone.
         const float pad = settings_.radius * 1.001f + 4 * scene_.sceneEpsilon();
-        std::vector<uint64_t> candidates(vertices.size(), 0);
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
-            std::vector<SegmentRef> near;
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                const uint32_t v = vertices[i];
-                Bounds3f box;
-                box.extend(scene_.positions[v]);
-                tracked.refsNear(box.expanded(pad), near);
-                DetpVertexSums sums;
-                const VertexDisc& disc = discOf(v);
-                DiscCrossing at;
-                for (const SegmentRef& ref : near) {
-                    const Segment& s = tracked.segment(ref);
-                    if (detpCounts(s, scene_.positions[v], scene_.normals[v], disc, settings_.radius, settings_.boundary, &bvh_, at))
-                        sums.add(s.power, at, quantizer_, moments_);
-                }
-                sums_[v] = sums;
-                candidates[i] = near.size();
-            }
-        });
-        for (uint64_t c : candidates) stats.recomputeCandidates += c;
+        std::vector<Bounds3f> boxes(vertices.size());
+        for (size_t i = 0; i < vertices.size(); ++i) {
+            boxes[i].extend(scene_.positions[vertices[i]]);
+            boxes[i] = boxes[i].expanded(pad);
+        }
+        std::vector<SegmentRef> near;
+        tracked.refsNear(boxes, near);
+        std::vector<const Segment*> segments(near.size());
+        for (size_t i = 0; i < near.size(); ++i) segments[i] = &tracked.segment(near[i]);
+        discs().updateDynamic();
+        discs_->recompute(segments, quantizer_, vertices, sums_);
+        stats.recomputeCandidates += segments.size();
     }
 
     const VertexDisc& discOf(uint32_t v) const { return regions_ ? (*regions_)[v] : kPaperRuleDisc(); }

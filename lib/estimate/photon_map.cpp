@@ -27,8 +27,6 @@ PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* 
     rebuildBig();
 }
 
-PhotonMap::~PhotonMap() = default;
-
 // Incremental update
 
 void PhotonMap::rebuildBig() {
@@ -184,8 +182,9 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
                 // Every live impact nearer than `complete` is among the candidates; beyond it a
                 // tree may hold impacts it did not return (ties with its farthest one included).
                 float complete = std::numeric_limits<float>::infinity();
-                const auto ask = [&](const PointIndex* tree, size_t live, size_t firstSlot) {
-                    const size_t n = std::min(want, live);
+                bool all = true;  // both trees returned all their live impacts
+                const auto ask = [&](const PointIndex* tree, size_t live, size_t firstSlot, size_t count) {
+                    const size_t n = std::min(count, live);
                     if (n == 0) return;
                     tree->nearest(p, n, indices, d2);
                     float farthest = 0;
@@ -195,14 +194,18 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
                         farthest = std::max(farthest, dd);
                         candidates.emplace_back(dd, slot);
                     }
-                    if (n < live) complete = std::min(complete, farthest);
+                    if (n < live) {
+                        complete = std::min(complete, farthest);
+                        all = false;
+                    }
                 };
-                ask(big_.get(), bigLive, 0);
-                ask(small_.get(), smallLive, bigCount_);
+                ask(big_.get(), bigLive, 0, want);
+                // The small tree is sparser: as many as the big tree's would reach much farther,
+                // each a candidate to test. Twice its share covers about as far.
+                ask(small_.get(), smallLive, bigCount_, 8 + 2 * want * smallLive / std::max<size_t>(bigLive, 1));
                 // Only the candidates nearer than `complete` are tested: past it the k nearest
                 // could be missing an impact, and a sparse tree's far candidates cost tests for
                 // nothing.
-                const bool all = want >= most;
                 front.clear();
                 for (const auto& [dd, slot] : candidates)
                     if ((all || dd < complete) && dd <= radiusSquared && counts(filter, impacts_[slot]))

@@ -36,12 +36,12 @@ public:
     // the kd-tree. bvh: the scene's triangles in the current pose, to decide impacts in mixed
     // cells; it must outlive the map (a refit in place is fine).
     PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh);
-    ~PhotonMap();
 
     // One frame's change of the photon set: the impacts of `removed` (found by (path, bounce);
     // they must be in the map) leave, those of `added` (not yet in it) enter; segments without an
     // impact are ignored. scene: the new pose, for the triangles' front normals. Costs the
     // changed impacts, plus now and then a rebuild of the big tree (decided from counts alone).
+    // A change that does not match the map throws std::logic_error and leaves it unusable.
     void update(const std::vector<Segment>& removed, const std::vector<Segment>& added, const Scene& scene);
 
     // Irradiance at every vertex, queries in `order` (a permutation of the vertices), in parallel.
@@ -58,9 +58,10 @@ public:
 
     // The vertices (sorted) whose ball recorded by the last estimate holds an impact of `removed`
     // or `added`: r_k² ≥ its distance², where r_k is the k-th counted neighbour's distance, or the
-    // search radius when fewer were found. Only their estimates can change with these impacts.
-    // positions: the vertices where they were estimated. A vertex never estimated holds every
-    // impact. Thread-safe with other const calls.
+    // search radius when fewer were found. Of the vertices that did not move and whose filter did
+    // not change (the caller's to add), only these can see their estimate change. positions: the
+    // vertices where they were estimated. A vertex never estimated holds every impact. Before or
+    // after update(), alike; not during an estimate.
     std::vector<uint32_t> ballsHolding(const std::vector<Vec3f>& positions, const std::vector<Segment>& removed,
                                        const std::vector<Segment>& added) const;
 

@@ -34,9 +34,10 @@ void SegmentGrid::insert(const Vec3f& origin, const Vec3f& direction, double end
 void SegmentGrid::cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const {
     double t0 = 0, t1 = end;
     if (cells_.empty() || !bounds_.clip(origin, direction, t0, t1)) return;
-    // Pieces no longer than the smallest cell edge, each listed in every cell its (slightly
-    // padded) box overlaps: conservative, with no floating-point cell walk to get wrong.
-    const double step = 0.5 * double(std::min({cellSize_[0], cellSize_[1], cellSize_[2]}));
+    // Pieces shorter than the smallest cell edge (so at most 2 cells along each axis, 8 in all),
+    // each listed in every cell its (slightly padded) box overlaps: conservative, with no
+    // floating-point cell walk to get wrong.
+    const double step = 0.9 * double(std::min({cellSize_[0], cellSize_[1], cellSize_[2]}));
     const Vec3f pad(1e-4f * std::min({cellSize_[0], cellSize_[1], cellSize_[2]}));
     const size_t pieces = std::max<size_t>(1, size_t(std::ceil((t1 - t0) / step)));
     size_t last[8];

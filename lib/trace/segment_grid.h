@@ -53,6 +53,26 @@ public:
         std::sort(out.begin(), out.end());
         out.erase(std::unique(out.begin(), out.end()), out.end());
     }
+    // Every entry in the cells that overlap any of the boxes, sorted by (path, bounce), without
+    // duplicates and live only.
+    template <typename IsLive>
+    void query(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out, IsLive isLive) const {
+        out.clear();
+        std::vector<uint8_t> marked(cells_.size(), 0);
+        for (const Bounds3f& box : boxes) {
+            int lo[3], hi[3];
+            if (!cellRange(box, lo, hi)) continue;
+            for (int z = lo[2]; z <= hi[2]; ++z)
+                for (int y = lo[1]; y <= hi[1]; ++y)
+                    for (int x = lo[0]; x <= hi[0]; ++x) marked[cellIndex(x, y, z)] = 1;
+        }
+        for (size_t c = 0; c < cells_.size(); ++c)
+            if (marked[c])
+                for (const SegmentRef& r : cells_[c])
+                    if (isLive(r)) out.push_back(r);
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    }
     // Drops stale entries everywhere.
     template <typename IsLive>
     void sweep(IsLive isLive) {

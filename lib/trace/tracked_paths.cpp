@@ -204,6 +204,7 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
             }
         }
     });
+    const double tTrace = clock.seconds();
     // Sequential and in path order, so the cache's layout is the same for any thread count.
     size_t garbage = segments_.size() - liveSegments_;
     size_t removed = 0, added = 0, kept = 0;
@@ -245,6 +246,8 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
     stats.pathsRetraced += affected.size();
     stats.segmentsRemoved += removed;
     stats.segmentsAdded += added;
+    const double tSplice = clock.seconds();
+    if (getenv("QSGI_PROFILE")) fprintf(stderr, "retrace: trace+cells %.3f splice+index %.3f\n", tTrace, tSplice - tTrace);
     // Retraced paths leave their old segments behind; compact once they are half the store.
     if (garbage > liveSegments_) {
         std::vector<Segment> compact;

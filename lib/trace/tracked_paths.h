@@ -58,6 +58,9 @@ public:
     void refsNear(const Bounds3f& box, std::vector<SegmentRef>& out) const {
         grid_.query(box, out, [&](const SegmentRef& r) { return isLive(r); });
     }
+    void refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const {
+        grid_.query(boxes, out, [&](const SegmentRef& r) { return isLive(r); });
+    }
     const Segment& segment(const SegmentRef& r) const { return *segmentOf(r); }
     // Every tracked segment (for estimators that rebuild from all of them).
     void appendAll(std::vector<Segment>& out) const;

@@ -34,7 +34,8 @@ struct FrameTiming {
     uint64_t verticesUpdated = 0;
     double recomputeSeconds = 0;  // the vertices the move touched, from the segments near them
     uint64_t verticesRecomputed = 0;
-    uint64_t recomputeCandidates = 0;  // (vertex, segment) pairs those recomputations tested
+    uint64_t recomputeCandidates = 0;  // segments gathered for those recomputations
+    uint64_t crossingsForgotten = 0;   // DETP: removed crossings subtracted as remembered, untraced
     // Disc regions (DESIGN §5): time, vertices (re)computed this frame, and the vertices with an
     // empty own surface (paper fallback) or no reachable cell (buried: E = 0).
     double discRegionsSeconds = 0;
@@ -62,6 +63,7 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("recompute_s", f.recomputeSeconds);
     visit("vertices_recomputed", f.verticesRecomputed);
     visit("recompute_candidates", f.recomputeCandidates);
+    visit("crossings_forgotten", f.crossingsForgotten);
     visit("estimation_s", f.estimationSeconds);
     visit("render_s", f.renderSeconds);
     visit("write_s", f.writeSeconds);
