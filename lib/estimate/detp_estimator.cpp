@@ -77,18 +77,25 @@ public:
         rememberedMoments_.clear();
         liveRemembered_ = 0;
         if (!settings_.useIndex) return;  // brute force remembers nothing: it is the reference
-        std::vector<Segment> segments;
-        tracked.appendAll(segments);
+        // In blocks, so that the crossings found wait in a bounded buffer, not all at once.
+        std::vector<const Segment*> all;
+        tracked.allSegments(all);
+        constexpr size_t kBlock = 1 << 16;
+        std::vector<Segment> block;
         std::vector<SegmentCrossing> found;
-        discs_->findCrossings(segments, DetpDiscs::Discs::Fixed, found);
-        size_t next = 0;
-        for (size_t i = 0; i < segments.size(); ++i) {
-            const Segment& s = segments[i];
-            if (byPath_.size() <= s.path) byPath_.resize(size_t(s.path) + 1);
-            PathCrossings& record = byPath_[s.path];
-            if (record.count == 0) record.begin = remembered_.size();
-            for (; next < found.size() && found[next].segment == i; ++next) remember(s.bounce, found[next]);
-            record.count = uint32_t(remembered_.size() - record.begin);
+        for (size_t first = 0; first < all.size(); first += kBlock) {
+            block.clear();
+            for (size_t i = first; i < std::min(all.size(), first + kBlock); ++i) block.push_back(*all[i]);
+            discs_->findCrossings(block, DetpDiscs::Discs::Fixed, found);
+            size_t next = 0;
+            for (size_t i = 0; i < block.size(); ++i) {
+                const Segment& s = block[i];
+                if (byPath_.size() <= s.path) byPath_.resize(size_t(s.path) + 1);
+                PathCrossings& record = byPath_[s.path];
+                if (record.count == 0) record.begin = remembered_.size();
+                for (; next < found.size() && found[next].segment == i; ++next) remember(s.bounce, found[next]);
+                record.count = uint32_t(remembered_.size() - record.begin);
+            }
         }
         liveRemembered_ = remembered_.size();
     }

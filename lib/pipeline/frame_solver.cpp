@@ -94,7 +94,10 @@ std::vector<uint32_t> FrameSolver::touchedVertices(const PoseChange& change) con
 }
 
 void FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats) {
-    if (!regions_) return;
+    if (!regions_) {
+        regionsValid_ = true;  // nothing to compute
+        return;
+    }
     Stopwatch clock;
     if (!regionsValid_) {
         regions_->computeAll(scene_, bvh_);
