@@ -37,7 +37,6 @@ public:
                 if (!b.empty()) swept.push_back(b);
             for (uint32_t v : regions_->touchedBy(scene_, swept, mayBeTouched_)) mayBeTouched_[v] = 1;
         }
-        if (getenv("QSGI_PROFILE")) fprintf(stderr, "mayBeTouched %zu of %zu\n", size_t(std::count(mayBeTouched_.begin(), mayBeTouched_.end(), 1)), mayBeTouched_.size());
     }
 
     void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
@@ -170,7 +169,6 @@ private:
     // Returns how many crossings left by being remembered.
     uint64_t updateIndexed(const FrameChange& change, const std::vector<uint8_t>& skip, std::vector<uint8_t>& changed) {
         uint64_t forgotten = 0;
-        Stopwatch profile;
         discs().updateDynamic();
         const std::vector<Segment>& removed = change.removed;
         const std::vector<Segment>& added = change.added;
@@ -193,7 +191,6 @@ private:
             }
             i = end;
         }
-        const double tRemembered = profile.seconds();
         // Removed, at the discs a move can touch: traced through those (few) again.
         std::vector<SegmentCrossing> found;
         discs_->findCrossings(removed, DetpDiscs::Discs::Refitted, found);
@@ -202,18 +199,14 @@ private:
             add(c.vertex, removed[c.segment].power, c.at, -1);
             changed[c.vertex] = 1;
         }
-        const double tRefitted = profile.seconds();
         // Added: through every disc once; remembered where no move can touch.
         discs_->findCrossings(added, DetpDiscs::Discs::All, found);
-        const double tAddFind = profile.seconds();
         for (const SegmentCrossing& c : found) {
             if (skip[c.vertex]) continue;
             add(c.vertex, added[c.segment].power, c.at, +1);
             changed[c.vertex] = 1;
         }
-        const double tAddApply = profile.seconds();
         rememberAdded(removed, added, found);
-        if (getenv("QSGI_PROFILE")) fprintf(stderr, "detp: remembered %.3f refitted %.3f addfind %.3f addapply %.3f remember %.3f (found %zu)\n", tRemembered, tRefitted - tRemembered, tAddFind - tRefitted, tAddApply - tAddFind, profile.seconds() - tAddApply, found.size());
         return forgotten;
     }
 

@@ -11,6 +11,7 @@
 #include "estimate/estimator.h"
 #include "estimate/morton_order.h"
 #include "estimate/photon_map.h"
+#include "util/stopwatch.h"
 
 namespace qsgi {
 
@@ -39,12 +40,15 @@ public:
 
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
         const EstimatorSettings& e = settings_;
+        Stopwatch clock;
         // The balls of the previous frame that a changed impact enters or leaves.
         std::vector<uint32_t> vertices = map_->ballsHolding(scene_.positions, change.removed, change.added);
         vertices.insert(vertices.end(), change.touched.begin(), change.touched.end());
         std::sort(vertices.begin(), vertices.end());
         vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
         map_->update(change.removed, change.added, scene_);
+        stats.estimatorUpdateSeconds = clock.seconds();
+        clock.restart();
         if (e.useIndex) {
             map_->irradianceAt(scene_, regions_, e.radius, e.k, queryOrder(vertices), out.irradiance);
         } else {
@@ -52,6 +56,7 @@ public:
             vertices = inputOrder(scene_.vertexCount());
         }
         computeRadiosity(scene_, out);
+        stats.recomputeSeconds = clock.seconds();
         stats.verticesUpdated = vertices.size();
         stats.verticesRecomputed = vertices.size();
     }

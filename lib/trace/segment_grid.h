@@ -38,26 +38,22 @@ public:
         for (size_t i = 0; i < count; ++i) cells_[cells[i]].push_back(ref);
         entries_ += count;
     }
-    // Every entry in a cell that overlaps the box, sorted by (path, bounce) and without duplicates;
-    // entries whose generation is not current (isLive) are dropped.
-    template <typename IsLive>
-    void query(const Bounds3f& box, std::vector<SegmentRef>& out, IsLive isLive) const {
-        out.clear();
-        int lo[3], hi[3];
-        if (!cellRange(box, lo, hi)) return;
-        for (int z = lo[2]; z <= hi[2]; ++z)
-            for (int y = lo[1]; y <= hi[1]; ++y)
-                for (int x = lo[0]; x <= hi[0]; ++x)
-                    for (const SegmentRef& r : cells_[cellIndex(x, y, z)])
-                        if (isLive(r)) out.push_back(r);
-        std::sort(out.begin(), out.end());
-        out.erase(std::unique(out.begin(), out.end()), out.end());
+    // The same for the cells of one shard only (cell % shards == shard): shards can be filled
+    // in parallel, each cell still in the order its entries come.
+    size_t insertIntoShard(const uint32_t* cells, size_t count, const SegmentRef& ref, uint32_t shard, uint32_t shards) {
+        size_t n = 0;
+        for (size_t i = 0; i < count; ++i)
+            if (cells[i] % shards == shard) {
+                cells_[cells[i]].push_back(ref);
+                ++n;
+            }
+        return n;
     }
-    // Every entry in the cells that overlap any of the boxes, sorted by (path, bounce), without
-    // duplicates and live only.
-    template <typename IsLive>
-    void query(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out, IsLive isLive) const {
-        out.clear();
+    void countEntries(size_t added) { entries_ += added; }
+    // Calls visit(ref) for every entry of every cell that overlaps one of the boxes: an entry
+    // as often as it is listed in such cells, stale ones included (the caller filters).
+    template <typename Visit>
+    void visitCells(const std::vector<Bounds3f>& boxes, Visit&& visit) const {
         std::vector<uint8_t> marked(cells_.size(), 0);
         for (const Bounds3f& box : boxes) {
             int lo[3], hi[3];
@@ -68,10 +64,7 @@ public:
         }
         for (size_t c = 0; c < cells_.size(); ++c)
             if (marked[c])
-                for (const SegmentRef& r : cells_[c])
-                    if (isLive(r)) out.push_back(r);
-        std::sort(out.begin(), out.end());
-        out.erase(std::unique(out.begin(), out.end()), out.end());
+                for (const SegmentRef& r : cells_[c]) visit(r);
     }
     // Drops stale entries everywhere.
     template <typename IsLive>

@@ -1,6 +1,7 @@
 #include "trace/tracked_paths.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <limits>
@@ -59,14 +60,16 @@ void TrackedPaths::index(const Tracked& t) {
 }
 
 void TrackedPaths::indexSegment(const Tracked& t, uint32_t j, const uint32_t* cells, size_t cellCount) {
+    grid_.insertInto(cells, cellCount, SegmentRef{t.path, t.generation, t.firstBounce + j});
+    listOnTriangle(t, j);
+}
+
+void TrackedPaths::listOnTriangle(const Tracked& t, uint32_t j) {
     const Segment& s = segments_[t.begin + j];
-    const SegmentRef ref{t.path, t.generation, t.firstBounce + j};
-    grid_.insertInto(cells, cellCount, ref);
-    if (s.hasImpact() && s.impactDynamic) {
-        if (byTriangle_.size() <= s.triangle) byTriangle_.resize(size_t(s.triangle) + 1);
-        byTriangle_[s.triangle].push_back(ref);
-        ++triangleEntries_;
-    }
+    if (!s.hasImpact() || !s.impactDynamic) return;
+    if (byTriangle_.size() <= s.triangle) byTriangle_.resize(size_t(s.triangle) + 1);
+    byTriangle_[s.triangle].push_back(SegmentRef{t.path, t.generation, t.firstBounce + j});
+    ++triangleEntries_;
 }
 
 bool TrackedPaths::isLive(const SegmentRef& r) const {
@@ -121,13 +124,9 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
     };
     std::vector<SegmentRef> candidates;
     if (useGrid) {
-        std::vector<SegmentRef> near;
-        for (const Bounds3f& b : newBounds) {
-            grid_.query(b.expanded(eps), near, [&](const SegmentRef& r) { return isLive(r); });
-            candidates.insert(candidates.end(), near.begin(), near.end());
-        }
-        std::sort(candidates.begin(), candidates.end());
-        candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+        std::vector<Bounds3f> boxes;
+        for (const Bounds3f& b : newBounds) boxes.push_back(b.expanded(eps));
+        refsNear(boxes, candidates);
     } else {
         for (const Tracked& t : paths_)
             for (uint32_t j = 0; j < t.count; ++j) {
@@ -204,7 +203,6 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
             }
         }
     });
-    const double tTrace = clock.seconds();
     // Sequential and in path order, so the cache's layout is the same for any thread count.
     size_t garbage = segments_.size() - liveSegments_;
     size_t removed = 0, added = 0, kept = 0;
@@ -218,7 +216,6 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
     changes.added.reserve(changes.added.size() + added);
     const size_t needed = segments_.size() + added + kept;
     if (segments_.capacity() < needed) segments_.reserve(std::max(needed, segments_.capacity() + segments_.capacity() / 2));
-    std::vector<uint32_t> cellCursor(chunks.size(), 0);  // per chunk: segments whose cells were listed
     for (size_t i = 0; i < affected.size(); ++i) {
         const Chunk& chunk = chunks[i / kChunk];
         const size_t inChunk = i % kChunk;
@@ -237,17 +234,31 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
         t.begin = begin;
         t.count = keep + (tailEnd - tailBegin);
         ++t.generation;
-        // The whole path under its new generation, with the cells found above.
-        for (uint32_t j = 0; j < t.count; ++j, ++cellCursor[i / kChunk]) {
-            const uint32_t n = cellCursor[i / kChunk], from = n ? chunk.cellsEnd[n - 1] : 0;
-            indexSegment(t, j, chunk.cells.data() + from, chunk.cellsEnd[n] - from);
-        }
+        // Listed on its dynamic triangles under the new generation (the grid follows below).
+        for (uint32_t j = 0; j < t.count; ++j) listOnTriangle(t, j);
     }
+    // The grid's cells, filled in parallel by shards of cells: each cell takes its entries in
+    // path order, whatever the thread count.
+    const uint32_t kShards = uint32_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+    std::vector<size_t> listed(kShards, 0);
+    tbb::parallel_for(uint32_t(0), kShards, [&](uint32_t shard) {
+        for (size_t c = 0; c < chunks.size(); ++c) {
+            const Chunk& chunk = chunks[c];
+            size_t n = 0;  // segments of the chunk whose cells were listed
+            for (size_t i = c * kChunk; i < std::min(affected.size(), (c + 1) * kChunk); ++i) {
+                const Tracked& t = paths_[size_t(slot_[affected[i].path])];
+                for (uint32_t j = 0; j < t.count; ++j, ++n) {
+                    const uint32_t from = n ? chunk.cellsEnd[n - 1] : 0;
+                    listed[shard] += grid_.insertIntoShard(chunk.cells.data() + from, chunk.cellsEnd[n] - from,
+                                                           SegmentRef{t.path, t.generation, t.firstBounce + j}, shard, kShards);
+                }
+            }
+        }
+    });
+    for (size_t n : listed) grid_.countEntries(n);
     stats.pathsRetraced += affected.size();
     stats.segmentsRemoved += removed;
     stats.segmentsAdded += added;
-    const double tSplice = clock.seconds();
-    if (getenv("QSGI_PROFILE")) fprintf(stderr, "retrace: trace+cells %.3f splice+index %.3f\n", tTrace, tSplice - tTrace);
     // Retraced paths leave their old segments behind; compact once they are half the store.
     if (garbage > liveSegments_) {
         std::vector<Segment> compact;
@@ -271,8 +282,34 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
 
 void TrackedPaths::segmentsNear(const Bounds3f& box, std::vector<const Segment*>& out) const {
     std::vector<SegmentRef> refs;
-    grid_.query(box, refs, [&](const SegmentRef& r) { return isLive(r); });
+    refsNear({box}, refs);
     for (const SegmentRef& r : refs) out.push_back(segmentOf(r));
+}
+
+void TrackedPaths::refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const {
+    out.clear();
+    // A segment is listed in every cell it passes: one bit per (path, bounce) keeps it once,
+    // without sorting what may be millions of entries.
+    std::vector<uint64_t> seen(paths_.size(), 0);
+    std::vector<SegmentRef> deep;  // bounces past the 64 bits, deduplicated by sorting
+    grid_.visitCells(boxes, [&](const SegmentRef& r) {
+        const int32_t slot = slot_[r.path];
+        if (slot < 0) return;
+        const Tracked& t = paths_[size_t(slot)];
+        if (t.generation != r.generation) return;
+        const uint32_t bit = r.bounce - t.firstBounce;
+        if (bit >= 64) {
+            deep.push_back(r);
+            return;
+        }
+        uint64_t& mask = seen[size_t(slot)];
+        if (mask >> bit & 1) return;
+        mask |= uint64_t(1) << bit;
+        out.push_back(r);
+    });
+    std::sort(deep.begin(), deep.end());
+    deep.erase(std::unique(deep.begin(), deep.end()), deep.end());
+    out.insert(out.end(), deep.begin(), deep.end());
 }
 
 void TrackedPaths::appendAll(std::vector<Segment>& out) const {

@@ -55,12 +55,9 @@ public:
     // recomputes. Appends pointers valid until the next retrace.
     void segmentsNear(const Bounds3f& box, std::vector<const Segment*>& out) const;
     // The same as references (sorted, unique, live), and the segment a reference names.
-    void refsNear(const Bounds3f& box, std::vector<SegmentRef>& out) const {
-        grid_.query(box, out, [&](const SegmentRef& r) { return isLive(r); });
-    }
-    void refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const {
-        grid_.query(boxes, out, [&](const SegmentRef& r) { return isLive(r); });
-    }
+    // The live tracked segments listed in the grid cells that overlap any of the boxes, each
+    // once (in the grid's order, not sorted).
+    void refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const;
     const Segment& segment(const SegmentRef& r) const { return *segmentOf(r); }
     // Every tracked segment (for estimators that rebuild from all of them).
     void appendAll(std::vector<Segment>& out) const;
@@ -83,6 +80,7 @@ private:
     void index(const Tracked& t);
     // Lists segment j of t in the given grid cells, and on its triangle if dynamic.
     void indexSegment(const Tracked& t, uint32_t j, const uint32_t* cells, size_t cellCount);
+    void listOnTriangle(const Tracked& t, uint32_t j);
     double reach(const Segment& s) const;  // how far along the ray the grid lists it
 
     Envelope envelope_;

@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""Generates the scenes scripts/bench_update.py measures besides data/ (standard library only,
+deterministic bytes):
+
+- sheet/sheet.gltf: a 4 m sheet of 80 x 80 cells under a point lamp, with one morph target that
+  waves all of it (every vertex moves every frame), animated 0 -> 1 over 2 s: the case where
+  updating costs more than recomputing, so frames fall back to scratch.
+- flying-block.json: a transform file for data/cornell in which the block flies across the box,
+  turns, lifts and pauses (a large mover: about a quarter of the paths change per frame).
+
+Run: python3 scripts/make_bench_scenes.py OUT_DIR
+"""
+import json
+import math
+import os
+import struct
+import sys
+
+sys.path.insert(0, os.path.dirname(__file__))
+from make_cornell import GltfBuilder, grid  # noqa: E402
+
+CELLS = 80
+
+
+def sheet(folder):
+    g = GltfBuilder()
+    g.doc["asset"]["generator"] = "qsgi scripts/make_bench_scenes.py"
+    g.doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    white = g.material("White", [0.7, 0.7, 0.7])
+    positions, normals, indices = grid([-2, 0, 2], [4, 0, 0], [0, 0, -4], CELLS)
+    mesh = g.mesh("Sheet", positions, normals, indices, white)
+    # The morph target: a wave over the whole sheet (displacements only; normals left alone).
+    wave = [(0.0, 0.25 * math.sin(2.1 * p[0]) * math.cos(1.7 * p[2]), 0.0) for p in positions]
+    lo = [min(d[k] for d in wave) for k in range(3)]
+    hi = [max(d[k] for d in wave) for k in range(3)]
+    target = g.add_accessor(b"".join(struct.pack("<3f", *d) for d in wave), 5126, len(wave), "VEC3", lo, hi, 34962)
+    g.doc["meshes"][mesh]["primitives"][0]["targets"] = [{"POSITION": target}]
+    g.doc["meshes"][mesh]["weights"] = [0.0]
+    g.node({"name": "Sheet", "mesh": mesh})
+    g.doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"name": "Lamp", "type": "point", "intensity": 30.0}]}}
+    g.node({"name": "Lamp", "translation": [0.3, 2.0, 0.2], "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    g.doc["cameras"].append({"name": "Above", "type": "perspective",
+                             "perspective": {"yfov": 0.9, "aspectRatio": 4 / 3, "znear": 0.05}})
+    tilt = math.radians(-40)
+    g.node({"name": "Camera", "camera": 0, "translation": [0, 3.0, 4.0],
+            "rotation": [round(math.sin(tilt / 2), 9), 0, 0, round(math.cos(tilt / 2), 9)]})
+    times = [0.0, 2.0]
+    weights = [0.0, 1.0]
+    t_acc = g.add_accessor(struct.pack("<2f", *times), 5126, 2, "SCALAR", [0.0], [2.0])
+    w_acc = g.add_accessor(struct.pack("<2f", *weights), 5126, 2, "SCALAR")
+    node = len(g.doc["nodes"]) - 3  # the sheet
+    g.doc["animations"] = [{"name": "Wave", "samplers": [{"input": t_acc, "output": w_acc, "interpolation": "LINEAR"}],
+                            "channels": [{"sampler": 0, "target": {"node": node, "path": "weights"}}]}]
+    os.makedirs(os.path.join(folder, "sheet"), exist_ok=True)
+    g.write(os.path.join(folder, "sheet"), "sheet")
+
+
+def flying_block(folder):
+    frames = []
+    for f in range(48):
+        if 16 <= f < 24:  # a pause
+            t = 16
+        else:
+            t = f if f < 16 else f - 8
+        x = -0.6 + 1.2 * t / 39
+        y = 0.35 * math.sin(math.pi * t / 39)
+        z = 0.1 + 0.3 * math.sin(0.21 * t)
+        angle = 0.09 * t
+        frames.append({"frame": f, "nodes": {"Block": {
+            "translation": [round(x, 6), round(y, 6), round(z, 6)],
+            "rotation": [0, round(math.sin(angle / 2), 9), 0, round(math.cos(angle / 2), 9)]}}})
+    with open(os.path.join(folder, "flying-block.json"), "w") as out:
+        json.dump({"format": "qsgi-animation", "version": 1, "fps": 24, "frames": frames}, out, indent=1)
+        out.write("\n")
+
+
+def main():
+    folder = sys.argv[1] if len(sys.argv) > 1 else "out/bench/scenes"
+    os.makedirs(folder, exist_ok=True)
+    sheet(folder)
+    flying_block(folder)
+
+
+if __name__ == "__main__":
+    main()
