@@ -335,6 +335,28 @@ TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
     }
 }
 
+// DETP's FLANN candidates have no update: its frames are computed from scratch, say so, and
+// still equal --full-recompute.
+TEST(Incremental, AnEstimatorWithoutAnUpdateLogsItsFramesAsFromScratch) {
+    const AnimatedScene a = scenes()[0];
+    EstimatorCase e = kEstimators[3];
+    int moverA = -1, moverB = -1;
+    Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
+    EmbreeDevice device;
+    FrameSolverSettings flann = solverSettings(e, 0.12f, 3000);
+    flann.estimator.detpIndex = DetpIndex::Flann;
+    FrameSolverSettings full = flann;
+    full.fullRecompute = true;
+    FrameSolver inc(incScene, device, flann), ref(fullScene, device, full);
+    for (int f = 0; f < 3; ++f) {
+        FrameTiming wi, wf;
+        const std::vector<Vec3f> ri = inc.solve(localsAt(incScene, moverA, a.offset(f)), wi).radiosity;
+        EXPECT_TRUE(sameBits(ri, ref.solve(localsAt(fullScene, moverB, a.offset(f)), wf).radiosity)) << "frame " << f;
+        EXPECT_TRUE(wi.fromScratch);
+        EXPECT_EQ(wi.fromScratchReason, f == 0 ? "" : "estimator");
+    }
+}
+
 // Equal distances are ordered by (path, bounce): the k nearest impacts are the same set whatever
 // order the cache holds them in (an incremental update reorders it).
 TEST(PhotonMapOrder, KNearestDoNotDependOnTheCacheOrder) {

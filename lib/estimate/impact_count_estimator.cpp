@@ -28,21 +28,23 @@ public:
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
         // Old segments leave with the facing they were counted with, before the triangles move.
         for (const Segment& s : change.removed) sums_.subtract(s, quantizer_);
-        std::vector<uint32_t> triangles;
+        std::vector<uint32_t> moved;
         for (uint32_t t = 0; t < scene_.triangleCount(); ++t)
-            if (change.triangleMoved[t]) triangles.push_back(t);
-        sums_.updateGeometry(scene_, triangles);
+            if (change.triangleMoved[t]) moved.push_back(t);
+        sums_.updateGeometry(scene_, moved);
         for (const Segment& s : change.added) sums_.add(s, quantizer_);
+        // The vertices of the triangles whose sums or areas changed are averaged again.
+        std::vector<uint8_t> changed(scene_.vertexCount(), 0);
+        auto mark = [&](uint32_t t) {
+            for (uint32_t v : scene_.triangles[t].v) changed[v] = 1;
+        };
+        for (uint32_t t : moved) mark(t);
         for (const auto* list : {&change.removed, &change.added})
             for (const Segment& s : *list)
-                if (s.hasImpact()) triangles.push_back(s.triangle);
-        std::sort(triangles.begin(), triangles.end());
-        triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+                if (s.hasImpact()) mark(s.triangle);
         std::vector<uint32_t> vertices;
-        for (uint32_t t : triangles)
-            for (uint32_t v : scene_.triangles[t].v) vertices.push_back(v);
-        std::sort(vertices.begin(), vertices.end());
-        vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+        for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
+            if (changed[v]) vertices.push_back(v);
         sums_.estimateAt(scene_, quantizer_, vertices, out);
         stats.verticesUpdated = vertices.size();
     }

@@ -3,7 +3,8 @@
 // only if the fingerprint recorded in its timing.json equals the current run's, so a resumed
 // folder holds exactly what one uninterrupted run would have written.
 //
-// Left out on purpose: the thread count, --full-recompute, --no-envelope and the blocking grid.
+// Left out on purpose: the thread count, --full-recompute, --always-update, --no-envelope and the
+// blocking grid.
 // They change how frames are computed, not what they hold (the tests prove the bytes equal), so a
 // run may be resumed with more threads or another update strategy. The frame range is left out
 // too: resuming may extend the range.

@@ -85,7 +85,8 @@ const Segment* TrackedPaths::segmentOf(const SegmentRef& r) const {
 uint64_t TrackedPaths::segmentsListedOn(const std::vector<uint32_t>& triangles) const {
     uint64_t n = 0;
     for (uint32_t t : triangles)
-        if (t < byTriangle_.size()) n += byTriangle_[t].size();
+        if (t < byTriangle_.size())
+            for (const SegmentRef& r : byTriangle_[t]) n += isLive(r);
     return n;
 }
 
@@ -120,7 +121,13 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
     const float eps = bvh.rayEpsilon();
     auto blocked = [&](const Segment& s) {
         const float end = s.hasImpact() ? s.length + eps : s.length;
-        return bvh.movedOccludes(s.origin, s.direction, 0.0f, end, triangleMoved);
+        // The grid lists whole cells: most candidates pass beside the moved bounds themselves.
+        bool near = false;
+        for (const Bounds3f& b : newBounds) {
+            double t0 = 0, t1 = double(end);
+            near = near || b.expanded(eps).clip(s.origin, s.direction, t0, t1);
+        }
+        return near && bvh.movedOccludes(s.origin, s.direction, 0.0f, end, triangleMoved);
     };
     std::vector<SegmentRef> candidates;
     if (useGrid) {

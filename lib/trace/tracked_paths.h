@@ -45,8 +45,8 @@ public:
     std::vector<AffectedPath> findAffected(const std::vector<uint32_t>& movedTriangles, const std::vector<uint8_t>& triangleMoved,
                                            const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh, bool useGrid,
                                            FrameTiming& stats) const;
-    // Tracked segments that impacted one of the triangles (stale entries of retraced paths
-    // included): what rule (a) will read, known before any work, for the update's price.
+    // Live tracked segments that impacted one of the triangles: what rule (a) will find, known
+    // before any work, for the update's price.
     uint64_t segmentsListedOn(const std::vector<uint32_t>& triangles) const;
     // Retraces the affected paths and swaps their tails in; fills changes.removed/added.
     void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes, FrameTiming& stats);
