@@ -251,8 +251,12 @@ TEST(PhotonMapUpdate, RecomputingTheBallsHoldingAChangeEqualsAFullEstimate) {
         size_t recomputed = 0, changed = 0;
         for (size_t round = 0; round < 6; ++round) {
             const ChangingPhotons::Change change = photons.next(round);
+            std::vector<uint32_t> vertices = map.ballsHolding(f.scene, regions, change.removed);
             map.update(change.removed, change.added, f.scene);
-            const std::vector<uint32_t> vertices = map.ballsHolding(f.scene.positions, change.removed, change.added);
+            const std::vector<uint32_t> entered = map.ballsHolding(f.scene, regions, change.added);
+            vertices.insert(vertices.end(), entered.begin(), entered.end());
+            std::sort(vertices.begin(), vertices.end());
+            vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
             ASSERT_TRUE(std::is_sorted(vertices.begin(), vertices.end()));
             ASSERT_TRUE(std::adjacent_find(vertices.begin(), vertices.end()) == vertices.end());
             const std::vector<Vec3f> before = current;

@@ -269,7 +269,9 @@ void DetpDiscs::crossings(const Segment& s, std::vector<Crossed>& out) const {
 
 void DetpDiscs::crossingsIn(const Segment& s, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
                             std::vector<Crossed>& out) const {
-    std::vector<CrossedDisc> crossed;
+    // Per thread and reused: an allocation per segment cost as much as a small BVH's traversal.
+    thread_local std::vector<CrossedDisc> crossed;
+    crossed.clear();
     DiscQueryContext ctx;
     rtcInitIntersectContext(&ctx.base);
     ctx.segment = &s;

@@ -304,7 +304,6 @@ private:
         tracked.refsNear(boxes, near);
         std::vector<const Segment*> segments(near.size());
         for (size_t i = 0; i < near.size(); ++i) segments[i] = &tracked.segment(near[i]);
-        discs().updateDynamic();
         discs_->recompute(segments, quantizer_, vertices, sums_);
         stats.recomputeCandidates += segments.size();
     }

@@ -259,19 +259,27 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
 
 // Which estimates a change can alter
 
-std::vector<uint32_t> PhotonMap::ballsHolding(const std::vector<Vec3f>& positions, const std::vector<Segment>& removed,
-                                              const std::vector<Segment>& added) const {
-    std::vector<Vec3f> changed;
-    for (const auto* segments : {&removed, &added})
-        for (const Segment& s : *segments)
-            if (s.hasImpact()) changed.push_back(s.impactPoint());
-    if (changed.empty()) return {};
-    const PointIndex index(std::move(changed));
-    std::vector<uint8_t> holds(positions.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, positions.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+std::vector<uint32_t> PhotonMap::ballsHolding(const Scene& scene, const DiscRegions* regions,
+                                              const std::vector<Segment>& changed) const {
+    std::vector<Impact> impacts;
+    std::vector<Vec3f> points;
+    for (const Segment& s : changed)
+        if (s.hasImpact()) {
+            impacts.push_back(impactOf(s));
+            points.push_back(impacts.back().point);
+        }
+    if (impacts.empty()) return {};
+    const PointIndex index(std::move(points));
+    std::vector<uint8_t> holds(scene.vertexCount(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, scene.vertexCount(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             const float ball = v < ballsSquared_.size() ? ballsSquared_[v] : kNeverEstimated;
-            holds[v] = ball == kNeverEstimated || index.anyWithin(positions[v], ball);
+            if (ball == kNeverEstimated) {
+                holds[v] = 1;
+                continue;
+            }
+            const VertexFilter filter = filterFor(scene, regions, v);
+            holds[v] = index.anyWithin(scene.positions[v], ball, [&](size_t i) { return counts(filter, impacts[i]); });
         }
     });
     std::vector<uint32_t> vertices;

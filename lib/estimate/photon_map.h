@@ -56,14 +56,16 @@ public:
     // The same answers without an index: every vertex against every impact. Records nothing.
     std::vector<Vec3f> bruteForce(const Scene& scene, const DiscRegions* regions, float radius, int k) const;
 
-    // The vertices (sorted) whose ball recorded by the last estimate holds an impact of `removed`
-    // or `added`: r_k² ≥ its distance², where r_k is the k-th counted neighbour's distance, or the
-    // search radius when fewer were found. Of the vertices that did not move and whose filter did
-    // not change (the caller's to add), only these can see their estimate change. positions: the
-    // vertices where they were estimated. A vertex never estimated holds every impact. Before or
-    // after update(), alike; not during an estimate.
-    std::vector<uint32_t> ballsHolding(const std::vector<Vec3f>& positions, const std::vector<Segment>& removed,
-                                       const std::vector<Segment>& added) const;
+    // The vertices (sorted) whose ball recorded by the last estimate holds an impact of
+    // `changed` that counts for them: r_k² ≥ its distance², where r_k is the k-th counted
+    // neighbour's distance (or the search radius when fewer were found), and the vertex's own
+    // filter (front side, facing surface, height band, reachable cell) accepts it — an impact
+    // the filter rejects never enters the vertex's estimate. Of the vertices that did not move
+    // and whose regions did not change (the caller's to add), only these can see their estimate
+    // change. The filter reads the map's triangle normals: call it with the removed impacts
+    // before update() and with the added ones after. A vertex never estimated holds every
+    // change. Not during an estimate.
+    std::vector<uint32_t> ballsHolding(const Scene& scene, const DiscRegions* regions, const std::vector<Segment>& changed) const;
 
     size_t size() const { return impacts_.size() - bigRemoved_; }  // live impacts
 

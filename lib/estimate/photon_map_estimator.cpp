@@ -41,12 +41,15 @@ public:
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
         const EstimatorSettings& e = settings_;
         Stopwatch clock;
-        // The balls of the previous frame that a changed impact enters or leaves.
-        std::vector<uint32_t> vertices = map_->ballsHolding(scene_.positions, change.removed, change.added);
+        // The balls of the previous frame that a changed impact which counts there enters or
+        // leaves: the removed ones judged with the triangles as they were, the added ones after.
+        std::vector<uint32_t> vertices = map_->ballsHolding(scene_, regions_, change.removed);
+        map_->update(change.removed, change.added, scene_);
+        const std::vector<uint32_t> entered = map_->ballsHolding(scene_, regions_, change.added);
+        vertices.insert(vertices.end(), entered.begin(), entered.end());
         vertices.insert(vertices.end(), change.touched.begin(), change.touched.end());
         std::sort(vertices.begin(), vertices.end());
         vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-        map_->update(change.removed, change.added, scene_);
         stats.estimatorUpdateSeconds = clock.seconds();
         clock.restart();
         if (e.useIndex) {

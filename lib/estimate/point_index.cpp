@@ -38,17 +38,21 @@ const flann::SearchParams kExact(flann::FLANN_CHECKS_UNLIMITED, 0.0f, true);
 // worst distance so the tree visits nothing more.
 class FirstWithin : public flann::ResultSet<float> {
 public:
-    explicit FirstWithin(float limit)
+    FirstWithin(float limit, const std::function<bool(size_t)>& accept)
         // The tree prunes against the bound with its own rounding; a margin keeps a point lying
         // exactly at the limit from being pruned, and addPoint() applies the exact test.
-        : limit_(limit), bound_(std::nextafter(limit * (1.0f + 0x1p-10f), std::numeric_limits<float>::infinity())) {}
+        : limit_(limit), bound_(std::nextafter(limit * (1.0f + 0x1p-10f), std::numeric_limits<float>::infinity())),
+          accept_(accept) {}
     bool full() const override { return found_; }
-    void addPoint(float distance, size_t) override { found_ = found_ || distance <= limit_; }
+    void addPoint(float distance, size_t index) override {
+        found_ = found_ || (distance <= limit_ && (!accept_ || accept_(index)));
+    }
     float worstDist() const override { return found_ ? -1.0f : bound_; }
     bool found() const { return found_; }
 
 private:
     float limit_, bound_;
+    const std::function<bool(size_t)>& accept_;
     bool found_ = false;
 };
 }  // namespace
@@ -80,9 +84,9 @@ void PointIndex::withinRadius(const Vec3f& p, float radiusSquared, std::vector<s
     d2.swap(dst[0]);
 }
 
-bool PointIndex::anyWithin(const Vec3f& p, float radiusSquared) const {
+bool PointIndex::anyWithin(const Vec3f& p, float radiusSquared, const std::function<bool(size_t)>& accept) const {
     if (!tree_ || tree_->index.size() == 0 || !(radiusSquared >= 0)) return false;
-    FirstWithin result(radiusSquared);
+    FirstWithin result(radiusSquared, accept);
     tree_->index.findNeighbors(result, &p.x, kExact);
     return result.found();
 }

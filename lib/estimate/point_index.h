@@ -3,6 +3,7 @@
 // Points can be removed after the build (searches skip them); none can be added.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -34,7 +35,8 @@ public:
                       std::vector<float>& distancesSquared) const;
     // Whether some live point lies at distanceSquared() ≤ radiusSquared from p; the search stops at
     // the first one found. Thread-safe.
-    bool anyWithin(const Vec3f& p, float radiusSquared) const;
+    // accept, if given, must also hold for the point (by index).
+    bool anyWithin(const Vec3f& p, float radiusSquared, const std::function<bool(size_t)>& accept = {}) const;
     // FLANN's own metric, for index-free references that must rank exactly as the tree does.
     static float distanceSquared(const Vec3f& a, const Vec3f& b);
 

@@ -12,6 +12,7 @@ SegmentGrid::SegmentGrid(const Bounds3f& bounds, float cellSize, int maxCellsPer
         const float want = cellSize > 0 ? std::ceil(extent[a] / cellSize) : 1.0f;
         n_[a] = std::clamp(int(std::isfinite(want) ? want : 1.0f), 1, std::max(1, maxCellsPerAxis));
         cellSize_[a] = extent[a] > 0 ? extent[a] / float(n_[a]) : 1.0f;
+        inverseCellSize_[a] = 1.0f / cellSize_[a];
     }
     cells_.resize(size_t(n_[0]) * size_t(n_[1]) * size_t(n_[2]));
 }
@@ -19,8 +20,8 @@ SegmentGrid::SegmentGrid(const Bounds3f& bounds, float cellSize, int maxCellsPer
 bool SegmentGrid::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
     if (cells_.empty() || !box.overlaps(bounds_)) return false;
     for (int a = 0; a < 3; ++a) {
-        lo[a] = std::clamp(int(std::floor((box.lower[a] - bounds_.lower[a]) / cellSize_[a])), 0, n_[a] - 1);
-        hi[a] = std::clamp(int(std::floor((box.upper[a] - bounds_.lower[a]) / cellSize_[a])), 0, n_[a] - 1);
+        lo[a] = std::clamp(int(std::floor((box.lower[a] - bounds_.lower[a]) * inverseCellSize_[a])), 0, n_[a] - 1);
+        hi[a] = std::clamp(int(std::floor((box.upper[a] - bounds_.lower[a]) * inverseCellSize_[a])), 0, n_[a] - 1);
     }
     return true;
 }
@@ -40,17 +41,22 @@ void SegmentGrid::cellsOf(const Vec3f& origin, const Vec3f& direction, double en
     const double step = 0.9 * double(std::min({cellSize_[0], cellSize_[1], cellSize_[2]}));
     const Vec3f pad(1e-4f * std::min({cellSize_[0], cellSize_[1], cellSize_[2]}));
     const size_t pieces = std::max<size_t>(1, size_t(std::ceil((t1 - t0) / step)));
+    const Vec3d o(origin), d(direction);
     size_t last[8];
     int lastCount = 0;
+    Vec3f from(o + d * t0);  // each piece starts where the previous one ended
     for (size_t i = 0; i < pieces; ++i) {
-        const double a = t0 + (t1 - t0) * double(i) / double(pieces), b = t0 + (t1 - t0) * double(i + 1) / double(pieces);
-        Bounds3f piece;
-        piece.extend(Vec3f(Vec3d(origin) + Vec3d(direction) * a));
-        piece.extend(Vec3f(Vec3d(origin) + Vec3d(direction) * b));
-        piece.lower = piece.lower - pad;
-        piece.upper = piece.upper + pad;
+        const Vec3f to(o + d * (t0 + (t1 - t0) * double(i + 1) / double(pieces)));
         int lo[3], hi[3];
-        if (!cellRange(piece, lo, hi)) continue;
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) {
+            const float low = std::min(from[a], to[a]) - pad[a], high = std::max(from[a], to[a]) + pad[a];
+            inside = inside && high >= bounds_.lower[a] && low <= bounds_.upper[a];
+            lo[a] = std::clamp(int(std::floor((low - bounds_.lower[a]) * inverseCellSize_[a])), 0, n_[a] - 1);
+            hi[a] = std::clamp(int(std::floor((high - bounds_.lower[a]) * inverseCellSize_[a])), 0, n_[a] - 1);
+        }
+        from = to;
+        if (!inside) continue;
         size_t now[8];
         int nowCount = 0;
         for (int z = lo[2]; z <= hi[2]; ++z)

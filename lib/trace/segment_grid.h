@@ -88,7 +88,7 @@ private:
     size_t cellIndex(int x, int y, int z) const { return (size_t(z) * size_t(n_[1]) + size_t(y)) * size_t(n_[0]) + size_t(x); }
 
     Bounds3f bounds_;
-    Vec3f cellSize_{1.0f};
+    Vec3f cellSize_{1.0f}, inverseCellSize_{1.0f};
     int n_[3] = {0, 0, 0};
     std::vector<std::vector<SegmentRef>> cells_;
     size_t entries_ = 0;

@@ -148,9 +148,14 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
             }
     }
     stats.blockingCandidates += candidates.size();
+    // A path that rule (a) retraces from this bounce or earlier changes the same way whether
+    // or not the candidate is blocked: no need to ask.
+    std::vector<uint32_t> fromImpact(paths_.size(), kNone);
+    for (const auto& [slot, bounce] : firstBounce) fromImpact[slot] = bounce;
     std::vector<uint8_t> isBlocked(candidates.size(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) isBlocked[i] = blocked(*segmentOf(candidates[i]));
+        for (size_t i = r.begin(); i != r.end(); ++i)
+            isBlocked[i] = fromImpact[size_t(slot_[candidates[i].path])] > candidates[i].bounce && blocked(*segmentOf(candidates[i]));
     });
     std::vector<std::pair<uint32_t, uint32_t>> byBlocking;
     for (size_t i = 0; i < candidates.size(); ++i)
