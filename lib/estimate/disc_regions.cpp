@@ -157,19 +157,26 @@ void DiscRegions::computeAll(const Scene& scene, const SceneBvh& bvh) {
     recompute(scene, bvh, all);
 }
 
-void DiscRegions::recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices) {
+std::vector<uint32_t> DiscRegions::recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices) {
     if (discs_.size() != scene.vertexCount()) discs_.resize(scene.vertexCount());
-    if (vertices.empty()) return;
+    if (vertices.empty()) return {};
+    std::vector<uint8_t> changed(vertices.size(), 0);
     const MeshTopology topology(scene.positions, scene.triangles);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 32), [&](const tbb::blocked_range<size_t>& range) {
         OwnSurfaceScratch& local = scratch.local();
-        for (size_t i = range.begin(); i != range.end(); ++i)
-            discs_[vertices[i]] =
-                computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local);
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+            VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local);
+            changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
+            discs_[vertices[i]] = std::move(disc);
+        }
     });
+    std::vector<uint32_t> out;
+    for (size_t i = 0; i < vertices.size(); ++i)
+        if (changed[i]) out.push_back(vertices[i]);
+    return out;
 }
 
 std::vector<uint32_t> DiscRegions::touchedBy(const Scene& scene, const std::vector<Bounds3f>& movedBounds,

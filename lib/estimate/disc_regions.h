@@ -69,8 +69,11 @@ public:
 
     // Every vertex, for the scene's current pose (bvh must hold that pose).
     void computeAll(const Scene& scene, const SceneBvh& bvh);
-    // The given vertices only (sorted or not); the rest keep their values.
-    void recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices);
+    // The given vertices only (sorted or not); the rest keep their values. Returns those of them
+    // whose disc may now decide a crossing differently: its disc changed, or it has mixed cells
+    // (decided point by point against the current geometry). The others count every segment
+    // exactly as before.
+    std::vector<uint32_t> recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices);
     // Vertices to recompute after a move: those whose test region overlaps one of `movedBounds`
     // (old and new bounds of each moved object), and those flagged in `vertexMoved`.
     std::vector<uint32_t> touchedBy(const Scene& scene, const std::vector<Bounds3f>& movedBounds,

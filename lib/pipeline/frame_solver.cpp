@@ -93,21 +93,23 @@ std::vector<uint32_t> FrameSolver::touchedVertices(const PoseChange& change) con
     return moved;
 }
 
-void FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats) {
+std::vector<uint32_t> FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats) {
     if (!regions_) {
         regionsValid_ = true;  // nothing to compute
-        return;
+        return touched ? *touched : std::vector<uint32_t>();
     }
+    std::vector<uint32_t> redecided;
     Stopwatch clock;
     if (!regionsValid_) {
         regions_->computeAll(scene_, bvh_);
         stats.discRegionsUpdated = scene_.vertexCount();
         regionsValid_ = true;
     } else if (touched) {
-        regions_->recompute(scene_, bvh_, *touched);
+        redecided = regions_->recompute(scene_, bvh_, *touched);
         stats.discRegionsUpdated = touched->size();
     }
     stats.discRegionsSeconds = clock.seconds();
+    return redecided;
 }
 
 bool FrameSolver::changeTooLarge(const PoseChange& change, size_t touched) const {
@@ -139,8 +141,15 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     const PoseChange change = pose(target);
     Stopwatch clock;
     const bool firstTime = !regionsValid_;
-    const std::vector<uint32_t> touched = !firstTime && change.any ? touchedVertices(change) : std::vector<uint32_t>();
-    updateRegions(firstTime ? nullptr : &touched, stats);
+    std::vector<uint32_t> touched = !firstTime && change.any ? touchedVertices(change) : std::vector<uint32_t>();
+    // The estimators recompute the moved vertices and those whose disc now decides crossings
+    // differently; the regions' conservative test touched more (most keep their disc).
+    std::vector<uint32_t> redecided = updateRegions(firstTime ? nullptr : &touched, stats);
+    for (uint32_t v : touched)
+        if (change.vertexMoved[v]) redecided.push_back(v);
+    std::sort(redecided.begin(), redecided.end());
+    redecided.erase(std::unique(redecided.begin(), redecided.end()), redecided.end());
+    touched.swap(redecided);
     const double regionSeconds = clock.seconds();
 
     std::string why;

@@ -59,7 +59,8 @@ private:
     // Vertices whose disc moved or whose regions the move touched (the moved ones without regions).
     std::vector<uint32_t> touchedVertices(const PoseChange& change) const;
     // Computes every vertex's regions the first time, afterwards only the touched ones (if given).
-    void updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats);
+    // Returns those of the touched ones whose disc may now decide crossings differently.
+    std::vector<uint32_t> updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats);
     // Whether updating would cost more than solving the frame from scratch, from counts alone.
     bool changeTooLarge(const PoseChange& change, size_t touched) const;
     void solveFromScratch(FrameTiming& stats);
