@@ -32,9 +32,11 @@ public:
         mayBeTouched_ = context.scene.vertexDynamic;
         mayBeTouched_.resize(scene_.vertexCount(), 0);
         if (regions_) {
+            // Slightly dilated, so that no rounding between the sweep and a frame's pose can put
+            // a frame's moved bounds outside (a larger set only remembers less).
             std::vector<Bounds3f> swept;
             for (const Bounds3f& b : scene_.sweptInstanceBounds)
-                if (!b.empty()) swept.push_back(b);
+                if (!b.empty()) swept.push_back(b.expanded(64 * scene_.sceneEpsilon()));
             for (uint32_t v : regions_->touchedBy(scene_, swept, mayBeTouched_)) mayBeTouched_[v] = 1;
         }
     }

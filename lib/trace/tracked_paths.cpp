@@ -292,12 +292,6 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
     stats.retraceSeconds += clock.seconds();
 }
 
-void TrackedPaths::segmentsNear(const Bounds3f& box, std::vector<const Segment*>& out) const {
-    std::vector<SegmentRef> refs;
-    refsNear({box}, refs);
-    for (const SegmentRef& r : refs) out.push_back(segmentOf(r));
-}
-
 void TrackedPaths::refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const {
     out.clear();
     // A segment is listed in every cell it passes: one bit per (path, bounce) keeps it once,
@@ -322,11 +316,6 @@ void TrackedPaths::refsNear(const std::vector<Bounds3f>& boxes, std::vector<Segm
     std::sort(deep.begin(), deep.end());
     deep.erase(std::unique(deep.begin(), deep.end()), deep.end());
     out.insert(out.end(), deep.begin(), deep.end());
-}
-
-void TrackedPaths::appendAll(std::vector<Segment>& out) const {
-    for (const Tracked& t : paths_)
-        out.insert(out.end(), segments_.begin() + int64_t(t.begin), segments_.begin() + int64_t(t.begin + t.count));
 }
 
 void TrackedPaths::allSegments(std::vector<const Segment*>& out) const {

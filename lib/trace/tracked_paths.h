@@ -51,16 +51,13 @@ public:
     // Retraces the affected paths and swaps their tails in; fills changes.removed/added.
     void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes, FrameTiming& stats);
 
-    // Tracked segments that pass through the box (with their extension), for the discs an update
-    // recomputes. Appends pointers valid until the next retrace.
-    void segmentsNear(const Bounds3f& box, std::vector<const Segment*>& out) const;
-    // The same as references (sorted, unique, live), and the segment a reference names.
-    // The live tracked segments listed in the grid cells that overlap any of the boxes, each
-    // once (in the grid's order, not sorted).
+    // The live tracked segments listed in the grid cells that overlap any of the boxes (with
+    // their extension past the impact), each once, in the grid's order: for the blocking test
+    // and the discs an update recomputes. And the segment a reference names (valid until the
+    // next retrace).
     void refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const;
     const Segment& segment(const SegmentRef& r) const { return *segmentOf(r); }
-    // Every tracked segment (for estimators that rebuild from all of them).
-    void appendAll(std::vector<Segment>& out) const;
+    // Every tracked segment, in path order (valid until the next retrace).
     void allSegments(std::vector<const Segment*>& out) const;
 
     size_t trackedPaths() const { return paths_.size(); }
