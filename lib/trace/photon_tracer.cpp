@@ -11,7 +11,7 @@
 namespace qsgi {
 
 PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings)
-    : scene_(scene), bvh_(bvh), settings_(settings), lights_(scene, settings.photons, bvh.rayEpsilon(), settings.aim),
+    : bvh_(bvh), settings_(settings), lights_(scene, settings.photons, bvh.rayEpsilon(), settings.aim),
       bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {
     surfaces_.resize(scene.triangleCount());
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {

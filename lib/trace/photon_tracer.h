@@ -36,7 +36,6 @@ public:
     const LightSampler& lights() const { return lights_; }
 
 private:
-    const Scene& scene_;
     const SceneBvh& bvh_;
     TraceSettings settings_;
     LightSampler lights_;
