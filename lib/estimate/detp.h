@@ -105,7 +105,6 @@ public:
     // any thread count.
     enum class Discs { All, Refitted, Fixed };
     void findCrossings(const std::vector<Segment>& segments, Discs which, std::vector<SegmentCrossing>& out) const;
-    bool isRefitted(uint32_t vertex) const { return refitted_[vertex] != 0; }
 
     // The sums of the given vertices from the given segments (an update's touched vertices):
     // a disc BVH of just those vertices, built for the call, that each segment is traced through.

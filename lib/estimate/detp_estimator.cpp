@@ -310,15 +310,6 @@ private:
         stats.recomputeCandidates += segments.size();
     }
 
-    const VertexDisc& discOf(uint32_t v) const { return regions_ ? (*regions_)[v] : kPaperRuleDisc(); }
-    static const VertexDisc& kPaperRuleDisc() {
-        static const VertexDisc disc = [] {
-            VertexDisc d;
-            d.fallback = true;
-            return d;
-        }();
-        return disc;
-    }
     DetpVertexSums vertexSums(uint32_t v, const std::vector<const Segment*>& segments) const {
         return detpVertexSums(scene_, v, segments, settings_.radius, settings_.boundary, regions_, &bvh_, quantizer_);
     }

@@ -48,6 +48,7 @@ struct FrameChange {
     const std::vector<Segment>& added;          // new tails
     const std::vector<uint8_t>& vertexMoved;    // per scene vertex
     const std::vector<uint8_t>& triangleMoved;  // per scene triangle
+    const std::vector<uint32_t>& movedTriangles;  // the same, listed (increasing)
     // Vertices whose disc moved or whose disc regions the move touched (sorted): they are
     // recomputed, every other vertex is updated.
     const std::vector<uint32_t>& touched;

@@ -28,9 +28,7 @@ public:
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
         // Old segments leave with the facing they were counted with, before the triangles move.
         for (const Segment& s : change.removed) sums_.subtract(s, quantizer_);
-        std::vector<uint32_t> moved;
-        for (uint32_t t = 0; t < scene_.triangleCount(); ++t)
-            if (change.triangleMoved[t]) moved.push_back(t);
+        const std::vector<uint32_t>& moved = change.movedTriangles;
         sums_.updateGeometry(scene_, moved);
         for (const Segment& s : change.added) sums_.add(s, quantizer_);
         // The vertices of the triangles whose sums or areas changed are averaged again.

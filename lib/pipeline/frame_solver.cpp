@@ -237,7 +237,8 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
     stats.photonSimulationSeconds += clock.seconds();
 
     clock.restart();
-    const FrameChange frameChange{changes.removed, changes.added, change.vertexMoved, change.triangleMoved, touched, *tracked_};
+    const FrameChange frameChange{changes.removed,         changes.added, change.vertexMoved, change.triangleMoved,
+                                  change.movedTriangles, touched,       *tracked_};
     estimator_->update(frameChange, result_, stats);
     stats.estimationSeconds += clock.seconds();
 }

@@ -26,12 +26,6 @@ bool SegmentGrid::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
     return true;
 }
 
-void SegmentGrid::insert(const Vec3f& origin, const Vec3f& direction, double end, const SegmentRef& ref) {
-    std::vector<uint32_t> cells;
-    cellsOf(origin, direction, end, cells);
-    insertInto(cells.data(), cells.size(), ref);
-}
-
 void SegmentGrid::cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const {
     double t0 = 0, t1 = end;
     if (cells_.empty() || !bounds_.clip(origin, direction, t0, t1)) return;

@@ -29,27 +29,19 @@ public:
     // maxCellsPerAxis cells along any axis).
     SegmentGrid(const Bounds3f& bounds, float cellSize, int maxCellsPerAxis = 64);
 
-    // Lists the part [0, end] of the ray o + t·d (end may be infinite) in every cell it passes.
-    void insert(const Vec3f& origin, const Vec3f& direction, double end, const SegmentRef& ref);
-    // The two halves of insert: the cells the ray passes (appended to `cells`; read-only, so
-    // threads can find them in parallel), then listing ref in them.
+    // Listing the part [0, end] of the ray o + t·d (end may be infinite) in every cell it passes
+    // takes two steps: the cells the ray passes (appended to `cells`; read-only, so threads can
+    // find them in parallel), then listing ref in them.
     void cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const;
     void insertInto(const uint32_t* cells, size_t count, const SegmentRef& ref) {
         for (size_t i = 0; i < count; ++i) cells_[cells[i]].push_back(ref);
-        entries_ += count;
     }
     // The same for the cells of one shard only (cell % shards == shard): shards can be filled
     // in parallel, each cell still in the order its entries come.
-    size_t insertIntoShard(const uint32_t* cells, size_t count, const SegmentRef& ref, uint32_t shard, uint32_t shards) {
-        size_t n = 0;
+    void insertIntoShard(const uint32_t* cells, size_t count, const SegmentRef& ref, uint32_t shard, uint32_t shards) {
         for (size_t i = 0; i < count; ++i)
-            if (cells[i] % shards == shard) {
-                cells_[cells[i]].push_back(ref);
-                ++n;
-            }
-        return n;
+            if (cells[i] % shards == shard) cells_[cells[i]].push_back(ref);
     }
-    void countEntries(size_t added) { entries_ += added; }
     // Calls visit(ref) for every entry of every cell that overlaps one of the boxes: an entry
     // as often as it is listed in such cells, stale ones included (the caller filters).
     template <typename Visit>
@@ -69,18 +61,15 @@ public:
     // Drops stale entries everywhere.
     template <typename IsLive>
     void sweep(IsLive isLive) {
-        entries_ = 0;
         for (auto& cell : cells_) {
             size_t kept = 0;
             for (const SegmentRef& r : cell)
                 if (isLive(r)) cell[kept++] = r;
             cell.resize(kept);
             cell.shrink_to_fit();
-            entries_ += kept;
         }
     }
 
-    size_t entries() const { return entries_; }
     size_t bytes() const;
 
 private:
@@ -91,7 +80,6 @@ private:
     Vec3f cellSize_{1.0f}, inverseCellSize_{1.0f};
     int n_[3] = {0, 0, 0};
     std::vector<std::vector<SegmentRef>> cells_;
-    size_t entries_ = 0;
 };
 
 }  // namespace qsgi

@@ -12,7 +12,7 @@
 namespace qsgi {
 
 TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, float extension, const Bounds3f& gridBounds,
-                           float cellSize, std::vector<Segment>* untracked)
+                           float cellSize)
     : envelope_(envelope), extension_(extension), grid_(gridBounds, cellSize) {
     const size_t n = cache.pathCount();
     // Per path, the first segment that meets the envelope (or none).
@@ -27,9 +27,6 @@ TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, floa
     });
     slot_.assign(n, -1);
     for (size_t p = 0; p < n; ++p) {
-        const uint64_t kept = first[p] == std::numeric_limits<uint32_t>::max() ? cache.pathBegin[p + 1] : cache.pathBegin[p] + first[p];
-        if (untracked)
-            untracked->insert(untracked->end(), cache.segments.begin() + int64_t(cache.pathBegin[p]), cache.segments.begin() + int64_t(kept));
         if (first[p] == std::numeric_limits<uint32_t>::max()) continue;
         Tracked t;
         t.path = uint32_t(p);
@@ -69,7 +66,6 @@ void TrackedPaths::listOnTriangle(const Tracked& t, uint32_t j) {
     if (!s.hasImpact() || !s.impactDynamic) return;
     if (byTriangle_.size() <= s.triangle) byTriangle_.resize(size_t(s.triangle) + 1);
     byTriangle_[s.triangle].push_back(SegmentRef{t.path, t.generation, t.firstBounce + j});
-    ++triangleEntries_;
 }
 
 bool TrackedPaths::isLive(const SegmentRef& r) const {
@@ -252,7 +248,6 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
     // The grid's cells, filled in parallel by shards of cells: each cell takes its entries in
     // path order, whatever the thread count.
     const uint32_t kShards = uint32_t(std::max(1, tbb::this_task_arena::max_concurrency()));
-    std::vector<size_t> listed(kShards, 0);
     tbb::parallel_for(uint32_t(0), kShards, [&](uint32_t shard) {
         for (size_t c = 0; c < chunks.size(); ++c) {
             const Chunk& chunk = chunks[c];
@@ -261,13 +256,12 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
                 const Tracked& t = paths_[size_t(slot_[affected[i].path])];
                 for (uint32_t j = 0; j < t.count; ++j, ++n) {
                     const uint32_t from = n ? chunk.cellsEnd[n - 1] : 0;
-                    listed[shard] += grid_.insertIntoShard(chunk.cells.data() + from, chunk.cellsEnd[n] - from,
+                    grid_.insertIntoShard(chunk.cells.data() + from, chunk.cellsEnd[n] - from,
                                                            SegmentRef{t.path, t.generation, t.firstBounce + j}, shard, kShards);
                 }
             }
         }
     });
-    for (size_t n : listed) grid_.countEntries(n);
     stats.pathsRetraced += affected.size();
     stats.segmentsRemoved += removed;
     stats.segmentsAdded += added;
@@ -283,11 +277,8 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
         segments_.swap(compact);
         auto live = [&](const SegmentRef& r) { return isLive(r); };
         grid_.sweep(live);
-        triangleEntries_ = 0;
-        for (auto& list : byTriangle_) {
+        for (auto& list : byTriangle_)
             list.erase(std::remove_if(list.begin(), list.end(), [&](const SegmentRef& r) { return !live(r); }), list.end());
-            triangleEntries_ += list.size();
-        }
     }
     stats.retraceSeconds += clock.seconds();
 }

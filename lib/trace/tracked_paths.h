@@ -32,9 +32,8 @@ public:
     // extension: how far past its impact a segment is followed for the envelope test
     // (envelopeMargin's reasoning); gridBounds and cellSize: the segment grid's region (what
     // queries ask about: the envelope's bounds) and cell edge.
-    // untracked, if given, receives every segment that is not tracked.
     TrackedPaths(const RayCache& cache, const Envelope& envelope, float extension, const Bounds3f& gridBounds,
-                 float cellSize, std::vector<Segment>* untracked = nullptr);
+                 float cellSize);
 
     // The paths the move from the previous pose to the current one affects. movedTriangles: the
     // scene triangles any of whose vertices moved (sorted), triangleMoved the same as flags;
@@ -89,7 +88,6 @@ private:
     SegmentGrid grid_;
     // Per scene triangle, the tracked segments that impacted it (dynamic triangles only): rule (a).
     std::vector<std::vector<SegmentRef>> byTriangle_;
-    size_t triangleEntries_ = 0;
 };
 
 }  // namespace qsgi
