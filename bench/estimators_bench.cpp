@@ -52,7 +52,7 @@ struct CornellFixture {
     }
     const RayCache& cache(uint64_t photons) {
         auto& c = caches[photons];
-        if (!c) c = std::make_unique<RayCache>(PhotonTracer(scene, *bvh, TraceSettings{photons, 1, 32, EmissionAim{}}).traceAll());
+        if (!c) c = std::make_unique<RayCache>(PhotonTracer(scene, *bvh, TraceSettings{photons, 1, 32, EmissionAim{}, PhotonSampling{}}).traceAll());
         return *c;
     }
     const std::vector<Vec3f>& exact(uint64_t photons, int radiusMm) {
@@ -127,7 +127,7 @@ void BM_TracePhotons(benchmark::State& state) {
     CornellFixture& f = fixture();
     const uint64_t photons = uint64_t(state.range(0));
     SceneBvh bvh(f.device, f.scene);
-    const PhotonTracer tracer(f.scene, bvh, TraceSettings{photons, 1, 32, EmissionAim{}});
+    const PhotonTracer tracer(f.scene, bvh, TraceSettings{photons, 1, 32, EmissionAim{}, PhotonSampling{}});
     size_t segments = 0;
     for (auto _ : state) {
         const RayCache cache = tracer.traceAll();
@@ -336,7 +336,7 @@ struct FlightHelmetFixture {
         bvh = std::make_unique<SceneBvh>(device, scene);
     }
     RayCache trace(const EmissionAim& aim) const {
-        return PhotonTracer(scene, *bvh, TraceSettings{kPhotons, 1, 32, aim}).traceAll();
+        return PhotonTracer(scene, *bvh, TraceSettings{kPhotons, 1, 32, aim, PhotonSampling{}}).traceAll();
     }
 };
 

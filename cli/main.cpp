@@ -41,11 +41,11 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 1;
 
 struct CliOptions {
-    std::string config, animation, estimator, detpIndex, detpBoundary, frames, out;
+    std::string config, animation, estimator, detpIndex, detpBoundary, frames, out, sampler;
     // Unset options leave the config's (or the default) value alone.
     std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
     std::optional<double> exposure, radius, fps;
-    std::optional<int64_t> k;
+    std::optional<int64_t> k, qmcBounces;
     bool noRayCache = false, noSortQueries = false, fullRecompute = false, alwaysUpdate = false, noEnvelope = false, noAim = false, resume = false;
     bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false, gltfOut = false;
 };
@@ -76,6 +76,10 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.alwaysUpdate) s.alwaysUpdate = true;
     if (o.noEnvelope) s.useEnvelope = false;
     if (o.noAim) s.aimEmission = false;
+    if (!o.sampler.empty()) s.sampling.kind = qsgi::parseSampler(o.sampler, cli);
+    if (o.qmcBounces)
+        s.sampling.qmcBounces = uint32_t(qsgi::checkedInteger(*o.qmcBounces, 0, qsgi::kMaxQmcBounces, cli, "--qmc-bounces",
+                                                              " (the Sobol table covers that many scatterings)"));
     if (o.resume) s.resume = true;
     if (!o.frames.empty()) {
         s.frames = qsgi::parseFrameRange(o.frames, cli);
@@ -169,6 +173,12 @@ int main(int argc, char** argv) {
                      "emit photons in every direction a light shines, not only toward the scene (projection maps "
                      "off; the same estimate in expectation, more photons wasted)");
     render->add_option("--photons", o.photons, "photons traced per frame (default 1000000)");
+    render->add_option("--sampler", o.sampler,
+                       "where photons' numbers come from: sobol (scrambled Sobol points, stratified; default) or random "
+                       "(hashed, independent: the paper's)");
+    render->add_option("--qmc-bounces", o.qmcBounces,
+                       "sobol: scatterings whose survival and direction are Sobol coordinates too, 0..max_bounces "
+                       "(default 2; later ones are hashed)");
     render->add_option("--seed", o.seed, "random seed (default 1); same seed, same bytes");
     render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");
     render->add_option("--frames", o.frames, "frames A:B, inclusive at both ends (default: all)");

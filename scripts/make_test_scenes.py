@@ -5,6 +5,10 @@
   with a 1 W/sr KHR_lights_punctual point light at its centre: E = 2 W/m^2 everywhere.
 - plane_point_light.gltf: a 3.2 m square plane (albedo 0.5) under a 1 W/sr point light 1 m
   above its centre: E = I h / d^3.
+- corner_point_light.gltf: an inside corner (albedo 0.6): a 2 m square floor at y = 0 over x, z in
+  [0, 2] and two 2 m high walls on the planes x = 0 and z = 0, all facing into the corner, each a
+  24 x 24 grid of its own vertices and normals; a 1 W/sr point light at (0.7, 1.2, 0.7). Direct
+  E = I cos / d^2 (1/1.2^2 W/m^2 below the light); interreflection adds to it (Mitsuba reference).
 Each has a camera. Run: python3 scripts/make_test_scenes.py [OUT_DIR]
 """
 import base64
@@ -74,6 +78,30 @@ def gltf(positions, normals, faces, albedo, light_pos, camera_node, name):
     }
 
 
+def grid(origin, u, v, cells, pos, nrm, faces):
+    """Appends a cells x cells grid of quads (two triangles each) spanning origin + [0,1] u + [0,1] v,
+    with vertices of its own and normal u x v (counter-clockwise seen from that side)."""
+    n = normalize([u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]])
+    base, row = len(pos), cells + 1
+    for j in range(row):
+        for i in range(row):
+            pos.append([origin[k] + u[k] * i / cells + v[k] * j / cells for k in range(3)])
+            nrm.append(n)
+    for j in range(cells):
+        for i in range(cells):
+            a = base + j * row + i
+            faces += [(a, a + 1, a + row + 1), (a, a + row + 1, a + row)]
+
+
+def look_at(eye, target):
+    """A camera node at eye looking at target (yaw about y, then pitch about the camera's x)."""
+    d = [target[k] - eye[k] for k in range(3)]
+    yaw = math.atan2(-d[0], -d[2])
+    pitch = math.atan2(d[1], math.hypot(d[0], d[2]))
+    sy, cy, sp, cp = math.sin(yaw / 2), math.cos(yaw / 2), math.sin(pitch / 2), math.cos(pitch / 2)
+    return {"translation": eye, "rotation": [cy * sp, sy * cp, -sy * sp, cy * cp]}
+
+
 def main():
     folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "tests", "scenes")
     os.makedirs(folder, exist_ok=True)
@@ -95,7 +123,13 @@ def main():
     pitch = -math.atan2(2.0, 3.0)
     plane = gltf(pos, [[0, 1, 0]] * len(pos), faces, [0.5, 0.5, 0.5], [0, 1, 0],
                  {"translation": [0, 2, 3], "rotation": [math.sin(pitch / 2), 0, 0, math.cos(pitch / 2)]}, "Plane")
-    for name, doc in (("sphere_point_light", sphere), ("plane_point_light", plane)):
+    pos, nrm, faces = [], [], []
+    grid([0, 0, 0], [0, 0, 2], [2, 0, 0], 24, pos, nrm, faces)  # floor, +y
+    grid([0, 0, 0], [0, 2, 0], [0, 0, 2], 24, pos, nrm, faces)  # wall x = 0, +x
+    grid([0, 0, 0], [2, 0, 0], [0, 2, 0], 24, pos, nrm, faces)  # wall z = 0, +z
+    corner = gltf(pos, nrm, faces, [0.6, 0.6, 0.6], [0.7, 1.2, 0.7],
+                  look_at([3.2, 2.4, 3.2], [0.6, 0.6, 0.6]), "Corner")
+    for name, doc in (("sphere_point_light", sphere), ("plane_point_light", plane), ("corner_point_light", corner)):
         with open(os.path.join(folder, name + ".gltf"), "w") as out:
             json.dump(doc, out)
             out.write("\n")

@@ -35,7 +35,7 @@ Solved solveDetp(const Scene& source, uint64_t photons, bool aim, float radius) 
     FrameSolverSettings s;
     s.estimator.kind = EstimatorKind::Detp;
     s.estimator.radius = radius;
-    s.trace = TraceSettings{photons, 3, 32, EmissionAim{aim, 0}};
+    s.trace = TraceSettings{photons, 3, 32, EmissionAim{aim, 0}, PhotonSampling{}};
     s.fullRecompute = true;
     FrameSolver solver(scene, device, s);
     FrameTiming work;
@@ -120,7 +120,7 @@ TEST(AimedEmission, ThinSliverFarFromTheRestReceivesItsShare) {
     const uint64_t photons = 1000000;
     EmbreeDevice device;
     const SceneBvh bvh(device, scene);
-    const PhotonTracer tracer(scene, bvh, TraceSettings{photons, 5, 32, EmissionAim{true, 0}});
+    const PhotonTracer tracer(scene, bvh, TraceSettings{photons, 5, 32, EmissionAim{true, 0}, PhotonSampling{}});
     const RayCache cache = tracer.traceAll();
     // The sliver's triangles follow the plate's (instances in order).
     const uint32_t firstSliverTriangle = scene.instances[1].firstTriangle;

@@ -192,12 +192,19 @@ TEST(Cli, EveryEstimatorRendersEndToEnd) {
         if (std::string(estimator) != "impact-count") {
             EXPECT_NE(timing.find("\"radius\": 0.07"), std::string::npos) << timing;
         }
+        EXPECT_NE(timing.find("\"sampler\": \"sobol\""), std::string::npos) << timing;
+        EXPECT_NE(timing.find("\"qmc_bounces\": 2"), std::string::npos) << timing;
     }
     const fs::path out = fs::path(testScratchDir("estimator_bad")) / "out";
     expectBadInput("render " + cornell() + " --estimator magic", "magic", out);
     expectBadInput("render " + cornell() + " --estimator detp --radius -1", "--radius", out);
     expectBadInput("render " + cornell() + " --estimator detp --detp-index octree", "octree", out);
     expectBadInput("render " + cornell() + " --estimator photon-map --k 0", "--k", out);
+    expectBadInput("render " + cornell() + " --sampler halton", "halton", out);
+    expectBadInput("render " + cornell() + " --qmc-bounces 33", "--qmc-bounces", out);
+    const fs::path fewBounces = fs::path(testScratchDir("estimator_bad_config")) / "few_bounces.json";
+    writeText(fewBounces, R"({"max_bounces": 4})");
+    expectBadInput("render " + cornell() + " --qmc-bounces 5 --config " + fewBounces.string(), "qmc_bounces", out);
 }
 
 // The incremental update writes the bytes --full-recompute writes, for each estimator and rule on

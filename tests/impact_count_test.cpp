@@ -25,7 +25,7 @@ struct Estimate {
 Estimate runImpactCount(const Scene& scene, uint64_t photons, uint64_t seed = 7) {
     EmbreeDevice device;
     SceneBvh bvh(device, scene);
-    PhotonTracer tracer(scene, bvh, TraceSettings{photons, seed, 32, EmissionAim{}});
+    PhotonTracer tracer(scene, bvh, TraceSettings{photons, seed, 32, EmissionAim{}, PhotonSampling{}});
     Estimate e;
     e.cache = tracer.traceAll();
     ImpactCount ic(scene);

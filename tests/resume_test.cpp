@@ -147,7 +147,8 @@ TEST(Resume, FolderFromOtherInputsIsRefusedAndLeftUntouched) {
     const std::string scene = (cornell / "cornell.gltf").string() + " --animation " + (cornell / "animation.json").string();
     ASSERT_EQ(runQsgi("render " + scene + few + " --out " + out.string()).exitCode, 0);
     const std::string before = readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json");
-    for (const char* change : {" --seed 7", " --estimator photon-map", " --radius 0.02", " --spp 2", " --png"}) {
+    for (const char* change : {" --seed 7", " --estimator photon-map", " --radius 0.02", " --spp 2", " --png",
+                               " --sampler random", " --qmc-bounces 1"}) {
         SCOPED_TRACE(change);
         const CommandResult r = runQsgi("render " + scene + few + change + " --resume --out " + out.string());
         EXPECT_EQ(r.exitCode, 2) << r.output;

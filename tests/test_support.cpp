@@ -57,13 +57,13 @@ EstimatorSettings NamedEstimator::settings(float radius, int k) const {
     return s;
 }
 
-RayCache traceScene(const Scene& scene, uint64_t photons, uint64_t seed, bool aim) {
+RayCache traceScene(const Scene& scene, uint64_t photons, uint64_t seed, bool aim, const PhotonSampling& sampling) {
     EmbreeDevice device;
     const SceneBvh bvh(device, scene);
     // Aimed as a render aims (issue 12), at 10 % of the diagonal beside the geometry: more than
     // any DETP radius the tests estimate these photons with.
     const EmissionAim aiming{aim, 0.1f * scene.animationBounds.extent()};
-    return PhotonTracer(scene, bvh, TraceSettings{photons, seed, 32, aiming}).traceAll();
+    return PhotonTracer(scene, bvh, TraceSettings{photons, seed, 32, aiming, sampling}).traceAll();
 }
 
 VertexRadiosity estimateWith(const Scene& scene, const RayCache& cache, const EstimatorSettings& settings) {

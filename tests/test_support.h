@@ -8,6 +8,7 @@
 
 #include "estimate/estimator.h"
 #include "scene/scene.h"
+#include "trace/photon_numbers.h"
 #include "trace/ray_cache.h"
 
 std::filesystem::path sourceDir();  // the repository root
@@ -31,8 +32,9 @@ struct NamedEstimator {
 };
 
 // Every photon of the scene traced once (max 32 bounces), as a render's first frame does; aimed
-// (issue 12) unless `aim` is false.
-qsgi::RayCache traceScene(const qsgi::Scene& scene, uint64_t photons, uint64_t seed, bool aim = true);
+// (issue 12) unless `aim` is false; with the default sampler unless another is given.
+qsgi::RayCache traceScene(const qsgi::Scene& scene, uint64_t photons, uint64_t seed, bool aim = true,
+                          const qsgi::PhotonSampling& sampling = {});
 // Density estimation of the scene's current pose with these settings (disc regions computed here).
 qsgi::VertexRadiosity estimateWith(const qsgi::Scene& scene, const qsgi::RayCache& cache,
                                    const qsgi::EstimatorSettings& settings);

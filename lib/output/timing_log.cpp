@@ -33,7 +33,8 @@ void TimingLog::write(const std::filesystem::path& path) const {
                    {"detp_index", estimator == "detp" ? nlohmann::json(detpIndex) : nlohmann::json(nullptr)},
                    {"detp_boundary", hasRadius ? nlohmann::json(boundary) : nlohmann::json(nullptr)},
                    {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute}, {"envelope", envelope},
-                   {"aim_emission", aimEmission}, {"seed", seed}, {"threads", threads}, {"inputs_fingerprint", inputsFingerprint}};
+                   {"aim_emission", aimEmission}, {"sampler", sampler},
+                   {"qmc_bounces", sampler == "sobol" ? json(qmcBounces) : json(nullptr)}, {"seed", seed}, {"threads", threads}, {"inputs_fingerprint", inputsFingerprint}};
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
                   {"degenerate_triangles", degenerateTriangles}, {"animation_diagonal", animationDiagonal}};

@@ -24,6 +24,8 @@ struct TimingLog {
     bool fullRecompute = false;
     bool envelope = true;
     bool aimEmission = true;
+    std::string sampler;
+    uint32_t qmcBounces = 0;  // written only under sobol
     uint64_t photonsMissingScene = 0;  // at the run's first frame
     double emittedFraction = 1;        // LightSampler::emittedFraction
     bool emissionMeasured = false;     // the two above are set (after this run's first frame)

@@ -55,6 +55,13 @@ DetpBoundary parseDetpBoundary(const std::string& name, const std::string& sourc
                      "unknown boundary rule '" + name + "' (clip: default, linear: first-order edge correction, paper: the published rule)");
 }
 
+SamplerKind parseSampler(const std::string& name, const std::string& source) {
+    if (name == "sobol") return SamplerKind::Sobol;
+    if (name == "random") return SamplerKind::Random;
+    throw InputError(source, "sampler",
+                     "unknown sampler '" + name + "' (sobol: scrambled Sobol points, the default; random: hashed numbers)");
+}
+
 std::optional<int> gltfAnimationSelector(const std::string& animation, const std::string& source) {
     if (animation == "gltf") return -1;
     if (animation.rfind("gltf:", 0) != 0) return std::nullopt;
@@ -137,7 +144,7 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
 
 const std::vector<std::string> kConfigKeys = {
     "scene", "animation", "fps", "out", "estimator", "radius", "k", "ray_cache", "sort_queries", "full_recompute", "always_update",
-    "envelope", "aim_emission", "blocking_grid", "detp_index", "detp_boundary", "photons", "seed", "max_bounces", "threads",
+    "envelope", "aim_emission", "blocking_grid", "detp_index", "detp_boundary", "photons", "seed", "max_bounces", "sampler", "qmc_bounces", "threads",
     "frames", "lights", "width", "height", "spp", "exr", "exr_half", "png", "gltf_out", "exposure", "camera"};
 
 void applyConfig(const std::string& path, const json& doc, RenderSettings& s);
@@ -202,6 +209,10 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
         else if (key == "max_bounces")
             s.maxBounces = uint32_t(checkedInteger(jsonInteger(v, path, key), 1, kMaxBounces, path, key,
                                                    " (the bounce field of a segment is 16 bits)"));
+        else if (key == "sampler") s.sampling.kind = parseSampler(str(), path);
+        else if (key == "qmc_bounces")
+            s.sampling.qmcBounces = uint32_t(checkedInteger(jsonInteger(v, path, key), 0, kMaxQmcBounces, path, key,
+                                                            " (the Sobol table covers that many scatterings)"));
         else if (key == "threads")
             s.threads = int(checkedInteger(jsonInteger(v, path, key), 0, kMaxThreads, path, key, " (0: all cores)"));
         else if (key == "frames") {
@@ -260,6 +271,10 @@ void validateSettings(const RenderSettings& s) {
     if (s.scenePath.empty()) throw InputError(cli, "SCENE", "no scene given");
     checkedPhotons(int64_t(std::min<uint64_t>(s.photons, INT64_MAX)), cli, "--photons");
     checkedInteger(s.maxBounces, 1, kMaxBounces, cli, "max_bounces", " (the bounce field of a segment is 16 bits)");
+    // Checked here, after the config and the command line are merged: the bound is max_bounces.
+    checkedInteger(s.sampling.qmcBounces, 0, std::min<int64_t>(s.maxBounces, kMaxQmcBounces),
+                   s.configPath.empty() ? cli : s.configPath + " or the command line", "qmc_bounces",
+                   " (at most max_bounces, and the Sobol table covers 32 scatterings)");
     if (s.radiusGiven && !(s.estimator.radius > 0 && std::isfinite(s.estimator.radius)))
         throw InputError(cli, "--radius", "must be a positive number (scene units)");
     checkedInteger(s.estimator.k, 1, kMaxK, cli, "--k");

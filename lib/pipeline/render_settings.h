@@ -11,6 +11,7 @@
 
 #include "estimate/estimator.h"
 #include "scene/scene.h"
+#include "trace/photon_numbers.h"
 
 namespace qsgi {
 
@@ -30,6 +31,7 @@ struct RenderSettings {
     uint64_t photons = 1000000;
     uint64_t seed = 1;
     uint32_t maxBounces = 32;
+    PhotonSampling sampling;  // sobol with K quasi-random bounces (default) or random
     int threads = 0;  // 0: all cores
     bool fullRecompute = false;  // every frame from scratch instead of the incremental update
     bool alwaysUpdate = false;   // update even frames whose change would cost more than recomputing them
@@ -87,6 +89,7 @@ FrameRange parseFrameRange(const std::string& text, const std::string& source);
 EstimatorKind parseEstimator(const std::string& name, const std::string& source);
 DetpIndex parseDetpIndex(const std::string& name, const std::string& source);
 DetpBoundary parseDetpBoundary(const std::string& name, const std::string& source);
+SamplerKind parseSampler(const std::string& name, const std::string& source);
 
 // 1.5 % of the scene's bounding-box diagonal: a radius that means the same in any unit.
 float defaultRadius(const Scene& scene);

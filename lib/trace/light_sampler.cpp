@@ -15,7 +15,8 @@ constexpr int kMapDepth = 8;
 
 }  // namespace
 
-LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim)
+LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim,
+                           std::optional<uint64_t> dealSeed)
     : scene_(scene), rayEpsilon_(rayEpsilon) {
     const Bounds3f b = scene.animationBounds;
     boundsCentre_ = b.center();
@@ -74,6 +75,28 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         e.photonPower = e.power * float(1.0 / (double(photonCount) * p));
         maxPhotonPower_ = std::max(maxPhotonPower_, maxComponent(e.photonPower));
     }
+    if (dealSeed && !emitters_.empty()) {
+        const double offset = double(mix64(*dealSeed ^ 0xDEA1DEA1DEA1ull) >> 11) * 0x1p-53;
+        firstPhoton_.resize(emitters_.size() + 1);
+        firstPhoton_[0] = 0;
+        for (size_t i = 1; i < emitters_.size(); ++i) {
+            const double share = cdf_[i - 1] / sum;
+            const uint64_t first = uint64_t(std::floor(double(photonCount) * share + offset));
+            firstPhoton_[i] = std::clamp(first, firstPhoton_[i - 1], photonCount);
+        }
+        firstPhoton_.back() = photonCount;
+    }
+}
+
+LightSampler::Deal LightSampler::dealt(uint64_t photon) const {
+    const size_t e = size_t(std::upper_bound(firstPhoton_.begin(), firstPhoton_.end() - 1, photon) - firstPhoton_.begin()) - 1;
+    return {uint32_t(e), uint32_t(photon - firstPhoton_[e])};
+}
+
+size_t LightSampler::chooseEmitter(float u) const {
+    const double target = double(u) * cdf_.back();
+    const size_t i = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), target) - cdf_.begin());
+    return std::min(i, emitters_.size() - 1);
 }
 
 void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
@@ -122,14 +145,24 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
     aims_.push_back(std::move(a));
 }
 
-PhotonEmission LightSampler::sample(const PhotonRandom& rng) const {
+PhotonEmission LightSampler::sample(const PathNumbers& rng) const {
     using namespace rng_dim;
-    const double target = double(rng.uniform(0, kLightChoice)) * cdf_.back();
-    size_t i = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), target) - cdf_.begin());
-    i = std::min(i, emitters_.size() - 1);
-    const Emitter& e = emitters_[i];
-    const float u0 = rng.uniform(0, kEmitPosition0), u1 = rng.uniform(0, kEmitPosition1);
-    const float v0 = rng.uniform(0, kEmitDirection0), v1 = rng.uniform(0, kEmitDirection1);
+    const Emitter& e = emitters_[rng.dealt() ? rng.emitter() : chooseEmitter(rng.uniform(0, kLightChoice))];
+    float u0 = rng.uniform(0, kEmitPosition0), u1 = rng.uniform(0, kEmitPosition1);
+    float v0 = rng.uniform(0, kEmitDirection0), v1 = rng.uniform(0, kEmitDirection1);
+    // Dealt photons take their main pair from the direction dimensions, the Sobol sequence's best
+    // stratified pair: a directional light, which samples only a position, takes it for that.
+    if (rng.dealt() && e.kind == Emitter::Directional) {
+        std::swap(u0, v0);
+        std::swap(u1, v1);
+    }
+    // A projection map's point: from its own cell number and the main pair (random), or from the
+    // main pair alone, the first coordinate's leading bits choosing the cell (dealt: a map's
+    // cells are stratified as the pair is, and so are the points within each cell).
+    auto mapPoint = [&](const ProjectionMap& map, float p0, float p1, double& x, double& y) {
+        if (rng.dealt()) map.sampleStratified(rng.wide(0, kEmitDirection0), rng.uniform(0, kEmitDirection1), x, y);
+        else map.sample(rng.uniform(0, kEmitCell), p0, p1, x, y);
+    };
 
     PhotonEmission out;
     out.power = e.photonPower;
@@ -138,14 +171,14 @@ PhotonEmission LightSampler::sample(const PhotonRandom& rng) const {
         const PunctualLight& l = scene_.lights[e.index];
         double x, y;
         if (e.kind == Emitter::Directional) {
-            a.map.sample(rng.uniform(0, kEmitCell), u0, u1, x, y);
+            mapPoint(a.map, u0, u1, x, y);
             const Vec3d across = a.t * ((2 * x - 1) * a.halfSize) + a.b * ((2 * y - 1) * a.halfSize);
             out.origin = Vec3f(Vec3d(boundsCentre_) + across - a.axis * (2 * a.halfSize));
             out.direction = l.direction;
             return out;
         }
         // uniformCone's parameterisation, in double: the map's cells are exact in it.
-        a.map.sample(rng.uniform(0, kEmitCell), v0, v1, x, y);
+        mapPoint(a.map, v0, v1, x, y);
         const double cosTheta = 1 - x * (1 - a.cosMax), sinTheta = std::sqrt(std::max(0.0, 1 - cosTheta * cosTheta));
         const double phi = 2 * M_PI * y;
         const Vec3d d = normalize(coneDirection(a.axis, a.t, a.b, cosTheta, sinTheta, phi));

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "scene/scene.h"
-#include "trace/counter_rng.h"
+#include "trace/photon_numbers.h"
 #include "trace/projection_map.h"
 
 namespace qsgi {
@@ -30,8 +30,10 @@ struct EmissionAim {
 
 class LightSampler {
 public:
-    // photonCount is the number of photons the power is shared among.
-    LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim = {false, 0});
+    // photonCount is the number of photons the power is shared among. With dealSeed, photons are
+    // dealt to the emitters (dealt()) instead of each choosing one by a random number.
+    LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim = {false, 0},
+                 std::optional<uint64_t> dealSeed = std::nullopt);
 
     bool empty() const { return emitters_.empty(); }
     Vec3f totalPower() const { return totalPower_; }  // W, RGB, that the emitters send
@@ -39,7 +41,18 @@ public:
     // the lights' power that can reach the scene (1 unaimed).
     double emittedFraction() const { return emittedFraction_; }
     float maxPhotonPower() const { return maxPhotonPower_; }
-    PhotonEmission sample(const PhotonRandom& rng) const;
+    PhotonEmission sample(const PathNumbers& numbers) const;
+
+    // Dealing (the Sobol sampler): emitter e receives photons [first_e, first_{e+1}), with
+    // first_e = floor(N · (share of the power before e) + φ) for one offset φ in [0, 1) drawn
+    // from the seed: systematic sampling, so each emitter receives N · its share photons in
+    // expectation (the photon power is unchanged and the estimate unbiased), within one of it
+    // for every seed, and a light's photons are consecutive points of its own sequence.
+    struct Deal {
+        uint32_t emitter;
+        uint32_t index;  // the photon's place among its emitter's
+    };
+    Deal dealt(uint64_t photon) const;
 
 private:
     // A light's projection map and the domain it covers.
@@ -59,11 +72,13 @@ private:
         int aim = -1;     // into aims_, −1: unaimed
     };
     void aimLight(Emitter& e, const EmissionAim& aim);
+    size_t chooseEmitter(float u) const;
 
     const Scene& scene_;
     std::vector<Emitter> emitters_;
     std::vector<Aim> aims_;
     std::vector<double> cdf_;
+    std::vector<uint64_t> firstPhoton_;  // dealing: per emitter, and the photon count last
     Vec3f totalPower_{0.0f};
     double emittedFraction_ = 1;
     float maxPhotonPower_ = 0;

@@ -11,7 +11,9 @@
 namespace qsgi {
 
 PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings)
-    : bvh_(bvh), settings_(settings), lights_(scene, settings.photons, bvh.rayEpsilon(), settings.aim),
+    : bvh_(bvh), settings_(settings),
+      lights_(scene, settings.photons, bvh.rayEpsilon(), settings.aim,
+              settings.sampling.kind == SamplerKind::Sobol ? std::optional<uint64_t>(settings.seed) : std::nullopt),
       bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {
     surfaces_.resize(scene.triangleCount());
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
@@ -20,16 +22,27 @@ PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceS
     }
 }
 
+PathNumbers PhotonTracer::numbersFor(uint64_t path) const {
+    if (settings_.sampling.kind == SamplerKind::Random) return PathNumbers(settings_.seed, path);
+    const LightSampler::Deal deal = lights_.dealt(path);
+    return PathNumbers(settings_.seed, path, deal.emitter, deal.index, settings_.sampling.qmcBounces);
+}
+
 void PhotonTracer::tracePath(uint64_t path, std::vector<Segment>& out) const {
-    const PhotonEmission e = lights_.sample(PhotonRandom(settings_.seed, path));
+    const PathNumbers numbers = numbersFor(path);
+    const PhotonEmission e = lights_.sample(numbers);
     if (!(maxComponent(e.power) > 0)) return;  // a spot light's photon outside its cone: nothing sent
-    continuePath(path, 0, e.origin, e.direction, e.power, 0.0f, out);
+    follow(numbers, path, 0, e.origin, e.direction, e.power, 0.0f, out);
 }
 
 void PhotonTracer::continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power,
                                 float tnear, std::vector<Segment>& out) const {
+    follow(numbersFor(path), path, bounce, origin, direction, power, tnear, out);
+}
+
+void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction,
+                          Vec3f power, float tnear, std::vector<Segment>& out) const {
     using namespace rng_dim;
-    const PhotonRandom rng(settings_.seed, path);
     const float eps = bvh_.rayEpsilon();
     for (; bounce < settings_.maxBounces; ++bounce) {
         Segment s;

@@ -17,6 +17,7 @@ struct TraceSettings {
     uint64_t seed = 1;
     uint32_t maxBounces = 32;
     EmissionAim aim;  // on by default; its margin is the estimator's reach (FrameSolver sets it)
+    PhotonSampling sampling;
 };
 
 class PhotonTracer {
@@ -27,15 +28,20 @@ public:
     // times a second from a reporter thread, and once at the end.
     RayCache traceAll(const std::function<void(uint64_t, uint64_t)>& progress = {}) const;
 
-    // Appends the segments of `path` from segment index `fromBounce` on, continuing from the
-    // state the path had there (origin, direction, power) with the same random numbers.
+    // Appends every segment of `path`.
     void tracePath(uint64_t path, std::vector<Segment>& out) const;
+    // Appends the segments of `path` from bounce `bounce` on, continuing from the state the path
+    // had there (origin, direction, power) with the same numbers.
     void continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power, float tnear,
                       std::vector<Segment>& out) const;
 
     const LightSampler& lights() const { return lights_; }
 
 private:
+    PathNumbers numbersFor(uint64_t path) const;
+    void follow(const PathNumbers& numbers, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power,
+                float tnear, std::vector<Segment>& out) const;
+
     const SceneBvh& bvh_;
     TraceSettings settings_;
     LightSampler lights_;

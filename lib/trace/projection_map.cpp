@@ -184,6 +184,17 @@ void ProjectionMap::sample(float uCell, float u0, float u1, double& x, double& y
     y = (row + double(u1)) * size;
 }
 
+void ProjectionMap::sampleStratified(double u, float v, double& x, double& y) const {
+    const double scaled = u * double(cells_.size());  // exact: u has 32 bits, the cell count at most 2^(2·depth)
+    const size_t k = std::min(cells_.size() - 1, size_t(scaled));
+    const double within = std::min(scaled - double(k), 1.0);
+    const uint32_t cell = cells_[k];
+    const uint32_t row = cell >> depth_, column = cell & ((1u << depth_) - 1);
+    const double size = std::ldexp(1.0, -depth_);
+    x = (column + within) * size;
+    y = (row + double(v)) * size;
+}
+
 ProjectionMap directionMap(const Vec3d& apex, const Vec3d& axis, double cosMax, const Vec3d& extraAxis, double cosExtra,
                            const std::vector<Target>& targets, int depth) {
     // Each target as seen from the apex: a spherical triangle (its corners' directions, the unit

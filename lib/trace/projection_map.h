@@ -62,6 +62,11 @@ public:
     // A point of the unit square, uniform over the kept cells: uCell chooses the cell, (u0, u1)
     // the point in it.
     void sample(float uCell, float u0, float u1, double& x, double& y) const;
+    // The same from a stratified pair (u, v): the kept cells laid end to end in row-major order
+    // cover u's range in equal parts, u's place within its part is the column coordinate in the
+    // cell and v the row coordinate. Points stratified in (u, v) stay stratified over the cells
+    // and within each.
+    void sampleStratified(double u, float v, double& x, double& y) const;
 
 private:
     int depth_ = 0;
