@@ -126,8 +126,12 @@ void BM_DiscRegions(benchmark::State& state) {
 void BM_TracePhotons(benchmark::State& state) {
     CornellFixture& f = fixture();
     const uint64_t photons = uint64_t(state.range(0));
+    // Second argument: the sampler (0 Sobol with the default K, 1 random): the Sobol points'
+    // cost beside the hashed numbers'.
+    PhotonSampling sampling;
+    if (state.range(1) == 1) sampling.kind = SamplerKind::Random;
     SceneBvh bvh(f.device, f.scene);
-    const PhotonTracer tracer(f.scene, bvh, TraceSettings{photons, 1, 32, EmissionAim{}, PhotonSampling{}});
+    const PhotonTracer tracer(f.scene, bvh, TraceSettings{photons, 1, 32, EmissionAim{}, sampling});
     size_t segments = 0;
     for (auto _ : state) {
         const RayCache cache = tracer.traceAll();
@@ -403,7 +407,11 @@ void BM_FlightHelmetDetpWaste(benchmark::State& state) {
 BENCHMARK(BM_FlightHelmetEmission)->Args({0, 0})->Args({1, 0})->Args({1, 13})->ArgNames({"aim", "margin_mm"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FlightHelmetDetpWaste)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_TracePhotons)->Arg(100000)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_TracePhotons)
+    ->ArgNames({"photons", "random"})
+    ->ArgsProduct({{100000, 1000000, 10000000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_EmbreeClosestHitCeiling)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DetpSegments)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -4,6 +4,9 @@
 // and for the ceiling-panel scene the ceiling above the panel — must stay within bounds set from
 // measured values: the error at seed 1 plus a margin of three times its change between seeds 1
 // and 2 (the noise), and at least 0.005. A regression in any estimator's definition fails here.
+// The bounds were set again under the Sobol sampler (issue 20), whose photons lowered most errors,
+// and each kept at its earlier (random-photon) value where that was the tighter one. The corner
+// scene's near-edge region is empty (its grid spacing, 0.083, exceeds the radius).
 // SCENES ARE FROZEN WITH THEIR REFERENCES: regenerate both (scripts/reference.py) if a scene changes.
 #include <gtest/gtest.h>
 
@@ -61,6 +64,12 @@ Figures measure(const Scene& scene, const RayCache& cache, const VertexRadiosity
 
 }  // namespace
 
+// The test's name: the reference's file name without "_f0000.ply".
+std::string caseName(const Case& c) {
+    const std::string file = c.reference;
+    return file.substr(0, file.find("_f0000"));
+}
+
 class ReferenceAccuracy : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ReferenceAccuracy, EveryEstimatorStaysWithinItsMeasuredError) {
@@ -101,14 +110,20 @@ INSTANTIATE_TEST_SUITE_P(
     Scenes, ReferenceAccuracy,
     ::testing::Values(Case{"data/cornell/cornell.gltf",
                            "cornell_f0000.ply",
-                           {{"impact count", 0.083, 0.024, 0.019, 0.082, 0},
-                            {"photon map", 0.188, 0.025, 0.034, 0.196, 0},
-                            {"DETP clip", 0.073, 0.022, 0.035, 0.052, 0},
-                            {"DETP linear", 0.074, 0.038, 0.049, 0.052, 0}}},
+                           {{"impact count", 0.073, 0.012, 0.019, 0.07, 0},
+                            {"photon map", 0.17, 0.01, 0.023, 0.181, 0},
+                            {"DETP clip", 0.045, 0.016, 0.024, 0.041, 0},
+                            {"DETP linear", 0.049, 0.005, 0.01, 0.041, 0}}},
                       Case{"tests/scenes/ceiling_panel/ceiling_panel.gltf",
                            "ceiling_panel_f0000.ply",
-                           {{"impact count", 0.074, 0.028, 0.218, 0.035, 5.06},
-                            {"photon map", 0.215, 0.063, 0.943, 0.146, 5.14},
-                            {"DETP clip", 0.059, 0.017, 0.221, 0.042, 5.14},
-                            {"DETP linear", 0.064, 0.008, 0.277, 0.042, 5.14}}}),
-    [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.index == 0 ? "cornell" : "ceiling_panel"); });
+                           {{"impact count", 0.065, 0.016, 0.218, 0.028, 5.06},
+                            {"photon map", 0.215, 0.053, 0.943, 0.143, 5.14},
+                            {"DETP clip", 0.038, 0.012, 0.061, 0.033, 5.14},
+                            {"DETP linear", 0.042, 0.006, 0.098, 0.033, 5.14}}},
+                      Case{"tests/scenes/corner_point_light.gltf",
+                           "corner_point_light_f0000.ply",
+                           {{"impact count", 0.028, 0.065, 0.005, 0.018, 0},
+                            {"photon map", 0.093, 0.055, 0.005, 0.091, 0},
+                            {"DETP clip", 0.028, 0.033, 0.005, 0.024, 0},
+                            {"DETP linear", 0.031, 0.024, 0.005, 0.024, 0}}}),
+    [](const ::testing::TestParamInfo<Case>& info) { return caseName(info.param); });

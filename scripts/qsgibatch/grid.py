@@ -1,21 +1,30 @@
 """The sweep config (configs/sweep-*.json) and the grid points it names.
 
 A point is one qsgi render: estimator, boundary rule, photons, radius (as a fraction of the
-animation's bounding-box diagonal, so one config fits any scale), k, update strategy and frames.
-Three families: `accuracy` (the grid the plots of the trade are drawn from), `full` (the same
-renders with --full-recompute at one radius: the second line style of the Pareto plot) and
-`extreme` (radius from 1e-6 of the diagonal to all of it, photons from 1 up: stability)."""
+animation's bounding-box diagonal, so one config fits any scale), k, update strategy, frames and
+photon sampler. Three families: `accuracy` (the grid the plots of the trade are drawn from, for
+every sampler of grid.samplers), `full` (the same renders with --full-recompute at one radius: the
+second line style of the Pareto plot) and `extreme` (radius from 1e-6 of the diagonal to all of
+it, photons from 1 up: stability); those two use the first sampler of the list only.
+
+The `grid` keys: photons, radius_fraction, k (photon map; default [50]), estimators,
+full_recompute_radius_fraction (default 0.015) and samplers: a list of "random", "sobol" (qsgi's
+default number of Sobol bounces: no --qmc-bounces) or "sobol:K" (--qmc-bounces K, 0..32); default
+["sobol"], qsgi's default sampler."""
 import dataclasses
 import json
 import math
 import os
+import re
 
 ESTIMATORS = ("impact-count", "photon-map", "photon-map:paper", "detp", "detp:clip", "detp:linear", "detp:paper")
 DEFAULT_K = 50
 DEFAULT_RADIUS_FRACTION = 0.015  # qsgi's default radius (render_settings.cpp: defaultRadius)
 KNOWN_KEYS = {"scene", "animation", "reference", "frames", "seeds", "grid", "extremes", "quick",
               "reference_build", "jobs"}
-GRID_KEYS = {"photons", "radius_fraction", "k", "estimators", "full_recompute_radius_fraction"}
+GRID_KEYS = {"photons", "radius_fraction", "k", "estimators", "full_recompute_radius_fraction", "samplers"}
+DEFAULT_SAMPLER = "sobol"  # qsgi's default sampler, at its default --qmc-bounces
+MAX_QMC_BOUNCES = 32       # qsgi render --qmc-bounces: 0..32 (and at most max_bounces, 32 by default)
 EXTREME_KEYS = {"radius_fraction", "radius_photons", "photons", "estimators"}
 REFERENCE_KEYS = {"photons", "seeds", "radius_fraction"}
 
@@ -34,6 +43,7 @@ class Point:
     k: int                # photon map only (0 otherwise)
     full_recompute: bool
     frames: str           # "A:B"
+    sampler: str = DEFAULT_SAMPLER  # random | sobol (qsgi's default K) | sobol:K
 
     @property
     def label(self) -> str:
@@ -53,6 +63,8 @@ class Point:
         parts.append("f" + self.frames.replace(":", "-"))
         if self.full_recompute:
             parts.append("full")
+        if self.sampler != DEFAULT_SAMPLER:  # the default's names are those points had before samplers
+            parts.append(self.sampler.replace(":", "-"))
         return "_".join(parts)
 
     def qsgi_options(self, diagonal: float) -> list:
@@ -65,6 +77,10 @@ class Point:
             options += ["--k", str(self.k)]
         if self.full_recompute:
             options.append("--full-recompute")
+        sampler, _, bounces = self.sampler.partition(":")
+        options += ["--sampler", sampler]
+        if bounces:
+            options += ["--qmc-bounces", bounces]
         return options
 
 
@@ -119,6 +135,19 @@ def _estimator(path, where, value):
     return name, ("" if name == "impact-count" else rule or "clip")
 
 
+def _sampler(path, where, value):
+    match = re.fullmatch(r"(random|sobol)(?::([0-9]+))?", value) if isinstance(value, str) else None
+    if not match or match.group(1) == "random" and match.group(2) is not None:
+        _fail(path, where, f"unknown sampler {json.dumps(value)} (known: \"random\", \"sobol\", "
+                           f"\"sobol:K\" with K in 0..{MAX_QMC_BOUNCES})")
+    if match.group(2) is None:
+        return match.group(1)
+    bounces = int(match.group(2))
+    if bounces > MAX_QMC_BOUNCES:
+        _fail(path, where, f"\"sobol:K\" needs K in 0..{MAX_QMC_BOUNCES}, not {json.dumps(value)}")
+    return f"sobol:{bounces}"
+
+
 def _frames(path, where, value):
     try:
         a, b = (int(x) for x in str(value).split(":"))
@@ -144,22 +173,25 @@ def _grid_points(path, grid, frames):
     estimators = _list(path, "grid.estimators", grid.get("estimators"), _estimator)
     full_radius = _fraction(path, "grid.full_recompute_radius_fraction",
                             grid.get("full_recompute_radius_fraction", DEFAULT_RADIUS_FRACTION))
+    samplers = list(dict.fromkeys(_list(path, "grid.samplers", grid.get("samplers", [DEFAULT_SAMPLER]), _sampler)))
+    first = samplers[0]  # the full and extreme families' sampler
     points = []
     for name, rule in estimators:
         for n in photons:
             if name == "impact-count":
-                points.append(Point("accuracy", name, rule, n, 0.0, 0, False, frames))
-                points.append(Point("full", name, rule, n, 0.0, 0, True, frames))
+                points += [Point("accuracy", name, rule, n, 0.0, 0, False, frames, s) for s in samplers]
+                points.append(Point("full", name, rule, n, 0.0, 0, True, frames, first))
                 continue
-            for r in radii:
-                for k in (ks if name == "photon-map" else [0]):
-                    points.append(Point("accuracy", name, rule, n, r, k, False, frames))
+            for s in samplers:
+                for r in radii:
+                    for k in (ks if name == "photon-map" else [0]):
+                        points.append(Point("accuracy", name, rule, n, r, k, False, frames, s))
             k = DEFAULT_K if name == "photon-map" else 0
-            points.append(Point("full", name, rule, n, full_radius, k, True, frames))
-    return points
+            points.append(Point("full", name, rule, n, full_radius, k, True, frames, first))
+    return points, first
 
 
-def _extreme_points(path, extremes):
+def _extreme_points(path, extremes, sampler):
     _check_keys(path, "extremes", extremes, EXTREME_KEYS)
     radii = _list(path, "extremes.radius_fraction", extremes.get("radius_fraction"), _fraction)
     radius_photons = _count(path, "extremes.radius_photons", extremes.get("radius_photons", 100000))
@@ -171,9 +203,9 @@ def _extreme_points(path, extremes):
     for name, rule in estimators:
         k = DEFAULT_K if name == "photon-map" else 0
         if name != "impact-count":
-            points += [Point("extreme", name, rule, radius_photons, r, k, False, "0:0") for r in radii]
+            points += [Point("extreme", name, rule, radius_photons, r, k, False, "0:0", sampler) for r in radii]
         points += [Point("extreme", name, rule, n, DEFAULT_RADIUS_FRACTION if name != "impact-count" else 0.0,
-                         k, False, "0:0") for n in photons]
+                         k, False, "0:0", sampler) for n in photons]
     return points
 
 
@@ -209,9 +241,9 @@ def load(path: str, quick: bool) -> SweepConfig:
     reference_build = raw.get("reference_build", {})
     _check_keys(path, "reference_build", reference_build, REFERENCE_KEYS)
     grid = raw.get("grid") or _fail(path, "grid", "missing")
-    points = _grid_points(path, grid, frames)
+    points, first_sampler = _grid_points(path, grid, frames)
     if "extremes" in raw:
-        points += _extreme_points(path, raw["extremes"])
+        points += _extreme_points(path, raw["extremes"], first_sampler)
     unique = list(dict.fromkeys(points))
     smallest = min(p.radius_fraction for p in points if p.family == "accuracy" and p.radius_fraction) \
         if any(p.radius_fraction for p in points if p.family == "accuracy") else DEFAULT_RADIUS_FRACTION

@@ -1,6 +1,8 @@
 """The sweep's plots, drawn from sweep.csv alone (so a merge job can draw them from rows that other
 machines computed). Every axis names its quantity and unit; errors are relative to the
-reference's mean radiosity at frame 0, times are per frame on this machine."""
+reference's mean radiosity at frame 0, times are per frame on this machine. Rows of different
+photon samplers (the CSV's `sampler`) are never joined into one line: each plot draws one series
+per estimator and sampler (colour: estimator; line style and marker: sampler) or one panel each."""
 import math
 import os
 
@@ -16,8 +18,26 @@ ERROR_AXIS = "relative RMS error at frame 0"
 MIN_PHOTONS_FOR_SLOPE = 1e4  # below, the fixed cost per frame (regions, setup) hides the growth
 
 
+# Per sampler, in the order the rows name them: (line style, marker). "s" (square) is left to the
+# --full-recompute lines.
+SAMPLER_STYLES = [("-", "o"), (":", "^"), ("-.", "v"), ((0, (5, 1, 1, 1, 1, 1)), "D"), ((0, (1, 3)), "P")]
+
+
 def _estimators(rows):
     return list(dict.fromkeys(r["estimator"] for r in rows))
+
+
+def _samplers(rows):
+    return list(dict.fromkeys(r["sampler"] for r in rows))
+
+
+def _sampler_styles(samplers):
+    return {s: SAMPLER_STYLES[i % len(SAMPLER_STYLES)] for i, s in enumerate(samplers)}
+
+
+def _legend(axis, **options):
+    if axis.get_legend_handles_labels()[0]:
+        axis.legend(**options)
 
 
 def _finite(values):
@@ -40,38 +60,45 @@ def _colours(names):
 
 
 def error_vs_photons(rows, out, note):
+    """One panel per estimator (columns) and sampler (rows)."""
     accuracy = [r for r in rows if r["family"] == "accuracy"]
-    estimators = _estimators(accuracy)
-    figure, axes = plt.subplots(1, len(estimators), figsize=(4.2 * len(estimators), 3.8), squeeze=False, sharey=True)
-    for axis, name in zip(axes[0], estimators):
-        mine = [r for r in accuracy if r["estimator"] == name]
-        ks = sorted({r["k"] for r in mine if not math.isnan(r["k"])})
-        default_k = 50.0 if 50.0 in ks else (ks[0] if ks else math.nan)
-        curves = {}
-        for r in mine:
-            if not math.isnan(r["k"]) and r["k"] != default_k:
-                continue
-            curves.setdefault(r["radius_fraction"], []).append(r)
-        for fraction, points in sorted(curves.items()):
-            points.sort(key=lambda r: r["photons"])
-            label = f"r = {100 * fraction:g} % of diagonal" if fraction else "no radius"
-            axis.plot([r["photons"] for r in points], [r["rms_all"] for r in points], "o-", label=label, ms=3)
-        if len(ks) > 1:  # photon map: k at the middle radius, dashed
-            radii = sorted({r["radius_fraction"] for r in mine})
-            middle = radii[len(radii) // 2]
-            for k in ks:
-                if k == default_k:
-                    continue
-                points = sorted((r for r in mine if r["k"] == k and r["radius_fraction"] == middle),
-                                key=lambda r: r["photons"])
-                axis.plot([r["photons"] for r in points], [r["rms_all"] for r in points], "x--", ms=4,
-                          label=f"k = {k:g}, r = {100 * middle:g} %")
-        axis.set(xscale="log", yscale="log", title=name + (f" (k = {default_k:g})" if ks else ""),
-                 xlabel="photons per frame")
-        axis.grid(True, which="both", alpha=0.3)
-        axis.legend(fontsize=7)
-    axes[0][0].set_ylabel(ERROR_AXIS)
+    estimators, samplers = _estimators(accuracy), _samplers(accuracy)
+    figure, axes = plt.subplots(len(samplers), len(estimators), figsize=(4.2 * len(estimators), 3.8 * len(samplers)),
+                                squeeze=False, sharey=True)
+    for row, sampler in zip(axes, samplers):
+        for axis, name in zip(row, estimators):
+            _error_vs_photons_panel(axis, [r for r in accuracy if r["estimator"] == name and r["sampler"] == sampler],
+                                    name, sampler)
+        row[0].set_ylabel(ERROR_AXIS)
     return _save(figure, out, "error_vs_photons.png", note)
+
+
+def _error_vs_photons_panel(axis, mine, name, sampler):
+    ks = sorted({r["k"] for r in mine if not math.isnan(r["k"])})
+    default_k = 50.0 if 50.0 in ks else (ks[0] if ks else math.nan)
+    curves = {}
+    for r in mine:
+        if not math.isnan(r["k"]) and r["k"] != default_k:
+            continue
+        curves.setdefault(r["radius_fraction"], []).append(r)
+    for fraction, points in sorted(curves.items()):
+        points.sort(key=lambda r: r["photons"])
+        label = f"r = {100 * fraction:g} % of diagonal" if fraction else "no radius"
+        axis.plot([r["photons"] for r in points], [r["rms_all"] for r in points], "o-", label=label, ms=3)
+    if len(ks) > 1:  # photon map: k at the middle radius, dashed
+        radii = sorted({r["radius_fraction"] for r in mine})
+        middle = radii[len(radii) // 2]
+        for k in ks:
+            if k == default_k:
+                continue
+            points = sorted((r for r in mine if r["k"] == k and r["radius_fraction"] == middle),
+                            key=lambda r: r["photons"])
+            axis.plot([r["photons"] for r in points], [r["rms_all"] for r in points], "x--", ms=4,
+                      label=f"k = {k:g}, r = {100 * middle:g} %")
+    axis.set(xscale="log", yscale="log", title=f"{name}, {sampler} sampler" + (f" (k = {default_k:g})" if ks else ""),
+             xlabel="photons per frame")
+    axis.grid(True, which="both", alpha=0.3)
+    _legend(axis, fontsize=7)
 
 
 def _pareto_front(points):
@@ -86,25 +113,32 @@ def _pareto_front(points):
 
 def pareto(rows, out, note):
     timed = [r for r in rows if r["family"] in ("accuracy", "full") and not math.isnan(r["median_frame_s"])]
-    estimators = _estimators(timed)
-    colours = _colours(estimators)
-    figure, axis = plt.subplots(figsize=(7.5, 5))
+    estimators, samplers = _estimators(timed), _samplers(timed)
+    colours, styles = _colours(estimators), _sampler_styles(samplers)
+    figure, axis = plt.subplots(figsize=(7.5 if len(samplers) == 1 else 10.5, 5))
     for name in estimators:
-        incremental = [r for r in timed if r["estimator"] == name and r["family"] == "accuracy"]
-        full = [r for r in timed if r["estimator"] == name and r["family"] == "full"]
-        axis.scatter([r["median_frame_s"] for r in incremental], [r["rms_all"] for r in incremental], s=8,
-                     color=colours[name], alpha=0.35)
-        front = _pareto_front(incremental)
-        axis.plot([r["median_frame_s"] for r in front], [r["rms_all"] for r in front], "-", color=colours[name],
-                  label=f"{name}, incremental (front)")
-        full.sort(key=lambda r: r["median_frame_s"])
-        if full:
-            axis.plot([r["median_frame_s"] for r in full], [r["rms_all"] for r in full], "--", marker="s", ms=3,
-                      color=colours[name], label=f"{name}, --full-recompute")
+        for sampler in samplers:
+            line, marker = styles[sampler]
+            mine = [r for r in timed if r["estimator"] == name and r["sampler"] == sampler]
+            incremental = [r for r in mine if r["family"] == "accuracy"]
+            full = sorted((r for r in mine if r["family"] == "full"), key=lambda r: r["median_frame_s"])
+            if incremental:
+                axis.scatter([r["median_frame_s"] for r in incremental], [r["rms_all"] for r in incremental], s=9,
+                             marker=marker, color=colours[name], alpha=0.35)
+                front = _pareto_front(incremental)
+                axis.plot([r["median_frame_s"] for r in front], [r["rms_all"] for r in front], linestyle=line,
+                          marker=marker, ms=3, color=colours[name], label=f"{name}, {sampler}: incremental (front)")
+            if full:
+                axis.plot([r["median_frame_s"] for r in full], [r["rms_all"] for r in full], "--", marker="s", ms=3,
+                          color=colours[name], label=f"{name}, {sampler}: --full-recompute")
     axis.set(xscale="log", yscale="log", xlabel="median time per frame after the first (s)", ylabel=ERROR_AXIS,
              title="The trade: error against time per frame (lower left is better)")
     axis.grid(True, which="both", alpha=0.3)
-    axis.legend(fontsize=7)
+    if len(samplers) == 1:
+        _legend(axis, fontsize=7)
+    else:  # a series per estimator and sampler: beside the plot, not over it
+        _legend(axis, fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1), title="estimator, sampler: kind",
+                title_fontsize=7)
     return _save(figure, out, "pareto.png", note)
 
 
@@ -119,29 +153,38 @@ def fitted_slope(photons, seconds):
 
 
 def time_vs_photons(rows, out, note):
+    """Per estimator: the --full-recompute points and the incremental ones at their radius (k = 50),
+    one line per sampler; the slopes are keyed (estimator, "full|incremental, SAMPLER")."""
     full_rows = [r for r in rows if r["family"] == "full"]
     estimators = _estimators(full_rows)
-    colours = _colours(estimators)
+    samplers = _samplers([r for r in rows if r["family"] in ("full", "accuracy")])
+    colours, styles = _colours(estimators), _sampler_styles(samplers)
     figure, axis = plt.subplots(figsize=(7.5, 5))
     slopes = {}
     for name in estimators:
-        full = sorted((r for r in full_rows if r["estimator"] == name), key=lambda r: r["photons"])
-        fraction = full[0]["radius_fraction"] if full else math.nan
-        incremental = sorted((r for r in rows if r["family"] == "accuracy" and r["estimator"] == name and
-                              (r["radius_fraction"] == fraction or (math.isnan(fraction) or not fraction))
-                              and (math.isnan(r["k"]) or r["k"] == 50)), key=lambda r: r["photons"])
-        for points, style, kind in ((full, "--s", "full"), (incremental, "-o", "incremental")):
-            if not points:
-                continue
-            n, t = [r["photons"] for r in points], [r["median_frame_s"] for r in points]
-            slope = fitted_slope(n, t)
-            slopes[(name, kind)] = slope
-            axis.plot(n, t, style, ms=3, color=colours[name],
-                      label=f"{name}, {kind}: slope {slope:.2f}" if not math.isnan(slope) else f"{name}, {kind}")
+        fraction = next((r["radius_fraction"] for r in full_rows if r["estimator"] == name), math.nan)
+        for sampler in samplers:
+            line, marker = styles[sampler]
+            full = sorted((r for r in full_rows if r["estimator"] == name and r["sampler"] == sampler),
+                          key=lambda r: r["photons"])
+            incremental = sorted((r for r in rows if r["family"] == "accuracy" and r["estimator"] == name and
+                                  r["sampler"] == sampler and
+                                  (r["radius_fraction"] == fraction or (math.isnan(fraction) or not fraction))
+                                  and (math.isnan(r["k"]) or r["k"] == 50)), key=lambda r: r["photons"])
+            for points, style, kind in ((full, dict(linestyle="--", marker="s"), "full"),
+                                        (incremental, dict(linestyle=line, marker=marker), "incremental")):
+                if not points:
+                    continue
+                n, t = [r["photons"] for r in points], [r["median_frame_s"] for r in points]
+                slope = fitted_slope(n, t)
+                slopes[(name, f"{kind}, {sampler}")] = slope
+                label = f"{name}, {sampler}: {kind}"
+                axis.plot(n, t, ms=3, color=colours[name], **style,
+                          label=f"{label}, slope {slope:.2f}" if not math.isnan(slope) else label)
     axis.set(xscale="log", yscale="log", xlabel="photons per frame", ylabel="median time per frame (s)",
              title=f"Frame time against photons (slope fitted from {MIN_PHOTONS_FOR_SLOPE:.0e} photons up)")
     axis.grid(True, which="both", alpha=0.3)
-    axis.legend(fontsize=7)
+    _legend(axis, fontsize=7)
     return _save(figure, out, "time_vs_photons.png", note), slopes
 
 
@@ -151,21 +194,25 @@ def bias_vs_radius(rows, out, note):
     if not accuracy:
         return None
     most = max(r["photons"] for r in accuracy)
-    estimators = _estimators(accuracy)
-    colours = _colours(estimators)
+    estimators, samplers = _estimators(accuracy), _samplers(accuracy)
+    colours, styles = _colours(estimators), _sampler_styles(samplers)
     figure, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
     for axis, region, title in ((axes[0], "near_edge", "within one radius of an edge"),
                                 (axes[1], "interior", "interior")):
         for name in estimators:
-            points = sorted((r for r in accuracy if r["estimator"] == name and r["photons"] == most),
-                            key=lambda r: r["radius_fraction"])
-            axis.plot([100 * r["radius_fraction"] for r in points], [r[f"bias_{region}"] for r in points], "o-",
-                      ms=3, color=colours[name], label=name)
+            for sampler in samplers:
+                points = sorted((r for r in accuracy if r["estimator"] == name and r["sampler"] == sampler
+                                 and r["photons"] == most), key=lambda r: r["radius_fraction"])
+                if not points:
+                    continue
+                line, marker = styles[sampler]
+                axis.plot([100 * r["radius_fraction"] for r in points], [r[f"bias_{region}"] for r in points],
+                          linestyle=line, marker=marker, ms=3, color=colours[name], label=f"{name}, {sampler}")
         axis.axhline(0, color="black", lw=0.6)
         axis.set(xscale="log", xlabel="radius (% of the scene diagonal)", title=f"{title}, {most:.0e} photons")
         axis.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("relative bias at frame 0 (signed)")
-    axes[0].legend(fontsize=7)
+    _legend(axes[0], fontsize=7)
     return _save(figure, out, "bias_vs_radius.png", note)
 
 
@@ -176,6 +223,7 @@ def extremes(rows, out, note):
     bad = int(sum(r["nan_count"] + r["inf_count"] for r in extreme))
     estimators = _estimators(extreme)
     colours = _colours(estimators)
+    sampler = ", ".join(_samplers(extreme)) + " sampler"  # one: the grid's first
     figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     radius_photons = min((r["photons"] for r in extreme if r["radius_fraction"] != DEFAULT_RADIUS_FRACTION and r["radius_fraction"]),
                          default=math.nan)
@@ -195,12 +243,12 @@ def extremes(rows, out, note):
                      color=colours[name], label=f"{name}: noise")
     axes[0].set(xscale="log", yscale="log", xlabel="radius (fraction of the scene diagonal)",
                 ylabel="relative error at frame 0",
-                title=f"Radius extremes, {radius_photons:.0e} photons\n(no photon in a disc: estimate 0, noise 0, bias -100 %)")
+                title=f"Radius extremes, {radius_photons:.0e} photons, {sampler}\n(no photon in a disc: estimate 0, noise 0, bias -100 %)")
     axes[1].set(xscale="log", yscale="log", xlabel="photons per frame", ylabel=ERROR_AXIS,
-                title="Photon extremes, default radius (1.5 % of the diagonal)")
+                title=f"Photon extremes, default radius (1.5 % of the diagonal)\n{sampler}")
     for axis in axes:
         axis.grid(True, which="both", alpha=0.3)
-        axis.legend(fontsize=6)
+        _legend(axis, fontsize=6)
     return _save(figure, out, "extremes.png", f"{note}   NaN/Inf values in every PLY: {bad}")
 
 

@@ -11,6 +11,7 @@ import glob
 import json
 import math
 import os
+import shutil
 import statistics
 import threading
 import time
@@ -20,7 +21,7 @@ import numpy as np
 from . import ply
 from .grid import DEFAULT_RADIUS_FRACTION
 
-RESULT_VERSION = 1
+RESULT_VERSION = 2  # 2: points have a sampler (results of 1 came from qsgi before Sobol: random photons)
 
 
 class Occupancy:
@@ -108,6 +109,31 @@ def _noise(a: str, b: str, reference: np.ndarray) -> float:
     return rms / mean if mean > 0 else rms
 
 
+def _discard_other_sampler(run, point):
+    """Removes a render folder left by another sampler (or by qsgi before samplers: no "sampler" in
+    its timing.json), which `qsgi render --resume` would refuse as rendered from other settings."""
+    try:
+        with open(os.path.join(run, "timing.json")) as f:
+            config = json.load(f)["config"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return  # nothing rendered yet, or nothing to judge by: qsgi decides
+    sampler, _, bounces = point.sampler.partition(":")
+    if config.get("sampler") != sampler or bounces and config.get("qmc_bounces") != int(bounces):
+        shutil.rmtree(run)
+
+
+def finished(out, point):
+    """The point's result.json if there is one of this result version and the point's sampler, else
+    None (whatever its reference: Sweep.cached checks that too)."""
+    path = os.path.join(out, "points", point.name, "result.json")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        result = json.load(f)
+    same = result.get("result_version") == RESULT_VERSION and result.get("sampler") == point.sampler
+    return result if same else None
+
+
 class Sweep:
     def __init__(self, config, qsgi, out, diagonal, reference_path, reference_description, jobs, cores):
         self.config, self.qsgi, self.out, self.diagonal = config, qsgi, out, diagonal
@@ -123,13 +149,8 @@ class Sweep:
 
     def cached(self, point):
         """The point's result if it was computed with this reference and this qsgi, else None."""
-        path = os.path.join(self.folder(point), "result.json")
-        if not os.path.exists(path):
-            return None
-        with open(path) as f:
-            result = json.load(f)
-        same = result.get("result_version") == RESULT_VERSION and result.get("reference") == self.reference_description
-        return result if same else None
+        result = finished(self.out, point)
+        return result if result is not None and result.get("reference") == self.reference_description else None
 
     def run(self, point) -> dict:
         result = self.cached(point)
@@ -157,6 +178,8 @@ class Sweep:
         folder = self.folder(point)
         run = os.path.join(folder, "run")
         seed, second_seed = self.config.seeds
+        for previous in (run, os.path.join(folder, "seed2")):
+            _discard_other_sampler(previous, point)
         timing = self.qsgi.render(run, point.qsgi_options(self.diagonal), seed, self.threads)
         radius = (point.radius_fraction or DEFAULT_RADIUS_FRACTION) * self.diagonal
         frame0 = os.path.join(run, "frame_0000.ply")
@@ -174,7 +197,9 @@ class Sweep:
         for path in plys:
             n, i = ply.count_non_finite(path)
             nan, inf = nan + n, inf + i
+        bounces = timing["config"].get("qmc_bounces")  # qsgi's K (its default for plain "sobol"); null: random
         result = {"result_version": RESULT_VERSION, "family": point.family, "estimator": point.label,
+                  "sampler": point.sampler, "qmc_bounces": math.nan if bounces is None else bounces,
                   "photons": point.photons, "radius_fraction": point.radius_fraction,
                   "radius": point.radius_fraction * self.diagonal if point.radius_fraction else math.nan,
                   "k": point.k or math.nan, "full_recompute": point.full_recompute, "frames": point.frames,

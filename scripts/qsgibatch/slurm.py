@@ -10,6 +10,8 @@ import shlex
 import subprocess
 import sys
 
+from .runner import finished
+
 
 class SlurmError(Exception):
     pass
@@ -71,8 +73,7 @@ def submit_sweep(args, config, script) -> int:
     command = [python_executable(), script, os.path.abspath(config.path), "--out", out, "--qsgi", os.path.abspath(args.qsgi),
                "--cores", str(cpus)] + (["--quick"] if args.quick else []) + \
         (["--max-photons", repr(args.max_photons)] if args.max_photons is not None else [])  # the same point indices
-    missing = [i for i, p in enumerate(config.points)
-               if not os.path.exists(os.path.join(out, "points", p.name, "result.json"))]
+    missing = [i for i, p in enumerate(config.points) if finished(out, p) is None]
     try:
         prepare = sbatch("qsgi-sweep-prepare", shlex.join(command + ["--prepare"]), logs, args.slurm_option,
                          cpus=cpus)

@@ -5,7 +5,7 @@ import os
 
 COLUMNS = [
     # parameters
-    "family", "estimator", "photons", "radius_fraction", "radius", "k", "full_recompute", "frames", "seed",
+    "family", "estimator", "sampler", "qmc_bounces", "photons", "radius_fraction", "radius", "k", "full_recompute", "frames", "seed",
     "noise_seed",
     # error against the reference at frame 0 (relative to the reference's mean; bias signed)
     "rms_all", "bias_all", "rms_edge", "bias_edge", "rms_near_edge", "bias_near_edge", "rms_interior",
