@@ -81,7 +81,7 @@ public:
 private:
     uint32_t scrambled(int d) const {
         const uint32_t seed = uint32_t(mix64(scrambleKey_ ^ (uint64_t(d) + 1) * 0x9E3779B97F4A7C15ull));
-        return owenScramble(sobol_->bits(index_, d), seed);
+        return reverseBits32(owenScrambleReversed(sobol_->reversedBits(index_, d), seed));
     }
 
     PhotonRandom hashed_;

@@ -10,12 +10,13 @@ const SobolSequence& SobolSequence::instance() {
 }
 
 SobolSequence::SobolSequence() {
+    std::array<std::array<uint32_t, 32>, kDimensions> directions;
     // Dimension 0: van der Corput, every m_j = 1.
-    for (int j = 0; j < 32; ++j) directions_[0][std::size_t(j)] = 1u << (31 - j);
+    for (int j = 0; j < 32; ++j) directions[0][std::size_t(j)] = 1u << (31 - j);
     for (int d = 1; d < kDimensions; ++d) {
         const JoeKuoRow& row = kJoeKuoRows[d - 1];
         const int s = row.degree;
-        std::array<uint32_t, 32>& v = directions_[std::size_t(d)];
+        std::array<uint32_t, 32>& v = directions[std::size_t(d)];
         for (int j = 0; j < 32; ++j) {
             if (j < s) {
                 v[std::size_t(j)] = uint32_t(row.initial[j]) << (31 - j);
@@ -28,6 +29,8 @@ SobolSequence::SobolSequence() {
             v[std::size_t(j)] = x;
         }
     }
+    for (int d = 0; d < kDimensions; ++d)
+        for (int j = 0; j < 32; ++j) reversedDirections_[std::size_t(d)][std::size_t(j)] = reverseBits32(directions[std::size_t(d)][std::size_t(j)]);
 }
 
 const char* samplerName(SamplerKind kind) { return kind == SamplerKind::Sobol ? "sobol" : "random"; }
