@@ -20,4 +20,5 @@ cd build-asan
 statistical='DetpBoundary\.(InsideCorner|OpenEdgeOfAFloor|OutsideOfASphere|FloorBesideABox)'
 statistical+='|Estimators\.(PaperRuleMatches|PlaneUnderPointLight|ClosedSphereGives|DetpAndPhotonMapAreIndependentOfTessellation)'
 statistical+='|Incremental\.(NoDriftOverTenThousandFrames|RememberedCrossingsLeaveNoTraceAfterAThousandFrames)|Sweep\.TinyGrid|ReferenceAccuracy'
+statistical+='|Sobol\.AgreesWith'
 ctest --output-on-failure -j 2 -E "$statistical" "$@"
