@@ -77,9 +77,11 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.noEnvelope) s.useEnvelope = false;
     if (o.noAim) s.aimEmission = false;
     if (!o.sampler.empty()) s.sampling.kind = qsgi::parseSampler(o.sampler, cli);
-    if (o.qmcBounces)
+    if (o.qmcBounces) {
         s.sampling.qmcBounces = uint32_t(qsgi::checkedInteger(*o.qmcBounces, 0, qsgi::kMaxQmcBounces, cli, "--qmc-bounces",
                                                               " (the Sobol table covers that many scatterings)"));
+        s.qmcBouncesGiven = true;
+    }
     if (o.resume) s.resume = true;
     if (!o.frames.empty()) {
         s.frames = qsgi::parseFrameRange(o.frames, cli);

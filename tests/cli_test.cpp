@@ -205,6 +205,14 @@ TEST(Cli, EveryEstimatorRendersEndToEnd) {
     const fs::path fewBounces = fs::path(testScratchDir("estimator_bad_config")) / "few_bounces.json";
     writeText(fewBounces, R"({"max_bounces": 4})");
     expectBadInput("render " + cornell() + " --qmc-bounces 5 --config " + fewBounces.string(), "qmc_bounces", out);
+    // The default K (2) is capped at max_bounces, not refused.
+    const fs::path oneBounce = fs::path(testScratchDir("estimator_bad_config")) / "one_bounce.json";
+    writeText(oneBounce, R"({"max_bounces": 1})");
+    const fs::path capped = fs::path(testScratchDir("estimator_capped_k")) / "out";
+    const CommandResult r = runQsgi("render " + cornell() + " --photons 2000 --no-exr --quiet --config " + oneBounce.string() +
+                                    " --out " + capped.string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(readFileBytes(capped / "timing.json").find("\"qmc_bounces\": 1"), std::string::npos);
 }
 
 // The incremental update writes the bytes --full-recompute writes, for each estimator and rule on

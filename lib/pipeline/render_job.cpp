@@ -219,7 +219,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     log.envelope = settings_.useEnvelope;
     log.aimEmission = settings_.aimEmission;
     log.sampler = samplerName(settings_.sampling.kind);
-    log.qmcBounces = settings_.sampling.qmcBounces;
+    log.qmcBounces = effectiveSampling(settings_).qmcBounces;
     log.sortQueries = settings_.estimator.sortQueries;
     log.detpIndex = settings_.estimator.detpIndex == DetpIndex::Flann ? "flann" : "embree";
     log.boundary = detpBoundaryName(settings_.estimator.boundary);
@@ -259,7 +259,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     FrameSolverSettings solverSettings;
     solverSettings.estimator = settings_.estimator;
     solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces, EmissionAim{settings_.aimEmission, 0},
-                                         settings_.sampling};
+                                         effectiveSampling(settings_)};
     solverSettings.fullRecompute = settings_.fullRecompute;
     solverSettings.alwaysUpdate = settings_.alwaysUpdate;
     solverSettings.useEnvelope = settings_.useEnvelope;

@@ -211,8 +211,11 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
                                                    " (the bounce field of a segment is 16 bits)"));
         else if (key == "sampler") s.sampling.kind = parseSampler(str(), path);
         else if (key == "qmc_bounces")
+        {
             s.sampling.qmcBounces = uint32_t(checkedInteger(jsonInteger(v, path, key), 0, kMaxQmcBounces, path, key,
                                                             " (the Sobol table covers that many scatterings)"));
+            s.qmcBouncesGiven = true;
+        }
         else if (key == "threads")
             s.threads = int(checkedInteger(jsonInteger(v, path, key), 0, kMaxThreads, path, key, " (0: all cores)"));
         else if (key == "frames") {
@@ -264,6 +267,12 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
 
 }  // namespace
 
+PhotonSampling effectiveSampling(const RenderSettings& s) {
+    PhotonSampling sampling = s.sampling;
+    sampling.qmcBounces = sampling.kind == SamplerKind::Random ? 0 : std::min(sampling.qmcBounces, s.maxBounces);
+    return sampling;
+}
+
 void validateSettings(const RenderSettings& s) {
     // Values from a config were checked against the config's name as they were read; these
     // checks catch the command line's (and any program that fills RenderSettings itself).
@@ -272,9 +281,10 @@ void validateSettings(const RenderSettings& s) {
     checkedPhotons(int64_t(std::min<uint64_t>(s.photons, INT64_MAX)), cli, "--photons");
     checkedInteger(s.maxBounces, 1, kMaxBounces, cli, "max_bounces", " (the bounce field of a segment is 16 bits)");
     // Checked here, after the config and the command line are merged: the bound is max_bounces.
-    checkedInteger(s.sampling.qmcBounces, 0, std::min<int64_t>(s.maxBounces, kMaxQmcBounces),
-                   s.configPath.empty() ? cli : s.configPath + " or the command line", "qmc_bounces",
-                   " (at most max_bounces, and the Sobol table covers 32 scatterings)");
+    if (s.qmcBouncesGiven)
+        checkedInteger(s.sampling.qmcBounces, 0, std::min<int64_t>(s.maxBounces, kMaxQmcBounces),
+                       s.configPath.empty() ? cli : s.configPath + " or the command line", "qmc_bounces",
+                       " (at most max_bounces, and the Sobol table covers 32 scatterings)");
     if (s.radiusGiven && !(s.estimator.radius > 0 && std::isfinite(s.estimator.radius)))
         throw InputError(cli, "--radius", "must be a positive number (scene units)");
     checkedInteger(s.estimator.k, 1, kMaxK, cli, "--k");

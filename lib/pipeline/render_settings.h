@@ -32,6 +32,7 @@ struct RenderSettings {
     uint64_t seed = 1;
     uint32_t maxBounces = 32;
     PhotonSampling sampling;  // sobol with K quasi-random bounces (default) or random
+    bool qmcBouncesGiven = false;  // K from the config or the command line (else the default, capped at maxBounces)
     int threads = 0;  // 0: all cores
     bool fullRecompute = false;  // every frame from scratch instead of the incremental update
     bool alwaysUpdate = false;   // update even frames whose change would cost more than recomputing them
@@ -93,6 +94,10 @@ SamplerKind parseSampler(const std::string& name, const std::string& source);
 
 // 1.5 % of the scene's bounding-box diagonal: a radius that means the same in any unit.
 float defaultRadius(const Scene& scene);
+
+// The sampling a run uses: the default K is capped at max_bounces (an explicit K above it is
+// refused by validateSettings); K means nothing under random and is 0 there.
+PhotonSampling effectiveSampling(const RenderSettings& settings);
 
 // Checks values that no parser can (photons > 0, …). Throws InputError naming the option.
 void validateSettings(const RenderSettings& settings);

@@ -64,8 +64,8 @@ std::string runFingerprint(const RenderSettings& s, const Scene& scene, const st
                                int64_t(s.maxBounces), s.width, s.height, s.samplesPerPixel, int64_t(s.writeExr),
                                int64_t(s.exrHalf), int64_t(s.writePng), int64_t(s.exposure.has_value()),
                                int64_t(s.writeGltf), int64_t(s.aimEmission), int64_t(s.sampling.kind),
-                               // K changes nothing under random, so it does not change the fingerprint.
-                               s.sampling.kind == SamplerKind::Sobol ? int64_t(s.sampling.qmcBounces) : int64_t(-1)});
+                               // The K that shapes the bytes: none under random, capped at max_bounces.
+                               int64_t(effectiveSampling(s).qmcBounces)});
     f.addValue(e.radius);
     f.addValue(s.exposure.value_or(0.0f));
     f.addValue(camera.position);
