@@ -6,7 +6,8 @@
 // and 2 (the noise), and at least 0.005. A regression in any estimator's definition fails here.
 // The bounds were set again under the Sobol sampler (issue 20), whose photons lowered most errors,
 // and each kept at its earlier (random-photon) value where that was the tighter one. The corner
-// scene's near-edge region is empty (its grid spacing, 0.083, exceeds the radius).
+// scene's near-edge region is empty (its grid spacing, 0.083, exceeds the radius): its near-edge
+// bound is not checked.
 // SCENES ARE FROZEN WITH THEIR REFERENCES: regenerate both (scripts/reference.py) if a scene changes.
 #include <gtest/gtest.h>
 
@@ -98,7 +99,9 @@ TEST_P(ReferenceAccuracy, EveryEstimatorStaysWithinItsMeasuredError) {
                     f.report.interior.relativeBias, f.region.relativeBias);
         EXPECT_LE(f.report.all.relativeRms, b.allRms) << b.estimator;
         EXPECT_LE(std::fabs(f.report.edge.relativeBias), b.edgeBias) << b.estimator;
-        EXPECT_LE(std::fabs(f.report.nearEdge.relativeBias), b.nearBias) << b.estimator;
+        if (f.report.nearEdge.vertices > 0) {  // empty on the corner scene: nothing to bound
+            EXPECT_LE(std::fabs(f.report.nearEdge.relativeBias), b.nearBias) << b.estimator;
+        }
         EXPECT_LE(f.report.interior.relativeRms, b.interiorRms) << b.estimator;
         if (b.regionBias > 0) {
             EXPECT_LE(std::fabs(f.region.relativeBias), b.regionBias) << b.estimator;
@@ -122,8 +125,8 @@ INSTANTIATE_TEST_SUITE_P(
                             {"DETP linear", 0.042, 0.006, 0.098, 0.033, 5.14}}},
                       Case{"tests/scenes/corner_point_light.gltf",
                            "corner_point_light_f0000.ply",
-                           {{"impact count", 0.028, 0.065, 0.005, 0.018, 0},
-                            {"photon map", 0.093, 0.055, 0.005, 0.091, 0},
-                            {"DETP clip", 0.028, 0.033, 0.005, 0.024, 0},
-                            {"DETP linear", 0.031, 0.024, 0.005, 0.024, 0}}}),
+                           {{"impact count", 0.028, 0.065, 0, 0.018, 0},
+                            {"photon map", 0.093, 0.055, 0, 0.091, 0},
+                            {"DETP clip", 0.028, 0.033, 0, 0.024, 0},
+                            {"DETP linear", 0.031, 0.024, 0, 0.024, 0}}}),
     [](const ::testing::TestParamInfo<Case>& info) { return caseName(info.param); });

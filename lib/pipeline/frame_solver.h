@@ -46,6 +46,11 @@ public:
     // The share of the lights' power that emission sends toward the scene (LightSampler).
     double emittedFraction() const { return tracer_.lights().emittedFraction(); }
     const DiscRegions* regions() const { return regions_ ? &*regions_ : nullptr; }
+    // The paths an incremental frame keeps (null until the first update): what tests compare with
+    // a fresh trace of the same pose.
+    const TrackedPaths* trackedPaths() const { return tracked_.get(); }
+    // The tracer, with the settings the solver gave it (emission aimed at the estimator's reach).
+    const PhotonTracer& tracer() const { return tracer_; }
 
 private:
     struct PoseChange {

@@ -210,8 +210,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
             s.maxBounces = uint32_t(checkedInteger(jsonInteger(v, path, key), 1, kMaxBounces, path, key,
                                                    " (the bounce field of a segment is 16 bits)"));
         else if (key == "sampler") s.sampling.kind = parseSampler(str(), path);
-        else if (key == "qmc_bounces")
-        {
+        else if (key == "qmc_bounces") {
             s.sampling.qmcBounces = uint32_t(checkedInteger(jsonInteger(v, path, key), 0, kMaxQmcBounces, path, key,
                                                             " (the Sobol table covers that many scatterings)"));
             s.qmcBouncesGiven = true;
@@ -269,7 +268,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
 
 PhotonSampling effectiveSampling(const RenderSettings& s) {
     PhotonSampling sampling = s.sampling;
-    sampling.qmcBounces = sampling.kind == SamplerKind::Random ? 0 : std::min(sampling.qmcBounces, s.maxBounces);
+    sampling.qmcBounces = sampling.kind == SamplerKind::Random ? 0 : std::min({sampling.qmcBounces, s.maxBounces, kMaxQmcBounces});
     return sampling;
 }
 
@@ -281,7 +280,7 @@ void validateSettings(const RenderSettings& s) {
     checkedPhotons(int64_t(std::min<uint64_t>(s.photons, INT64_MAX)), cli, "--photons");
     checkedInteger(s.maxBounces, 1, kMaxBounces, cli, "max_bounces", " (the bounce field of a segment is 16 bits)");
     // Checked here, after the config and the command line are merged: the bound is max_bounces.
-    if (s.qmcBouncesGiven)
+    if (s.qmcBouncesGiven && s.sampling.kind == SamplerKind::Sobol)  // K means nothing under random
         checkedInteger(s.sampling.qmcBounces, 0, std::min<int64_t>(s.maxBounces, kMaxQmcBounces),
                        s.configPath.empty() ? cli : s.configPath + " or the command line", "qmc_bounces",
                        " (at most max_bounces, and the Sobol table covers 32 scatterings)");

@@ -29,7 +29,8 @@ private:
 };
 
 // Dimensions used at each bounce. Bounce 0 is the emission; bounce k > 0 is the scattering at the
-// impact of segment k-1.
+// impact of segment k-1. Under the Sobol sampler (photon_numbers.h) photons are dealt to lights
+// and aimed maps sampled from the direction pair, so kLightChoice and kEmitCell go unused there.
 namespace rng_dim {
 constexpr uint32_t kLightChoice = 0, kEmitPosition0 = 1, kEmitPosition1 = 2, kEmitDirection0 = 3, kEmitDirection1 = 4;
 constexpr uint32_t kEmitCell = 5;  // a projection map's cell (aimed emission)

@@ -1,6 +1,7 @@
 #include "trace/light_sampler.h"
 
 #include <algorithm>
+#include <cassert>
 
 #include "trace/sampling.h"
 
@@ -89,6 +90,7 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
 }
 
 LightSampler::Deal LightSampler::dealt(uint64_t photon) const {
+    assert(!firstPhoton_.empty() && "dealt() needs a deal seed at construction");
     const size_t e = size_t(std::upper_bound(firstPhoton_.begin(), firstPhoton_.end() - 1, photon) - firstPhoton_.begin()) - 1;
     return {uint32_t(e), uint32_t(photon - firstPhoton_[e])};
 }
@@ -156,11 +158,12 @@ PhotonEmission LightSampler::sample(const PathNumbers& rng) const {
         std::swap(u0, v0);
         std::swap(u1, v1);
     }
-    // A projection map's point: from its own cell number and the main pair (random), or from the
-    // main pair alone, the first coordinate's leading bits choosing the cell (dealt: a map's
-    // cells are stratified as the pair is, and so are the points within each cell).
+    // A projection map's point from the main pair (p0, p1): random photons choose the cell with a
+    // number of their own; dealt ones with the leading bits of p0, read at 32 bits (wide), the
+    // rest placing the point in the cell, so cells and points within them are stratified as the
+    // pair is.
     auto mapPoint = [&](const ProjectionMap& map, float p0, float p1, double& x, double& y) {
-        if (rng.dealt()) map.sampleStratified(rng.wide(0, kEmitDirection0), rng.uniform(0, kEmitDirection1), x, y);
+        if (rng.dealt()) map.sampleStratified(rng.wide(0, kEmitDirection0), p1, x, y);  // p0 is wide's 24-bit cut
         else map.sample(rng.uniform(0, kEmitCell), p0, p1, x, y);
     };
 

@@ -52,7 +52,7 @@ public:
         uint32_t emitter;
         uint32_t index;  // the photon's place among its emitter's
     };
-    Deal dealt(uint64_t photon) const;
+    Deal dealt(uint64_t photon) const;  // only for a sampler built with a deal seed
 
 private:
     // A light's projection map and the domain it covers.

@@ -14,6 +14,7 @@
 // position; scattering k = 1..K reads survival from 4 + 3(k−1) and direction from the pair after.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include "trace/counter_rng.h"
@@ -28,7 +29,7 @@ constexpr uint32_t kSobolDimensionsPerBounce = 3;
 // The scatterings the shipped table can cover.
 constexpr uint32_t kMaxQmcBounces = (SobolSequence::kDimensions - kSobolEmissionDimensions) / kSobolDimensionsPerBounce;
 
-const char* samplerName(SamplerKind kind);  // "sobol", "random"
+inline const char* samplerName(SamplerKind kind) { return kind == SamplerKind::Sobol ? "sobol" : "random"; }
 
 struct PhotonSampling {
     SamplerKind kind = SamplerKind::Sobol;
@@ -40,10 +41,10 @@ public:
     // Hashed everywhere (the random sampler): exactly the numbers qsgi drew before Sobol.
     PathNumbers(uint64_t seed, uint64_t photon) : hashed_(seed, photon) {}
     // Point `index` of emitter `emitter`'s scrambled sequence for the emission and the first
-    // qmcBounces scatterings, hashed beyond.
+    // qmcBounces scatterings (at most kMaxQmcBounces: the table's dimensions), hashed beyond.
     PathNumbers(uint64_t seed, uint64_t photon, uint32_t emitter, uint32_t index, uint32_t qmcBounces)
         : hashed_(seed, photon), sobol_(&SobolSequence::instance()), scrambleKey_(mix64(mix64(seed ^ 0x50B01A5EEDull) + emitter)),
-          emitter_(emitter), index_(index), qmcBounces_(qmcBounces) {}
+          emitter_(emitter), index_(index), qmcBounces_(std::min(qmcBounces, kMaxQmcBounces)) {}
 
     // Whether the light was chosen by dealing (Sobol) rather than by a number (random).
     bool dealt() const { return sobol_ != nullptr; }

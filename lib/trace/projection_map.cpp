@@ -177,22 +177,21 @@ ProjectionMap::ProjectionMap(int depth, const std::vector<Target>& targets, cons
 
 void ProjectionMap::sample(float uCell, float u0, float u1, double& x, double& y) const {
     const size_t k = std::min(cells_.size() - 1, size_t(double(uCell) * double(cells_.size())));
+    pointInCell(k, double(u0), double(u1), x, y);
+}
+
+void ProjectionMap::pointInCell(size_t k, double u, double v, double& x, double& y) const {
     const uint32_t cell = cells_[k];
     const uint32_t row = cell >> depth_, column = cell & ((1u << depth_) - 1);
     const double size = std::ldexp(1.0, -depth_);
-    x = (column + double(u0)) * size;
-    y = (row + double(u1)) * size;
+    x = (column + u) * size;
+    y = (row + v) * size;
 }
 
 void ProjectionMap::sampleStratified(double u, float v, double& x, double& y) const {
     const double scaled = u * double(cells_.size());  // exact: u has 32 bits, the cell count at most 2^(2·depth)
     const size_t k = std::min(cells_.size() - 1, size_t(scaled));
-    const double within = std::min(scaled - double(k), 1.0);
-    const uint32_t cell = cells_[k];
-    const uint32_t row = cell >> depth_, column = cell & ((1u << depth_) - 1);
-    const double size = std::ldexp(1.0, -depth_);
-    x = (column + within) * size;
-    y = (row + double(v)) * size;
+    pointInCell(k, scaled - double(k), double(v), x, y);
 }
 
 ProjectionMap directionMap(const Vec3d& apex, const Vec3d& axis, double cosMax, const Vec3d& extraAxis, double cosExtra,

@@ -69,6 +69,9 @@ public:
     void sampleStratified(double u, float v, double& x, double& y) const;
 
 private:
+    // The point (u, v) of the unit square inside kept cell k.
+    void pointInCell(size_t k, double u, double v, double& x, double& y) const;
+
     int depth_ = 0;
     std::vector<uint32_t> cells_;  // (row << depth) | column, increasing
 };

@@ -1,7 +1,5 @@
 #include "trace/sobol.h"
 
-#include "trace/photon_numbers.h"
-
 namespace qsgi {
 
 const SobolSequence& SobolSequence::instance() {
@@ -32,7 +30,5 @@ SobolSequence::SobolSequence() {
     for (int d = 0; d < kDimensions; ++d)
         for (int j = 0; j < 32; ++j) reversedDirections_[std::size_t(d)][std::size_t(j)] = reverseBits32(directions[std::size_t(d)][std::size_t(j)]);
 }
-
-const char* samplerName(SamplerKind kind) { return kind == SamplerKind::Sobol ? "sobol" : "random"; }
 
 }  // namespace qsgi

@@ -60,6 +60,4 @@ constexpr uint32_t owenScrambleReversed(uint32_t reversed, uint32_t seed) {
     return x;
 }
 
-constexpr uint32_t owenScramble(uint32_t x, uint32_t seed) { return reverseBits32(owenScrambleReversed(reverseBits32(x), seed)); }
-
 }  // namespace qsgi
