@@ -45,7 +45,7 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         const float area = scene.triangleArea(t);
         if (!m.isEmissive() || !(area > 0)) continue;
         // One-sided Lambertian emitter: exitance π L_e over the area.
-        emitters_.push_back({Emitter::Triangle, t, m.emission * (kPi * area), Vec3f(0.0f)});
+        emitters_.push_back({Emitter::Triangle, t, m.emission * (kPi * area), Vec3f(0.0f), -1, scene.geometricNormal(t)});
     }
     double unaimed = 0;
     for (Emitter& e : emitters_) {
@@ -219,7 +219,7 @@ PhotonEmission LightSampler::sample(const PathNumbers& rng) const {
             const Vec3f& a = scene_.positions[tri.v[0]];
             const Vec3f& b = scene_.positions[tri.v[1]];
             const Vec3f& c = scene_.positions[tri.v[2]];
-            const Vec3f n = scene_.geometricNormal(e.index);
+            const Vec3f& n = e.normal;
             out.origin = a * (1 - b1 - b2) + b * b1 + c * b2 + n * rayEpsilon_;
             out.direction = cosineHemisphere(n, v0, v1);
             break;

@@ -70,6 +70,7 @@ private:
         Vec3f power;      // W, sent toward the scene
         Vec3f photonPower;
         int aim = -1;     // into aims_, −1: unaimed
+        Vec3f normal{0.0f};  // a triangle's front (lights are static: worked out once, not per photon)
     };
     void aimLight(Emitter& e, const EmissionAim& aim);
     size_t chooseEmitter(float u) const;
