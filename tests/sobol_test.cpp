@@ -94,10 +94,47 @@ TEST(Sobol, EveryStratifiedPairIsANetWithItsTBeforeAndAfterScrambling) {
     }
 }
 
+// Seeds (and emitters) randomise independently. Two scrambles of one point set are related by a
+// nested permutation, so the same point under two seeds is strongly correlated or anti-correlated
+// (the leading bit is flipped in both or in one): what must be independent is the scrambles
+// themselves. Point 0 of the sequence is 0 in every dimension, so its scrambled value is the
+// scramble's own leading bits: over n = 4096 seeds it must be uniform (mean within 4 standard
+// errors, √(1/12n), of ½) and uncorrelated (|Pearson r| < 4/√n) between consecutive seeds,
+// between the dimensions photons read, and between two emitters.
 TEST(Sobol, SeedsScrambleIndependentlyAndHashedNumbersLieBeyondK) {
     using namespace rng_dim;
-    const PathNumbers a(1, 5, 0, 5, 2), b(2, 5, 0, 5, 2);
-    EXPECT_NE(a.uniform(0, kEmitDirection0), b.uniform(0, kEmitDirection0));
+    const int n = 4096;
+    const std::pair<uint32_t, uint32_t> read[] = {{0, kEmitDirection0}, {0, kEmitDirection1}, {0, kEmitPosition0},
+                                                  {0, kEmitPosition1},  {1, kSurvival},        {1, kScatterDirection0},
+                                                  {2, kScatterDirection1}};
+    auto pointZero = [](uint64_t seed, uint32_t emitter, std::pair<uint32_t, uint32_t> d) {
+        return double(PathNumbers(seed, 0, emitter, 0, 2).uniform(d.first, d.second));
+    };
+    auto correlation = [n](const std::function<double(int)>& a, const std::function<double(int)>& b) {
+        double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+        for (int i = 0; i < n; ++i) {
+            const double x = a(i), y = b(i);
+            sa += x, sb += y, saa += x * x, sbb += y * y, sab += x * y;
+        }
+        const double ma = sa / n, mb = sb / n;
+        return (sab / n - ma * mb) / std::sqrt((saa / n - ma * ma) * (sbb / n - mb * mb));
+    };
+    const double rLimit = 4 / std::sqrt(double(n));
+    for (size_t k = 0; k < std::size(read); ++k) {
+        const auto d = read[k];
+        SCOPED_TRACE("bounce " + std::to_string(d.first) + ", dimension " + std::to_string(d.second));
+        double mean = 0;
+        for (int s = 0; s < n; ++s) mean += pointZero(uint64_t(s), 0, d) / n;
+        EXPECT_NEAR(mean, 0.5, 4 * std::sqrt(1.0 / (12.0 * n)));
+        EXPECT_LT(std::fabs(correlation([&](int s) { return pointZero(uint64_t(s), 0, d); },
+                                        [&](int s) { return pointZero(uint64_t(s) + 1, 0, d); })), rLimit);
+        EXPECT_LT(std::fabs(correlation([&](int s) { return pointZero(uint64_t(s), 0, d); },
+                                        [&](int s) { return pointZero(uint64_t(s), 1, d); })), rLimit);
+        const auto next = read[(k + 1) % std::size(read)];
+        EXPECT_LT(std::fabs(correlation([&](int s) { return pointZero(uint64_t(s), 0, d); },
+                                        [&](int s) { return pointZero(uint64_t(s), 0, next); })), rLimit);
+    }
+    const PathNumbers a(1, 5, 0, 5, 2);
     // Bounce 3 > K = 2: hashed, exactly as the random sampler draws it.
     EXPECT_EQ(a.sobolDimension(3, kSurvival), -1);
     EXPECT_EQ(a.uniform(3, kScatterDirection1), PathNumbers(1, 5).uniform(3, kScatterDirection1));
