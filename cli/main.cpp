@@ -78,8 +78,7 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.noAim) s.aimEmission = false;
     if (!o.sampler.empty()) s.sampling.kind = qsgi::parseSampler(o.sampler, cli);
     if (o.qmcBounces) {
-        s.sampling.qmcBounces = uint32_t(qsgi::checkedInteger(*o.qmcBounces, 0, qsgi::kMaxQmcBounces, cli, "--qmc-bounces",
-                                                              " (the Sobol table covers that many scatterings)"));
+        s.sampling.qmcBounces = qsgi::checkedQmcBounces(*o.qmcBounces, cli, "--qmc-bounces");
         s.qmcBouncesGiven = true;
     }
     if (o.resume) s.resume = true;

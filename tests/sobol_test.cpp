@@ -227,10 +227,18 @@ Agreement agreement(const Scene& scene, const SeedStatistics& sobol, const SeedS
             std::sqrt(sobolVar / randomVar)};
 }
 
+// The same scene, seeds and photons under both samplers.
+struct BothSamplers {
+    SeedStatistics sobol, random;
+};
+BothSamplers runBoth(const Scene& scene, int seeds, uint64_t photons, bool aim = true) {
+    return {overSeeds(scene, PhotonSampling{SamplerKind::Sobol, 2}, seeds, photons, aim),
+            overSeeds(scene, PhotonSampling{SamplerKind::Random, 0}, seeds, photons, aim)};
+}
+
 Agreement compareSamplers(const Scene& scene, int seeds, uint64_t photons, bool aim = true) {
-    const SeedStatistics sobol = overSeeds(scene, PhotonSampling{SamplerKind::Sobol, 2}, seeds, photons, aim);
-    const SeedStatistics random = overSeeds(scene, PhotonSampling{SamplerKind::Random, 0}, seeds, photons, aim);
-    return agreement(scene, sobol, random, seeds);
+    const BothSamplers runs = runBoth(scene, seeds, photons, aim);
+    return agreement(scene, runs.sobol, runs.random, seeds);
 }
 
 // Limits for unbiased estimates, from the statistics. Per vertex, (mean_sobol − mean_random) over
@@ -271,15 +279,16 @@ TEST(Sobol, AgreesWithRandomWithinNoiseAndSpreadsLessUnderAPointLight) {
     Scene twoLights = testscenes::plane(1.6f, 24, Vec3f(0.5f));
     testscenes::addPointLight(twoLights, Vec3f(-0.8f, 1, 0), Vec3f(1.0f));
     testscenes::addPointLight(twoLights, Vec3f(0.9f, 0.6f, 0.3f), Vec3f(0.3f));
-    const SeedStatistics sobol = overSeeds(twoLights, PhotonSampling{SamplerKind::Sobol, 2}, 16, 1000000);
-    const SeedStatistics random = overSeeds(twoLights, PhotonSampling{SamplerKind::Random, 0}, 16, 1000000);
-    const Agreement b = agreement(twoLights, sobol, random, 16);
-    expectAgreement(b, 16, twoLights.vertexCount(), "plane under two point lights, 10^6 photons");
+    // 2·10^5 photons: the gain is clear (spread 0.28 of random's here, 0.18 at 10^6) at a fifth of the time.
+    const BothSamplers runs = runBoth(twoLights, 16, 200000);
+    const Agreement b = agreement(twoLights, runs.sobol, runs.random, 16);
+    expectAgreement(b, 16, twoLights.vertexCount(), "plane under two point lights, 2*10^5 photons");
     EXPECT_LE(b.spreadRatio, 0.7);
     const Vec3f lights[2] = {Vec3f(-0.8f, 0, 0), Vec3f(0.9f, 0, 0.3f)};
     for (int l = 0; l < 2; ++l) {
         // Within 0.5 of the point below light l (the other light is at least 1.2 away there).
-        const Agreement under = agreement(twoLights, sobol, random, 16, [&](const Vec3f& p) { return length(p - lights[l]) < 0.5f; });
+        const Agreement under =
+            agreement(twoLights, runs.sobol, runs.random, 16, [&](const Vec3f& p) { return length(p - lights[l]) < 0.5f; });
         std::printf("  under light %d: spread sobol/random %.3f\n", l, under.spreadRatio);
         EXPECT_LE(under.spreadRatio, 0.7) << "light " << l;
     }

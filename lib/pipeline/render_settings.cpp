@@ -32,6 +32,10 @@ uint64_t checkedPhotons(int64_t value, const std::string& source, const std::str
     return photons;
 }
 
+uint32_t checkedQmcBounces(int64_t value, const std::string& source, const std::string& place) {
+    return uint32_t(checkedInteger(value, 0, kMaxQmcBounces, source, place, " (the Sobol table covers that many scatterings)"));
+}
+
 EstimatorKind parseEstimator(const std::string& name, const std::string& source) {
     if (name == "impact-count") return EstimatorKind::ImpactCount;
     if (name == "photon-map") return EstimatorKind::PhotonMap;
@@ -211,8 +215,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
                                                    " (the bounce field of a segment is 16 bits)"));
         else if (key == "sampler") s.sampling.kind = parseSampler(str(), path);
         else if (key == "qmc_bounces") {
-            s.sampling.qmcBounces = uint32_t(checkedInteger(jsonInteger(v, path, key), 0, kMaxQmcBounces, path, key,
-                                                            " (the Sobol table covers that many scatterings)"));
+            s.sampling.qmcBounces = checkedQmcBounces(jsonInteger(v, path, key), path, key);
             s.qmcBouncesGiven = true;
         }
         else if (key == "threads")

@@ -73,6 +73,8 @@ int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string&
 // A photon count: within 1..kMaxPhotons and within the machine's memory (each photon stores at
 // least one segment and its path's start).
 uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place);
+// A number of quasi-random scatterings: within 0..kMaxQmcBounces (the Sobol table's reach).
+uint32_t checkedQmcBounces(int64_t value, const std::string& source, const std::string& place);
 
 // Reads a config file into `settings` (only the keys present change). Relative scene and
 // animation paths are resolved against the config's folder. Throws InputError.
