@@ -57,6 +57,33 @@ void discCellCentre(int cell, double& x, double& y) {
     y = rho * std::sin(phi);
 }
 
+namespace {
+DiscPatternPoints computePatternPoints() {
+    DiscPatternPoints p;
+    for (int i = 0; i <= kDiscRings; ++i)
+        for (int j = 0; j < kDiscSectors; ++j) {
+            const double rho = std::sqrt(double(i) / kDiscRings), phi = 2 * M_PI * j / kDiscSectors;
+            p.corners[size_t(i) * kDiscSectors + size_t(j)] = {rho * std::cos(phi), rho * std::sin(phi)};
+        }
+    for (int c = 0; c < kDiscCells; ++c) {
+        discCellCentre(c, p.centres[size_t(c)].x, p.centres[size_t(c)].y);
+        const int ring = c / kDiscSectors, sector = c % kDiscSectors;
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j) {
+                const double rho = std::sqrt((ring + (i + 0.5) / 4) / kDiscRings);
+                const double phi = 2 * M_PI * (sector + (j + 0.5) / 4) / kDiscSectors;
+                p.subPoints[size_t(c)][size_t(4 * i + j)] = {rho * std::cos(phi), rho * std::sin(phi)};
+            }
+    }
+    return p;
+}
+}  // namespace
+
+const DiscPatternPoints& discPatternPoints() {
+    static const DiscPatternPoints points = computePatternPoints();
+    return points;
+}
+
 const CellMoments& discCellMoments(int cell) {
     static const std::array<CellMoments, kDiscCells> table = computeMoments();
     return table[cell];

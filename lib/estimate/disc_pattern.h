@@ -32,6 +32,19 @@ int discCellOf(double x, double y);
 inline int discRingOf(int cell) { return cell / kDiscSectors; }
 void discCellCentre(int cell, double& x, double& y);
 
+// The points of the pattern that reachability tests aim at (DESIGN §5), on the unit disc: the
+// cells' shared corners (ring boundaries × sector boundaries, ring boundary 0 being v), each
+// cell's centre, and each cell's 4×4 sub-points. Worked out once: every disc tests the same ones.
+struct DiscPatternPoints {
+    struct Point {
+        double x, y;
+    };
+    std::array<Point, size_t(kDiscRings + 1) * kDiscSectors> corners;  // [ring boundary · sectors + sector]
+    std::array<Point, kDiscCells> centres;                             // discCellCentre
+    std::array<std::array<Point, 16>, kDiscCells> subPoints;           // [cell][4 · ring step + sector step]
+};
+const DiscPatternPoints& discPatternPoints();
+
 // Exact integrals over one cell of the unit disc: ∫1, ∫x, ∫y, ∫x², ∫xy, ∫y².
 struct CellMoments {
     double m0, mx, my, mxx, mxy, myy;

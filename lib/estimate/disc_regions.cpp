@@ -61,27 +61,54 @@ bool pointReachable(Reach reach, const VertexDisc& disc, const Vec3f& centre, co
 
 namespace {
 
+// Where a corner's and a cell centre's answers sit in StaticAnswers (ring 0's corners are v).
+constexpr int cornerSlot(int ring, int sector) { return (ring - 1) * kDiscSectors + sector; }
+constexpr int centreSlot(int cell) { return kDiscRings * kDiscSectors + cell; }
+
+// What a disc's rays may skip asking the static BVH, every answer being the one it would give.
+struct StaticShortcuts {
+    bool nothingNear = false;  // no static triangle near any of the disc's rays: all clear
+    DiscRegions::StaticAnswers* answers = nullptr;  // where corner and centre answers are kept
+    bool reuse = false;  // read them from there (kept for this very start and lift)
+};
+
 // The cells of v's disc that light can reach from `startPoint` (DESIGN §5).
 VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
-                    const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage, const OwnSurface& own) {
+                    const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage, const OwnSurface& own,
+                    const StaticShortcuts& shortcuts) {
     const Vec3f& normal = scene.normals[v];
     disc.start = startPoint;
     const Vec3d start(disc.start);
     const Vec3f& centre = scene.positions[v];
-    auto clear = [&](double x, double y) { return segmentClear(start, liftedDiscPoint(disc, centre, normal, radius, x, y), bvh); };
+    // segmentClear, with the static and dynamic halves of SceneBvh::occluded asked apart.
+    auto clearRay = [&](double x, double y, int slot) {
+        const Vec3d d = liftedDiscPoint(disc, centre, normal, radius, x, y) - start;
+        const double len = length(d);
+        if (!(len > 0)) return true;
+        const Vec3f origin(start), direction(d / len);
+        bool staticClear;
+        if (slot >= 0 && shortcuts.reuse) {
+            staticClear = shortcuts.answers->clear.test(size_t(slot));
+        } else {
+            staticClear = shortcuts.nothingNear || !bvh.staticOccludes(origin, direction, 0.0f, float(len));
+            if (slot >= 0 && shortcuts.answers) shortcuts.answers->clear.set(size_t(slot), staticClear);
+        }
+        return staticClear && !bvh.dynamicOccludes(origin, direction, 0.0f, float(len));
+    };
+    auto clear = [&](double x, double y) { return clearRay(x, y, -1); };
     // Corners of the polar cells (shared between neighbours): ring boundaries × sector boundaries.
+    const DiscPatternPoints& points = discPatternPoints();
     std::array<uint8_t, size_t(kDiscRings + 1) * kDiscSectors> cornerClear;
     for (int i = 0; i <= kDiscRings; ++i)
         for (int j = 0; j < kDiscSectors; ++j) {
-            const double rho = std::sqrt(double(i) / kDiscRings), phi = 2 * M_PI * j / kDiscSectors;
-            cornerClear[size_t(i) * kDiscSectors + size_t(j)] = i == 0 ? 1 : clear(rho * std::cos(phi), rho * std::sin(phi));
+            const size_t k = size_t(i) * kDiscSectors + size_t(j);
+            cornerClear[k] = i == 0 ? 1 : clearRay(points.corners[k].x, points.corners[k].y, cornerSlot(i, j));
         }
     double share = 0;
     for (int c = 0; c < kDiscCells; ++c) {
         const int ring = c / kDiscSectors, sector = c % kDiscSectors, next = (sector + 1) % kDiscSectors;
-        double x, y;
-        discCellCentre(c, x, y);
-        const bool centreClear = clear(x, y);
+        const double x = points.centres[size_t(c)].x, y = points.centres[size_t(c)].y;
+        const bool centreClear = clearRay(x, y, centreSlot(c));
         // The centre of ring 0's corners is v itself: its own side, reachable by construction.
         const uint8_t corners[4] = {cornerClear[size_t(ring) * kDiscSectors + size_t(sector)],
                                     cornerClear[size_t(ring) * kDiscSectors + size_t(next)],
@@ -95,12 +122,7 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
             share += 1;
         } else {
             int clearSubPoints = 0;
-            for (int i = 0; i < 4; ++i)
-                for (int j = 0; j < 4; ++j) {
-                    const double rho = std::sqrt((ring + (i + 0.5) / 4) / kDiscRings);
-                    const double phi = 2 * M_PI * (sector + (j + 0.5) / 4) / kDiscSectors;
-                    clearSubPoints += clear(rho * std::cos(phi), rho * std::sin(phi));
-                }
+            for (const DiscPatternPoints::Point& sub : points.subPoints[size_t(c)]) clearSubPoints += clear(sub.x, sub.y);
             disc.mixed.set(c);
             disc.mixedShare.emplace_back(uint8_t(c), uint8_t(clearSubPoints));
             share += clearSubPoints / 16.0;
@@ -117,7 +139,7 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
 
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
-                             OwnSurfaceScratch& scratch) {
+                             OwnSurfaceScratch& scratch, DiscRegions::StaticAnswers* answers) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
     discFrame(normal, disc.tangent, disc.bitangent);
@@ -131,8 +153,24 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     // Double precision for the points, so the float rays start exactly where the rule says.
     const double sideStep = std::min(1e-3 * double(radius), double(scene.sceneEpsilon()));
     const Vec3d lifted = Vec3d(scene.positions[v]) + Vec3d(normal) * double(own.epsAbove);
-    VertexDisc best = discFrom(Vec3f(lifted + Vec3d(own.towardSurface) * sideStep), disc, v, scene, bvh, frontNormals,
-                               radius, withCoverage, own);
+    const Vec3f start(lifted + Vec3d(own.towardSurface) * sideStep);
+    StaticShortcuts shortcuts;
+    // Every ray of the disc (from any of the starts below) stays within r + ε⁺ + the side step
+    // of v; the BVH's ray epsilon is far more than their rounding. Worth asking for a moving
+    // vertex only: a static one has its own surface near.
+    shortcuts.nothingNear = scene.vertexDynamic[v] &&
+        !bvh.staticGeometryNear(scene.positions[v], float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon());
+    // The kept answers hold while the rays are the same: same start and lift (a static vertex's
+    // own surface is static, unless a moved vertex now welds onto it).
+    StaticShortcuts primary = shortcuts;
+    primary.answers = answers;
+    primary.reuse = answers && answers->valid && answers->start == start && answers->epsAbove == own.epsAbove;
+    if (answers && !primary.reuse) {
+        answers->valid = true;
+        answers->start = start;
+        answers->epsAbove = own.epsAbove;
+    }
+    VertexDisc best = discFrom(start, disc, v, scene, bvh, frontNormals, radius, withCoverage, own, primary);
     if (best.reachableArea > 0) return best;
     // Nothing reachable from the start point: either v is buried, or the start lies exactly on a
     // surface through v (a floor vertex at the foot of a wall, where the own surface runs on under
@@ -142,7 +180,7 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     const Vec3d sides[4] = {Vec3d(disc.tangent), -Vec3d(disc.tangent), Vec3d(disc.bitangent), -Vec3d(disc.bitangent)};
     for (const Vec3d& side : sides) {
         VertexDisc candidate = discFrom(Vec3f(lifted + side * sideStep), disc, v, scene, bvh, frontNormals, radius,
-                                        withCoverage, own);
+                                        withCoverage, own, shortcuts);
         if (candidate.reachableArea > best.reachableArea) best = std::move(candidate);
     }
     return best;
@@ -152,14 +190,30 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
 
 void DiscRegions::computeAll(const Scene& scene, const SceneBvh& bvh) {
     discs_.assign(scene.vertexCount(), VertexDisc{});
+    answerSlot_.clear();
+    answers_.clear();
     std::vector<uint32_t> all(scene.vertexCount());
     for (uint32_t v = 0; v < all.size(); ++v) all[v] = v;
-    recompute(scene, bvh, all);
+    compute(scene, bvh, all, false);
 }
 
 std::vector<uint32_t> DiscRegions::recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices) {
+    return compute(scene, bvh, vertices, true);
+}
+
+std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
+                                           bool keepAnswers) {
     if (discs_.size() != scene.vertexCount()) discs_.resize(scene.vertexCount());
     if (vertices.empty()) return {};
+    if (keepAnswers) {
+        // A record per vertex a move has touched: the touchable set is small beside the scene.
+        answerSlot_.resize(scene.vertexCount(), -1);
+        for (uint32_t v : vertices)
+            if (answerSlot_[v] < 0) {
+                answerSlot_[v] = int32_t(answers_.size());
+                answers_.emplace_back();
+            }
+    }
     std::vector<uint8_t> changed(vertices.size(), 0);
     const MeshTopology topology(scene.positions, scene.triangles);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
@@ -168,7 +222,9 @@ std::vector<uint32_t> DiscRegions::recompute(const Scene& scene, const SceneBvh&
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 32), [&](const tbb::blocked_range<size_t>& range) {
         OwnSurfaceScratch& local = scratch.local();
         for (size_t i = range.begin(); i != range.end(); ++i) {
-            VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local);
+            StaticAnswers* answers = keepAnswers ? &answers_[size_t(answerSlot_[vertices[i]])] : nullptr;
+            if (answers && scene.vertexDynamic[vertices[i]]) answers = nullptr;
+            VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local, answers);
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);
         }

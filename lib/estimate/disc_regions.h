@@ -16,6 +16,7 @@
 // from-scratch computation of that frame.
 #pragma once
 
+#include <bitset>
 #include <cstdint>
 #include <vector>
 
@@ -88,11 +89,29 @@ public:
     uint64_t fallbackVertices() const;
     uint64_t buriedVertices() const;
     uint64_t mixedCells() const;  // cells cut by geometry, over all vertices
+    // Bytes of the static answers kept for recomputed vertices.
+    size_t keptAnswerBytes() const { return answers_.capacity() * sizeof(StaticAnswers) + answerSlot_.capacity() * sizeof(int32_t); }
+
+    // What the static BVH answered for a vertex's corner and cell-centre rays. occluded() is the
+    // static answer or the dynamic one; the static scene never changes, so a static vertex whose
+    // rays are the same (start and lift) gets the same static answers every frame, and a
+    // recompute asks only the dynamic BVH — exactly what a from-scratch computation would find.
+    // Kept from a vertex's first recompute on.
+    struct StaticAnswers {
+        bool valid = false;
+        Vec3f start{0.0f};
+        float epsAbove = 0;
+        std::bitset<size_t(2 * kDiscCells)> clear;  // corners of rings 1…16, then cell centres
+    };
 
 private:
+    std::vector<uint32_t> compute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices, bool keepAnswers);
+
     float radius_;
     bool withCoverage_;
     std::vector<VertexDisc> discs_;
+    std::vector<int32_t> answerSlot_;  // per vertex, into answers_ (−1: none kept)
+    std::vector<StaticAnswers> answers_;
 };
 
 }  // namespace qsgi

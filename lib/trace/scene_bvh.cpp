@@ -1,5 +1,6 @@
 #include "trace/scene_bvh.h"
 
+#include <algorithm>
 #include <limits>
 #include <unordered_map>
 
@@ -91,6 +92,7 @@ SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     const Bounds3f b = scene.animationBounds;
     rayEpsilon_ = std::max(1e-5f * b.extent(), 64 * std::numeric_limits<float>::epsilon() * b.maxAbsCoordinate());
     if (!(rayEpsilon_ > 0)) rayEpsilon_ = 1e-5f;
+    boundDynamic(scene);
 }
 
 SceneBvh::Part SceneBvh::addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality) {
@@ -137,6 +139,14 @@ void SceneBvh::updateDynamic(const Scene& scene) {
     rtcCommitGeometry(geom);
     rtcCommitScene(dynamicScene_.get());
     device_.checkError("refitting dynamic geometry");
+    boundDynamic(scene);
+}
+
+void SceneBvh::boundDynamic(const Scene& scene) {
+    dynamicBounds_ = Bounds3f();
+    for (uint32_t v : dynamic_.vertices) dynamicBounds_.extend(scene.positions[v]);
+    // Far more than a float hit's rounding (the epsilon is ~1e-5 of the scene).
+    dynamicBounds_ = dynamicBounds_.expanded(rayEpsilon_);
 }
 
 std::optional<SurfaceHit> SceneBvh::intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
@@ -163,12 +173,66 @@ std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& 
 }
 
 bool SceneBvh::occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    return (!static_.empty() && occludes(staticScene_.get(), origin, direction, tnear, tfar)) ||
-           dynamicOccludes(origin, direction, tnear, tfar);
+    return staticOccludes(origin, direction, tnear, tfar) || dynamicOccludes(origin, direction, tnear, tfar);
+}
+
+bool SceneBvh::staticOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
+    return !static_.empty() && occludes(staticScene_.get(), origin, direction, tnear, tfar);
+}
+
+namespace {
+struct NearQuery {
+    const uint32_t* index;  // the static geometry's own buffers
+    const float* vertex;
+    Vec3f centre;
+    float radius;
+    bool found = false;
+};
+
+// Called for the static triangles whose BVH boxes meet the query ball: one whose own box does
+// ends the search.
+bool triangleBoxNear(RTCPointQueryFunctionArguments* args) {
+    auto* q = static_cast<NearQuery*>(args->userPtr);
+    if (q->found) return false;
+    Bounds3f box;
+    for (size_t k = 0; k < 3; ++k) {
+        const float* p = q->vertex + 3 * size_t(q->index[3 * size_t(args->primID) + k]);
+        box.extend(Vec3f(p[0], p[1], p[2]));
+    }
+    double squared = 0;
+    for (int a = 0; a < 3; ++a) {
+        const double below = double(box.lower[a]) - double(q->centre[a]), above = double(q->centre[a]) - double(box.upper[a]);
+        const double gap = std::max({below, above, 0.0});
+        squared += gap * gap;
+    }
+    if (squared > double(q->radius) * double(q->radius)) return false;
+    q->found = true;
+    args->query->radius = 0;  // nothing more to look for
+    return true;
+}
+}  // namespace
+
+bool SceneBvh::staticGeometryNear(const Vec3f& centre, float radius) const {
+    if (static_.empty()) return false;
+    RTCGeometry geom = rtcGetGeometry(staticScene_.get(), static_.geomId);
+    NearQuery q{static_cast<const uint32_t*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0)),
+                static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0)), centre, radius};
+    RTCPointQuery query;
+    query.x = centre.x;
+    query.y = centre.y;
+    query.z = centre.z;
+    query.radius = radius;
+    query.time = 0;
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(staticScene_.get(), &query, &context, triangleBoxNear, &q);
+    return q.found;
 }
 
 bool SceneBvh::dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    return !dynamic_.empty() && occludes(dynamicScene_.get(), origin, direction, tnear, tfar);
+    if (dynamic_.empty()) return false;
+    double t0 = tnear, t1 = tfar;
+    return dynamicBounds_.clip(origin, direction, t0, t1) && occludes(dynamicScene_.get(), origin, direction, tnear, tfar);
 }
 
 bool SceneBvh::movedOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,

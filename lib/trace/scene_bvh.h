@@ -33,6 +33,13 @@ public:
     std::optional<SurfaceHit> intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // True if any geometry blocks the ray within (tnear, tfar).
     bool occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // True if the static geometry alone blocks the ray within (tnear, tfar): occluded() is this
+    // or dynamicOccludes(), so a caller may keep static answers across frames.
+    bool staticOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // False only if no static triangle comes within `radius` of `centre` (an Embree point query,
+    // tested on each triangle's box: true may be said of a triangle a little farther). A ray
+    // that stays within the ball is then never blocked by static geometry.
+    bool staticGeometryNear(const Vec3f& centre, float radius) const;
     // True if the dynamic geometry alone blocks the ray within (tnear, tfar].
     bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // The same, counting only the triangles flagged in triangleMoved (by scene triangle).
@@ -51,6 +58,7 @@ private:
     };
     Part addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality);
     void fillVertices(RTCGeometry geom, const Part& part, const Scene& scene);
+    void boundDynamic(const Scene& scene);
     std::optional<SurfaceHit> intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
                                             const Vec3f& direction, float tnear, float tfar) const;
 
@@ -58,6 +66,9 @@ private:
     EmbreeScene staticScene_, dynamicScene_;
     Part static_, dynamic_;
     float rayEpsilon_ = 1e-5f;
+    // The dynamic triangles' bounds in the current pose, padded: a ray that misses them cannot
+    // meet a dynamic triangle, and skips Embree (most occlusion rays pass far from the movers).
+    Bounds3f dynamicBounds_;
 };
 
 }  // namespace qsgi
