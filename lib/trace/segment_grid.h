@@ -42,10 +42,11 @@ public:
         for (size_t i = 0; i < count; ++i)
             if (cells[i] % shards == shard) cells_[cells[i]].push_back(ref);
     }
-    // Calls visit(ref) for every entry of every cell that overlaps one of the boxes: an entry
-    // as often as it is listed in such cells, stale ones included (the caller filters).
-    template <typename Visit>
-    void visitCells(const std::vector<Bounds3f>& boxes, Visit&& visit) const {
+    // Calls visit(ref) for every live entry (isLive(ref)) of every cell that overlaps one of the
+    // boxes, as often as it is listed in such cells, and drops the stale entries of those cells
+    // on the way (the order of the rest is kept). Returns how many it dropped.
+    template <typename IsLive, typename Visit>
+    size_t visitLiveCells(const std::vector<Bounds3f>& boxes, IsLive&& isLive, Visit&& visit) {
         std::vector<uint8_t> marked(cells_.size(), 0);
         for (const Bounds3f& box : boxes) {
             int lo[3], hi[3];
@@ -54,9 +55,20 @@ public:
                 for (int y = lo[1]; y <= hi[1]; ++y)
                     for (int x = lo[0]; x <= hi[0]; ++x) marked[cellIndex(x, y, z)] = 1;
         }
-        for (size_t c = 0; c < cells_.size(); ++c)
-            if (marked[c])
-                for (const SegmentRef& r : cells_[c]) visit(r);
+        size_t dropped = 0;
+        for (size_t c = 0; c < cells_.size(); ++c) {
+            if (!marked[c]) continue;
+            std::vector<SegmentRef>& cell = cells_[c];
+            size_t kept = 0;
+            for (const SegmentRef& r : cell) {
+                if (!isLive(r)) continue;
+                cell[kept++] = r;
+                visit(r);
+            }
+            dropped += cell.size() - kept;
+            cell.resize(kept);
+        }
+        return dropped;
     }
     // Drops stale entries everywhere.
     template <typename IsLive>

@@ -32,9 +32,11 @@ TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, floa
         t.path = uint32_t(p);
         t.firstBounce = cache.segments[cache.pathBegin[p] + first[p]].bounce;
         t.begin = segments_.size();
-        t.count = uint32_t(cache.pathBegin[p + 1] - cache.pathBegin[p] - first[p]);
+        t.count = t.capacity = uint32_t(cache.pathBegin[p + 1] - cache.pathBegin[p] - first[p]);
         segments_.insert(segments_.end(), cache.segments.begin() + int64_t(cache.pathBegin[p] + first[p]),
                          cache.segments.begin() + int64_t(cache.pathBegin[p + 1]));
+        generation_.resize(segments_.size(), 0);
+        cellCount_.resize(segments_.size(), 0);
         slot_[p] = int32_t(paths_.size());
         paths_.push_back(t);
         liveSegments_ += t.count;
@@ -57,7 +59,10 @@ void TrackedPaths::index(const Tracked& t) {
 }
 
 void TrackedPaths::indexSegment(const Tracked& t, uint32_t j, const uint32_t* cells, size_t cellCount) {
-    grid_.insertInto(cells, cellCount, SegmentRef{t.path, t.generation, t.firstBounce + j});
+    grid_.insertInto(cells, cellCount, SegmentRef{t.path, generation_[t.begin + j], t.firstBounce + j});
+    cellCount_[t.begin + j] = uint16_t(cellCount);
+    gridEntries_ += cellCount;
+    liveGridEntries_ += cellCount;
     listOnTriangle(t, j);
 }
 
@@ -65,12 +70,15 @@ void TrackedPaths::listOnTriangle(const Tracked& t, uint32_t j) {
     const Segment& s = segments_[t.begin + j];
     if (!s.hasImpact() || !s.impactDynamic) return;
     if (byTriangle_.size() <= s.triangle) byTriangle_.resize(size_t(s.triangle) + 1);
-    byTriangle_[s.triangle].push_back(SegmentRef{t.path, t.generation, t.firstBounce + j});
+    byTriangle_[s.triangle].push_back(SegmentRef{t.path, generation_[t.begin + j], t.firstBounce + j});
 }
 
 bool TrackedPaths::isLive(const SegmentRef& r) const {
     const int32_t slot = slot_[r.path];
-    return slot >= 0 && paths_[size_t(slot)].generation == r.generation;
+    if (slot < 0) return false;
+    const Tracked& t = paths_[size_t(slot)];
+    const uint32_t j = r.bounce - t.firstBounce;  // wraps for bounces before the first: not live
+    return j < t.count && generation_[t.begin + j] == r.generation;
 }
 
 const Segment* TrackedPaths::segmentOf(const SegmentRef& r) const {
@@ -89,7 +97,7 @@ uint64_t TrackedPaths::segmentsListedOn(const std::vector<uint32_t>& triangles) 
 std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>& movedTriangles,
                                                      const std::vector<uint8_t>& triangleMoved,
                                                      const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh,
-                                                     bool useGrid, FrameTiming& stats) const {
+                                                     bool useGrid, FrameTiming& stats) {
     Stopwatch clock;
     constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
     // Per affected path (by slot), the first bounce to retrace from.
@@ -97,9 +105,16 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
     // (a) A segment that hit a triangle that moved: the photon would now land elsewhere.
     for (uint32_t tri : movedTriangles) {
         if (tri >= byTriangle_.size()) continue;
-        stats.impactCandidates += byTriangle_[tri].size();
-        for (const SegmentRef& r : byTriangle_[tri])
-            if (isLive(r)) firstBounce.push_back({uint32_t(slot_[r.path]), r.bounce});
+        std::vector<SegmentRef>& list = byTriangle_[tri];
+        stats.impactCandidates += list.size();
+        // Stale entries are dropped on the way (the order of the rest is kept).
+        size_t kept = 0;
+        for (const SegmentRef& r : list) {
+            if (!isLive(r)) continue;
+            list[kept++] = r;
+            firstBounce.push_back({uint32_t(slot_[r.path]), r.bounce});
+        }
+        list.resize(kept);
     }
     auto firstPerPath = [](std::vector<std::pair<uint32_t, uint32_t>>& list) {
         std::sort(list.begin(), list.end());
@@ -183,12 +198,12 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
                            FrameTiming& stats) {
     Stopwatch clock;
     // New tails and the grid cells each new segment passes, found in parallel; fixed chunks of
-    // paths, so nothing depends on the schedule.
+    // paths, so nothing depends on the schedule. The kept heads stay listed as they are.
     struct Chunk {
         std::vector<Segment> tails;
         std::vector<uint32_t> tailEnd;   // per path of the chunk: end of its tail in `tails`
-        std::vector<uint32_t> cells;     // per segment of the new paths (kept head, then tail), its cells
-        std::vector<uint32_t> cellsEnd;  // per such segment: end of its cells
+        std::vector<uint32_t> cells;     // per new segment, its cells
+        std::vector<uint32_t> cellsEnd;  // per new segment: end of its cells
     };
     constexpr size_t kChunk = 64;
     std::vector<Chunk> chunks((affected.size() + kChunk - 1) / kChunk);
@@ -197,53 +212,117 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
             Chunk& chunk = chunks[c];
             for (size_t i = c * kChunk; i < std::min(affected.size(), (c + 1) * kChunk); ++i) {
                 const Tracked& t = paths_[size_t(slot_[affected[i].path])];
-                const uint32_t keep = affected[i].bounce - t.firstBounce;
+                const Segment& s = segments_[t.begin + (affected[i].bounce - t.firstBounce)];
                 const size_t tailBegin = chunk.tails.size();
-                const Segment& s = segments_[t.begin + keep];
                 tracer.continuePath(s.path, s.bounce, s.origin, s.direction, s.power, 0.0f, chunk.tails);
                 chunk.tailEnd.push_back(uint32_t(chunk.tails.size()));
-                auto list = [&](const Segment& x) {
+                for (size_t j = tailBegin; j < chunk.tails.size(); ++j) {
+                    const Segment& x = chunk.tails[j];
                     grid_.cellsOf(x.origin, x.direction, reach(x), chunk.cells);
                     chunk.cellsEnd.push_back(uint32_t(chunk.cells.size()));
-                };
-                for (uint32_t j = 0; j < keep; ++j) list(segments_[t.begin + j]);
-                for (size_t j = tailBegin; j < chunk.tails.size(); ++j) list(chunk.tails[j]);
+                }
             }
         }
     });
-    // Sequential and in path order, so the cache's layout is the same for any thread count.
-    size_t garbage = segments_.size() - liveSegments_;
-    size_t removed = 0, added = 0, kept = 0;
-    for (size_t i = 0; i < affected.size(); ++i) {
-        const Tracked& t = paths_[size_t(slot_[affected[i].path])];
-        kept += affected[i].bounce - t.firstBounce;
-        removed += t.count - (affected[i].bounce - t.firstBounce);
-    }
-    for (const Chunk& c : chunks) added += c.tails.size();
-    changes.removed.reserve(changes.removed.size() + removed);
-    changes.added.reserve(changes.added.size() + added);
-    const size_t needed = segments_.size() + added + kept;
-    if (segments_.capacity() < needed) segments_.reserve(std::max(needed, segments_.capacity() + segments_.capacity() / 2));
-    for (size_t i = 0; i < affected.size(); ++i) {
+    auto tailOf = [&](size_t i, uint32_t& begin, uint32_t& end) {
         const Chunk& chunk = chunks[i / kChunk];
         const size_t inChunk = i % kChunk;
-        const uint32_t tailBegin = inChunk ? chunk.tailEnd[inChunk - 1] : 0, tailEnd = chunk.tailEnd[inChunk];
+        begin = inChunk ? chunk.tailEnd[inChunk - 1] : 0;
+        end = chunk.tailEnd[inChunk];
+    };
+
+    // Where everything goes, in path order (so the store's layout is the same for any thread
+    // count): offsets into the removed and added lists, and a new place for a path whose tail
+    // no longer fits its room.
+    struct Move {
+        uint64_t removedAt, addedAt;
+        uint64_t begin;  // the path's place after the retrace
+        uint32_t keep, tailBegin, tailEnd, capacity;
+        uint64_t cellsAt;  // the chunk's cells of this path's first new segment
+    };
+    std::vector<Move> moves(affected.size());
+    uint64_t removed = 0, added = 0, end = segments_.size();
+    size_t staleEntries = 0;
+    for (size_t i = 0; i < affected.size(); ++i) {
+        const Tracked& t = paths_[size_t(slot_[affected[i].path])];
+        Move& m = moves[i];
+        m.keep = affected[i].bounce - t.firstBounce;
+        tailOf(i, m.tailBegin, m.tailEnd);
+        m.removedAt = removed;
+        m.addedAt = added;
+        removed += t.count - m.keep;
+        added += m.tailEnd - m.tailBegin;
+        for (uint32_t j = m.keep; j < t.count; ++j) staleEntries += cellCount_[t.begin + j];
+        const uint32_t count = m.keep + (m.tailEnd - m.tailBegin);
+        m.begin = t.begin;
+        m.capacity = t.capacity;
+        if (count > t.capacity) {
+            // Room to grow by a few bounces, so that the next retraces fit where they land.
+            m.capacity = (count + 4) & ~3u;
+            m.begin = end;
+            end += m.capacity;
+            garbage_ += t.capacity;
+        }
+    }
+    // The first new segment's cells of each path: where the previous path's new segments end.
+    for (size_t c = 0; c < chunks.size(); ++c) {
+        size_t segment = 0;
+        for (size_t i = c * kChunk; i < std::min(affected.size(), (c + 1) * kChunk); ++i) {
+            moves[i].cellsAt = segment;
+            segment += moves[i].tailEnd - moves[i].tailBegin;
+        }
+    }
+    if (segments_.capacity() < end) {
+        const size_t room = std::max<size_t>(end, segments_.capacity() + segments_.capacity() / 2);
+        segments_.reserve(room);
+        generation_.reserve(room);
+        cellCount_.reserve(room);
+    }
+    segments_.resize(end);
+    generation_.resize(end, 0);
+    cellCount_.resize(end, 0);
+    const size_t removedBefore = changes.removed.size(), addedBefore = changes.added.size();
+    changes.removed.resize(removedBefore + removed);
+    changes.added.resize(addedBefore + added);
+
+    // Each path writes only its own places: in parallel.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, affected.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            const Tracked& t = paths_[size_t(slot_[affected[i].path])];
+            const Move& m = moves[i];
+            const Chunk& chunk = chunks[i / kChunk];
+            std::copy(segments_.begin() + int64_t(t.begin + m.keep), segments_.begin() + int64_t(t.begin + t.count),
+                      changes.removed.begin() + int64_t(removedBefore + m.removedAt));
+            std::copy(chunk.tails.begin() + m.tailBegin, chunk.tails.begin() + m.tailEnd,
+                      changes.added.begin() + int64_t(addedBefore + m.addedAt));
+            if (m.begin != t.begin) {
+                std::copy_n(segments_.begin() + int64_t(t.begin), m.keep, segments_.begin() + int64_t(m.begin));
+                std::copy_n(generation_.begin() + int64_t(t.begin), m.keep, generation_.begin() + int64_t(m.begin));
+                std::copy_n(cellCount_.begin() + int64_t(t.begin), m.keep, cellCount_.begin() + int64_t(m.begin));
+            }
+            std::copy(chunk.tails.begin() + m.tailBegin, chunk.tails.begin() + m.tailEnd,
+                      segments_.begin() + int64_t(m.begin + m.keep));
+            for (uint32_t j = 0; j < m.tailEnd - m.tailBegin; ++j) {
+                const size_t n = m.cellsAt + j;
+                const uint32_t from = n ? chunk.cellsEnd[n - 1] : 0;
+                generation_[m.begin + m.keep + j] = t.generation + 1;
+                cellCount_[m.begin + m.keep + j] = uint16_t(chunk.cellsEnd[n] - from);
+            }
+        }
+    });
+    // The paths' records, and the new segments on dynamic triangles listed in path order.
+    size_t newEntries = 0;
+    for (const Chunk& c : chunks) newEntries += c.cells.size();
+    for (size_t i = 0; i < affected.size(); ++i) {
         Tracked& t = paths_[size_t(slot_[affected[i].path])];
-        const uint32_t keep = affected[i].bounce - t.firstBounce;
-        changes.removed.insert(changes.removed.end(), segments_.begin() + int64_t(t.begin + keep),
-                               segments_.begin() + int64_t(t.begin + t.count));
-        changes.added.insert(changes.added.end(), chunk.tails.begin() + tailBegin, chunk.tails.begin() + tailEnd);
-        // The kept head is copied by index: segments_ has room reserved, so nothing moves.
-        const uint64_t begin = segments_.size();
-        for (uint32_t j = 0; j < keep; ++j) segments_.push_back(segments_[t.begin + j]);
-        segments_.insert(segments_.end(), chunk.tails.begin() + tailBegin, chunk.tails.begin() + tailEnd);
-        garbage += t.count;
-        liveSegments_ = liveSegments_ + keep + (tailEnd - tailBegin) - t.count;
-        t.begin = begin;
-        t.count = keep + (tailEnd - tailBegin);
+        const Move& m = moves[i];
+        const uint32_t count = m.keep + (m.tailEnd - m.tailBegin);
+        liveSegments_ = liveSegments_ + count - t.count;
+        t.begin = m.begin;
+        t.count = count;
+        t.capacity = m.capacity;
         ++t.generation;
-        // Listed on its dynamic triangles under the new generation (the grid follows below).
-        for (uint32_t j = 0; j < t.count; ++j) listOnTriangle(t, j);
+        for (uint32_t j = m.keep; j < t.count; ++j) listOnTriangle(t, j);
     }
     // The grid's cells, filled in parallel by shards of cells: each cell takes its entries in
     // path order, whatever the thread count.
@@ -251,36 +330,60 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
     tbb::parallel_for(uint32_t(0), kShards, [&](uint32_t shard) {
         for (size_t c = 0; c < chunks.size(); ++c) {
             const Chunk& chunk = chunks[c];
-            size_t n = 0;  // segments of the chunk whose cells were listed
             for (size_t i = c * kChunk; i < std::min(affected.size(), (c + 1) * kChunk); ++i) {
                 const Tracked& t = paths_[size_t(slot_[affected[i].path])];
-                for (uint32_t j = 0; j < t.count; ++j, ++n) {
+                const Move& m = moves[i];
+                for (uint32_t j = 0; j < m.tailEnd - m.tailBegin; ++j) {
+                    const size_t n = m.cellsAt + j;
                     const uint32_t from = n ? chunk.cellsEnd[n - 1] : 0;
                     grid_.insertIntoShard(chunk.cells.data() + from, chunk.cellsEnd[n] - from,
-                                                           SegmentRef{t.path, t.generation, t.firstBounce + j}, shard, kShards);
+                                          SegmentRef{t.path, t.generation, t.firstBounce + m.keep + j}, shard, kShards);
                 }
             }
         }
     });
+    gridEntries_ += newEntries;
+    liveGridEntries_ = liveGridEntries_ + newEntries - staleEntries;
     stats.pathsRetraced += affected.size();
     stats.segmentsRemoved += removed;
     stats.segmentsAdded += added;
-    // Retraced paths leave their old segments behind; compact once they are half the store.
-    if (garbage > liveSegments_) {
-        std::vector<Segment> compact;
-        compact.reserve(liveSegments_);
-        for (Tracked& t : paths_) {
-            const uint64_t begin = compact.size();
-            compact.insert(compact.end(), segments_.begin() + int64_t(t.begin), segments_.begin() + int64_t(t.begin + t.count));
-            t.begin = begin;
-        }
-        segments_.swap(compact);
-        auto live = [&](const SegmentRef& r) { return isLive(r); };
+    sweepIfStale();
+    stats.retraceSeconds += clock.seconds();
+}
+
+void TrackedPaths::sweepIfStale() {
+    auto live = [&](const SegmentRef& r) { return isLive(r); };
+    if (gridEntries_ > 2 * liveGridEntries_) {
         grid_.sweep(live);
         for (auto& list : byTriangle_)
             list.erase(std::remove_if(list.begin(), list.end(), [&](const SegmentRef& r) { return !live(r); }), list.end());
+        gridEntries_ = liveGridEntries_;
     }
-    stats.retraceSeconds += clock.seconds();
+    if (garbage_ > segments_.size() - garbage_) {
+        // References name (path, generation, bounce), not places: moving paths keeps them.
+        std::vector<Segment> segments;
+        std::vector<uint32_t> generation;
+        std::vector<uint16_t> cellCount;
+        const size_t room = segments_.size() - garbage_;
+        segments.reserve(room);
+        generation.reserve(room);
+        cellCount.reserve(room);
+        for (Tracked& t : paths_) {
+            const uint64_t begin = segments.size();
+            segments.insert(segments.end(), segments_.begin() + int64_t(t.begin), segments_.begin() + int64_t(t.begin + t.count));
+            generation.insert(generation.end(), generation_.begin() + int64_t(t.begin), generation_.begin() + int64_t(t.begin + t.count));
+            cellCount.insert(cellCount.end(), cellCount_.begin() + int64_t(t.begin), cellCount_.begin() + int64_t(t.begin + t.count));
+            t.begin = begin;
+            // Each path keeps its room (the store grows by retraces that outgrow it only).
+            segments.resize(begin + t.capacity);
+            generation.resize(begin + t.capacity, 0);
+            cellCount.resize(begin + t.capacity, 0);
+        }
+        segments_.swap(segments);
+        generation_.swap(generation);
+        cellCount_.swap(cellCount);
+        garbage_ = 0;
+    }
 }
 
 void TrackedPaths::refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const {
@@ -289,11 +392,9 @@ void TrackedPaths::refsNear(const std::vector<Bounds3f>& boxes, std::vector<Segm
     // without sorting what may be millions of entries.
     std::vector<uint64_t> seen(paths_.size(), 0);
     std::vector<SegmentRef> deep;  // bounces past the 64 bits, deduplicated by sorting
-    grid_.visitCells(boxes, [&](const SegmentRef& r) {
+    gridEntries_ -= grid_.visitLiveCells(boxes, [&](const SegmentRef& r) { return isLive(r); }, [&](const SegmentRef& r) {
         const int32_t slot = slot_[r.path];
-        if (slot < 0) return;
         const Tracked& t = paths_[size_t(slot)];
-        if (t.generation != r.generation) return;
         const uint32_t bit = r.bounce - t.firstBounce;
         if (bit >= 64) {
             deep.push_back(r);
@@ -317,8 +418,8 @@ void TrackedPaths::allSegments(std::vector<const Segment*>& out) const {
 size_t TrackedPaths::bytes() const {
     size_t listed = byTriangle_.capacity() * sizeof(byTriangle_[0]);
     for (const auto& list : byTriangle_) listed += list.capacity() * sizeof(SegmentRef);
-    return segments_.capacity() * sizeof(Segment) + paths_.capacity() * sizeof(Tracked) + slot_.capacity() * sizeof(int32_t) +
-           grid_.bytes() + listed;
+    return segments_.capacity() * (sizeof(Segment) + sizeof(uint32_t) + sizeof(uint16_t)) + paths_.capacity() * sizeof(Tracked) +
+           slot_.capacity() * sizeof(int32_t) + grid_.bytes() + listed;
 }
 
 }  // namespace qsgi

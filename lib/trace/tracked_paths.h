@@ -40,10 +40,11 @@ public:
     // newBounds: the moved triangles' bounds in the current pose; bvh: the current pose.
     // useGrid = false tests every tracked segment (the baseline the grid is measured against).
     // Rule (a) reads the segments listed on the moved triangles, rule (b) the grid's cells in
-    // the new bounds: neither scans the tracked segments. Counts and time go to `stats`.
+    // the new bounds: neither scans the tracked segments. Counts and time go to `stats`. Drops
+    // the stale entries it passes.
     std::vector<AffectedPath> findAffected(const std::vector<uint32_t>& movedTriangles, const std::vector<uint8_t>& triangleMoved,
                                            const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh, bool useGrid,
-                                           FrameTiming& stats) const;
+                                           FrameTiming& stats);
     // Live tracked segments that impacted one of the triangles: what rule (a) will find, known
     // before any work, for the update's price.
     uint64_t segmentsListedOn(const std::vector<uint32_t>& triangles) const;
@@ -54,6 +55,8 @@ public:
     // their extension past the impact), each once, in the grid's order: for the blocking test
     // and the discs an update recomputes. And the segment a reference names (valid until the
     // next retrace).
+    // Visiting drops the stale entries of the visited cells (no answer changes), so calls must
+    // not overlap.
     void refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const;
     const Segment& segment(const SegmentRef& r) const { return *segmentOf(r); }
     // Every tracked segment, in path order (valid until the next retrace).
@@ -64,12 +67,17 @@ public:
     size_t bytes() const;
 
 private:
+    // A tracked path's segments sit in segments_[begin, begin + count), room for `capacity`. A
+    // retrace writes the new tail over the old one when it fits (the kept head stays where it
+    // is, and stays listed), and moves the path to the end of the store, with some room to
+    // spare, when it does not.
     struct Tracked {
         uint32_t path;
-        uint32_t generation = 0;
-        uint32_t firstBounce;  // the first segment kept: the first that meets the envelope
-        uint64_t begin;        // into segments_
+        uint32_t generation = 0;  // of its newest segments: bumped by each retrace
+        uint32_t firstBounce;     // the first segment kept: the first that meets the envelope
+        uint64_t begin;           // into segments_
         uint32_t count;
+        uint32_t capacity;
     };
     const Segment* segmentOf(const SegmentRef& r) const;
     bool isLive(const SegmentRef& r) const;
@@ -79,13 +87,25 @@ private:
     void listOnTriangle(const Tracked& t, uint32_t j);
     double reach(const Segment& s) const;  // how far along the ray the grid lists it
 
+    // Drops stale entries from the grid and the per-triangle lists once they outnumber the live
+    // ones, and compacts the store once moved paths left more garbage than it holds live.
+    void sweepIfStale();
+
     Envelope envelope_;
     float extension_;
-    std::vector<Segment> segments_;  // tracked tails, appended; retraced paths leave garbage
+    std::vector<Segment> segments_;  // tracked tails; paths that outgrew their room leave garbage
+    // Per slot of segments_: the generation its segment was written in (a reference is live if
+    // it names that generation), and how many grid cells list it.
+    std::vector<uint32_t> generation_;
+    std::vector<uint16_t> cellCount_;
+    size_t garbage_ = 0;             // slots of segments_ no path owns
+    mutable size_t gridEntries_ = 0;  // listed in the grid, stale ones included
+    size_t liveGridEntries_ = 0;
     std::vector<Tracked> paths_;     // increasing path id
     std::vector<int32_t> slot_;      // path id -> index in paths_, −1 if untracked
     size_t liveSegments_ = 0;
-    SegmentGrid grid_;
+    // Mutable: refsNear drops stale entries as it passes them, which changes no answer.
+    mutable SegmentGrid grid_;
     // Per scene triangle, the tracked segments that impacted it (dynamic triangles only): rule (a).
     std::vector<std::vector<SegmentRef>> byTriangle_;
 };
