@@ -61,6 +61,9 @@ struct EstimatorContext {
     const SceneBvh& bvh;  // the scene's triangles in the current pose
     const EmbreeDevice& device;
     const DiscRegions* regions;  // null when the estimator needs none (needsDiscRegions)
+    // Frames will be updated from this one (not --full-recompute): an estimator may keep what
+    // its updates need while it solves (the photon map's neighbour lists).
+    bool updatesFollow = false;
 };
 
 class Estimator {

@@ -140,7 +140,7 @@ Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const Verte
     const bool full = found == size_t(k) && k > 1;
     const size_t summed = full ? found - 1 : found;
     PowerSum sum;
-    for (size_t i = 0; i < summed; ++i) sum.add(impacts_[sortedFront[i].impact].power, quantizer_);
+    for (size_t i = 0; i < summed; ++i) sum.add(sortedFront[i].power, quantizer_);
     double r = full ? std::sqrt(double(sortedFront[found - 1].distanceSquared)) : double(radius);
     if (!(r > 0)) r = double(radius);  // k coincident impacts: no finite density to report
     // The part of the r disc that surfaces facing n_v cover (all of it without regions).
@@ -156,14 +156,14 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
                            const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) const {
     if (out.size() != scene.vertexCount()) out.resize(scene.vertexCount(), Vec3f(0.0f));
     if (ballsSquared_.size() != scene.vertexCount()) ballsSquared_.assign(scene.vertexCount(), kNeverEstimated);
+    if (keepLists_ && lists_.size() != scene.vertexCount()) lists_.assign(scene.vertexCount(), NeighbourList());
     const float radiusSquared = radius * radius;
+    std::vector<uint8_t> queried(vertices.size(), 0);
     const size_t bigLive = big_ ? big_->liveSize() : 0, smallLive = small_ ? small_->liveSize() : 0;
     const size_t most = std::max(bigLive, smallLive);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<size_t> indices;
-        std::vector<float> d2;
-        std::vector<std::pair<float, uint32_t>> candidates;  // distance², slot
         std::vector<Neighbour> front;
+        QueryScratch scratch;
         for (size_t q = r.begin(); q != r.end(); ++q) {
             const uint32_t v = vertices[q];
             if (k <= 0) {
@@ -171,47 +171,15 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
                 ballsSquared_[v] = kNoBall;
                 continue;
             }
-            const Vec3f& p = scene.positions[v];
             const VertexFilter filter = filterFor(scene, regions, v);
-            // Impacts that do not count are skipped, so ask the trees for more neighbours until k
-            // counted ones are found or the candidates run past the radius. Distances are
-            // recomputed as bruteForce computes them.
-            size_t want = std::min(most, 2 * size_t(k));
-            while (true) {
-                candidates.clear();
-                // Every live impact nearer than `complete` is among the candidates; beyond it a
-                // tree may hold impacts it did not return (ties with its farthest one included).
-                float complete = std::numeric_limits<float>::infinity();
-                bool all = true;  // both trees returned all their live impacts
-                const auto ask = [&](const PointIndex* tree, size_t live, size_t firstSlot, size_t count) {
-                    const size_t n = std::min(count, live);
-                    if (n == 0) return;
-                    tree->nearest(p, n, indices, d2);
-                    float farthest = 0;
-                    for (size_t i = 0; i < indices.size(); ++i) {
-                        const uint32_t slot = uint32_t(firstSlot + indices[i]);
-                        const float dd = PointIndex::distanceSquared(p, impacts_[slot].point);
-                        farthest = std::max(farthest, dd);
-                        candidates.emplace_back(dd, slot);
-                    }
-                    if (n < live) {
-                        complete = std::min(complete, farthest);
-                        all = false;
-                    }
-                };
-                ask(big_.get(), bigLive, 0, want);
-                // The small tree is sparser: as many as the big tree's would reach much farther,
-                // each a candidate to test. Twice its share covers about as far.
-                ask(small_.get(), smallLive, bigCount_, 8 + 2 * want * smallLive / std::max<size_t>(bigLive, 1));
-                // Only the candidates nearer than `complete` are tested: past it the k nearest
-                // could be missing an impact, and a sparse tree's far candidates cost tests for
-                // nothing.
-                front.clear();
-                for (const auto& [dd, slot] : candidates)
-                    if ((all || dd < complete) && dd <= radiusSquared && counts(filter, impacts_[slot]))
-                        front.push_back({dd, impacts_[slot].key, slot});
-                if (all || complete > radiusSquared || front.size() >= size_t(k)) break;
-                want = std::min(most, want * 4);
+            if (keepLists_ && lists_[v].valid) {
+                // Every counted impact nearer than the list's bound is in it; at least k are,
+                // or the bound is the search radius: the k nearest are the list's.
+                front = lists_[v].counted;
+            } else {
+                queried[q] = 1;
+                nearestCounted(scene.positions[v], filter, radiusSquared, k, bigLive, smallLive, most, scratch, front,
+                               keepLists_ ? &lists_[v] : nullptr);
             }
             const size_t keep = std::min(front.size(), size_t(k));
             std::partial_sort(front.begin(), front.begin() + keep, front.end());
@@ -220,6 +188,86 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
             ballsSquared_[v] = keep == size_t(k) ? front[keep - 1].distanceSquared : radiusSquared;
         }
     });
+    lastQueries_ = size_t(std::count(queried.begin(), queried.end(), 1));
+}
+
+void PhotonMap::nearestCounted(const Vec3f& p, const VertexFilter& filter, float radiusSquared, int k, size_t bigLive,
+                               size_t smallLive, size_t most, QueryScratch& scratch, std::vector<Neighbour>& front,
+                               NeighbourList* list) const {
+    std::vector<size_t>& indices = scratch.indices;
+    std::vector<float>& d2 = scratch.d2;
+    std::vector<std::pair<float, uint32_t>>& candidates = scratch.candidates;  // distance², slot
+    // Impacts that do not count are skipped: ask the trees for twice k neighbours, and if
+    // fewer than k of them count, for all within the radius. Distances are recomputed as
+    // bruteForce computes them.
+    const size_t want = std::min(most, 2 * size_t(k));
+    candidates.clear();
+    // Every live impact nearer than `complete` is among the candidates; beyond it a
+    // tree may hold impacts it did not return (ties with its farthest one included).
+    float complete = std::numeric_limits<float>::infinity();
+    bool all = true;  // both trees returned all their live impacts
+    const auto ask = [&](const PointIndex* tree, size_t live, size_t firstSlot, size_t count) {
+        const size_t n = std::min(count, live);
+        if (n == 0) return;
+        tree->nearest(p, n, indices, d2);
+        float farthest = 0;
+        for (size_t i = 0; i < indices.size(); ++i) {
+            const uint32_t slot = uint32_t(firstSlot + indices[i]);
+            const float dd = PointIndex::distanceSquared(p, impacts_[slot].point);
+            farthest = std::max(farthest, dd);
+            candidates.emplace_back(dd, slot);
+        }
+        if (n < live) {
+            complete = std::min(complete, farthest);
+            all = false;
+        }
+    };
+    ask(big_.get(), bigLive, 0, want);
+    // The small tree is sparser: as many as the big tree's would reach much farther,
+    // each a candidate to test. Twice its share covers about as far.
+    ask(small_.get(), smallLive, bigCount_, 8 + 2 * want * smallLive / std::max<size_t>(bigLive, 1));
+    // Only the candidates nearer than `complete` are tested: past it the k nearest
+    // could be missing an impact, and a sparse tree's far candidates cost tests for
+    // nothing.
+    front.clear();
+    for (const auto& [dd, slot] : candidates)
+        if ((all || dd < complete) && dd <= radiusSquared && counts(filter, impacts_[slot]))
+            front.push_back({dd, impacts_[slot].key, impacts_[slot].power});
+    if (all || complete > radiusSquared || front.size() >= size_t(k)) {
+        if (list) {
+            // What was tested is complete up to `complete` (or the radius).
+            list->counted = front;
+            list->inclusive = all || complete > radiusSquared;
+            list->bound = list->inclusive ? radiusSquared : complete;
+            list->valid = true;
+        }
+        return;
+    }
+    // Too few counted among the nearest (a vertex beside surfaces its filter rejects):
+    // everything within the radius, from one radius search per tree, rather than asking
+    // again for ever more neighbours. The same set such a growing search ends with.
+    candidates.clear();
+    const float padded = radiusSquared * (1.0f + 1e-5f) + std::numeric_limits<float>::min();
+    const auto within = [&](const PointIndex* tree, size_t live, size_t firstSlot) {
+        if (!tree || live == 0) return;
+        tree->withinRadius(p, padded, indices, d2);
+        for (size_t i : indices) {
+            const uint32_t slot = uint32_t(firstSlot + i);
+            candidates.emplace_back(PointIndex::distanceSquared(p, impacts_[slot].point), slot);
+        }
+    };
+    within(big_.get(), bigLive, 0);
+    within(small_.get(), smallLive, bigCount_);
+    front.clear();
+    for (const auto& [dd, slot] : candidates)
+        if (dd <= radiusSquared && counts(filter, impacts_[slot]))
+            front.push_back({dd, impacts_[slot].key, impacts_[slot].power});
+    if (list) {
+        list->counted = front;
+        list->inclusive = true;
+        list->bound = radiusSquared;
+        list->valid = true;
+    }
 }
 
 std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, const DiscRegions* regions, float radius, int k,
@@ -246,7 +294,7 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
             for (size_t i = 0; i < impacts_.size(); ++i) {
                 if (i < bigCount_ && bigDead_[i]) continue;
                 const float d2 = PointIndex::distanceSquared(scene.positions[v], impacts_[i].point);
-                if (d2 <= radiusSquared && counts(filter, impacts_[i])) front.push_back({d2, impacts_[i].key, uint32_t(i)});
+                if (d2 <= radiusSquared && counts(filter, impacts_[i])) front.push_back({d2, impacts_[i].key, impacts_[i].power});
             }
             const size_t keep = std::min(front.size(), size_t(k));
             std::partial_sort(front.begin(), front.begin() + keep, front.end());
@@ -286,6 +334,62 @@ std::vector<uint32_t> PhotonMap::ballsHolding(const Scene& scene, const DiscRegi
     for (size_t v = 0; v < holds.size(); ++v)
         if (holds[v]) vertices.push_back(uint32_t(v));
     return vertices;
+}
+
+std::vector<uint32_t> PhotonMap::editLists(const Scene& scene, const DiscRegions* regions, const std::vector<Segment>& changed,
+                                           bool entering, int k) {
+    if (lists_.size() != scene.vertexCount()) lists_.assign(scene.vertexCount(), NeighbourList());
+    std::vector<Impact> impacts;
+    std::vector<Vec3f> points;
+    for (const Segment& s : changed)
+        if (s.hasImpact()) {
+            impacts.push_back(impactOf(s));
+            points.push_back(impacts.back().point);
+        }
+    std::vector<uint8_t> edited(scene.vertexCount(), 0);
+    std::unique_ptr<PointIndex> index = impacts.empty() ? nullptr : std::make_unique<PointIndex>(std::move(points));
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, scene.vertexCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<size_t> found;
+        std::vector<float> d2;
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            NeighbourList& list = lists_[v];
+            if (!list.valid) {
+                edited[v] = 1;
+                continue;
+            }
+            if (!index) continue;
+            const Vec3f& p = scene.positions[v];
+            // A hair wider than the bound, so that the tree's own comparison at the rim cannot
+            // leave out an impact the list's test keeps.
+            index->withinRadius(p, list.bound * (1.0f + 1e-5f) + std::numeric_limits<float>::min(), found, d2);
+            const VertexFilter filter = filterFor(scene, regions, v);
+            for (size_t i : found) {
+                const float dd = PointIndex::distanceSquared(p, impacts[i].point);
+                if (!list.holds(dd) || !counts(filter, impacts[i])) continue;
+                edited[v] = 1;
+                if (entering) {
+                    list.counted.push_back({dd, impacts[i].key, impacts[i].power});
+                    continue;
+                }
+                const auto it = std::find_if(list.counted.begin(), list.counted.end(),
+                                             [&](const Neighbour& n) { return n.key == impacts[i].key; });
+                if (it == list.counted.end()) throw std::logic_error("PhotonMap::editLists: a removed impact is not in its list");
+                *it = list.counted.back();
+                list.counted.pop_back();
+            }
+            // Fewer than k inside a bound short of the radius: the k-th lies beyond, unknown.
+            if (!entering && !list.inclusive && list.counted.size() < size_t(std::max(k, 0))) list.valid = false;
+        }
+    });
+    std::vector<uint32_t> vertices;
+    for (size_t v = 0; v < edited.size(); ++v)
+        if (edited[v]) vertices.push_back(uint32_t(v));
+    return vertices;
+}
+
+void PhotonMap::forget(const std::vector<uint32_t>& vertices) {
+    for (uint32_t v : vertices)
+        if (v < lists_.size()) lists_[v].valid = false;
 }
 
 }  // namespace qsgi

@@ -67,6 +67,24 @@ public:
     // change. Not during an estimate.
     std::vector<uint32_t> ballsHolding(const Scene& scene, const DiscRegions* regions, const std::vector<Segment>& changed) const;
 
+    // Neighbour lists, for a map that follows an animation: with them on, every estimate also
+    // keeps the vertex's *list* — every counted impact within a bound at least as far as its
+    // k-th (the candidates its query tested) — and editLists() keeps each list exact through a
+    // change, so that irradianceAt() estimates a vertex from its list alone, and queries the
+    // trees again only where a list fell short of k inside its bound, or was forgotten.
+    void keepLists(bool on) { keepLists_ = on; }
+    // Removed impacts (entering = false; judged as ballsHolding judges them: before update())
+    // leave the lists that hold them, added ones (after update()) enter the lists whose bound
+    // holds them and that they count for. Returns the vertices whose list changed or that have
+    // none (sorted): those whose estimate may change.
+    std::vector<uint32_t> editLists(const Scene& scene, const DiscRegions* regions, const std::vector<Segment>& changed,
+                                    bool entering, int k);
+    // The vertices' lists no longer hold (they moved, or their filter changed): their next
+    // estimate queries the trees.
+    void forget(const std::vector<uint32_t>& vertices);
+    // Of the vertices the last irradianceAt() estimated, how many it queried the trees for.
+    size_t lastQueries() const { return lastQueries_; }
+
     size_t size() const { return impacts_.size() - bigRemoved_; }  // live impacts
 
 private:
@@ -85,7 +103,7 @@ private:
     struct Neighbour {
         float distanceSquared;
         uint64_t key;
-        uint32_t impact;
+        Vec3f power;
         bool operator<(const Neighbour& o) const {
             return distanceSquared < o.distanceSquared || (distanceSquared == o.distanceSquared && key < o.key);
         }
@@ -102,6 +120,17 @@ private:
     Vec3f estimate(const std::vector<Neighbour>& sortedCounted, const VertexDisc* disc, float radius, int k) const;
     void estimateAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
                     const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) const;
+    struct NeighbourList;
+    struct QueryScratch {  // reused across one thread's queries
+        std::vector<size_t> indices;
+        std::vector<float> d2;
+        std::vector<std::pair<float, uint32_t>> candidates;
+    };
+    // The counted impacts a query of the trees finds for a vertex at p (at least the k nearest
+    // within the radius), unsorted; and, if given, the list they make.
+    void nearestCounted(const Vec3f& p, const VertexFilter& filter, float radiusSquared, int k, size_t bigLive,
+                        size_t smallLive, size_t most, QueryScratch& scratch, std::vector<Neighbour>& front,
+                        NeighbourList* list) const;
 
     // Slot of the live impact with this key in the big tree, or -1.
     int64_t bigSlot(uint64_t key) const;
@@ -124,6 +153,19 @@ private:
     // Per vertex, r_k² of its last estimate; +inf: never estimated; < 0: no ball (k ≤ 0).
     // irradiance() is const for its one-shot callers; recording changes none of its answers.
     mutable std::vector<float> ballsSquared_;
+
+    // Every counted impact at distance² < bound (≤ bound where inclusive: the search radius),
+    // unsorted. Valid lists hold exactly that set.
+    struct NeighbourList {
+        std::vector<Neighbour> counted;
+        float bound = 0;
+        bool inclusive = false;
+        bool valid = false;
+        bool holds(float distanceSquared) const { return inclusive ? distanceSquared <= bound : distanceSquared < bound; }
+    };
+    bool keepLists_ = false;
+    mutable std::vector<NeighbourList> lists_;  // per vertex, with keepLists_ (estimates write them)
+    mutable size_t lastQueries_ = 0;
 
     std::vector<Vec3f> frontNormals_;
     const SceneBvh* bvh_;  // of the impacted triangles, for the 45° test

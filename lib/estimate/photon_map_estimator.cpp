@@ -20,10 +20,12 @@ namespace {
 class PhotonMapEstimator final : public Estimator {
 public:
     PhotonMapEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
-        : settings_(settings), scene_(context.scene), bvh_(context.bvh), regions_(context.regions) {}
+        : settings_(settings), scene_(context.scene), bvh_(context.bvh), regions_(context.regions),
+          keepLists_(context.updatesFollow && settings.useIndex) {}
 
     void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
         map_.emplace(cache, scene_, &bvh_);
+        map_->keepLists(keepLists_);
         const EstimatorSettings& e = settings_;
         if (e.useIndex) {
             out.irradiance.assign(scene_.vertexCount(), Vec3f(0.0f));
@@ -41,11 +43,21 @@ public:
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
         const EstimatorSettings& e = settings_;
         Stopwatch clock;
-        // The balls of the previous frame that a changed impact which counts there enters or
-        // leaves: the removed ones judged with the triangles as they were, the added ones after.
-        std::vector<uint32_t> vertices = map_->ballsHolding(scene_, regions_, change.removed);
-        map_->update(change.removed, change.added, scene_);
-        const std::vector<uint32_t> entered = map_->ballsHolding(scene_, regions_, change.added);
+        // The lists (or, without them, the balls) of the previous frame that a changed impact
+        // which counts there enters or leaves: the removed ones judged with the triangles as
+        // they were, the added ones after. The touched vertices are queried afresh.
+        std::vector<uint32_t> vertices, entered;
+        if (keepLists_) {
+            // First: a touched vertex's filter changed, its list no longer matches it.
+            map_->forget(change.touched);
+            vertices = map_->editLists(scene_, regions_, change.removed, false, e.k);
+            map_->update(change.removed, change.added, scene_);
+            entered = map_->editLists(scene_, regions_, change.added, true, e.k);
+        } else {
+            vertices = map_->ballsHolding(scene_, regions_, change.removed);
+            map_->update(change.removed, change.added, scene_);
+            entered = map_->ballsHolding(scene_, regions_, change.added);
+        }
         vertices.insert(vertices.end(), entered.begin(), entered.end());
         vertices.insert(vertices.end(), change.touched.begin(), change.touched.end());
         std::sort(vertices.begin(), vertices.end());
@@ -60,8 +72,9 @@ public:
         }
         computeRadiosity(scene_, out);
         stats.recomputeSeconds = clock.seconds();
+        // Updated: estimated again; recomputed: from a fresh query of the trees.
         stats.verticesUpdated = vertices.size();
-        stats.verticesRecomputed = vertices.size();
+        stats.verticesRecomputed = e.useIndex ? map_->lastQueries() : vertices.size();
     }
 
 private:
@@ -79,6 +92,7 @@ private:
     const Scene& scene_;
     const SceneBvh& bvh_;
     const DiscRegions* regions_;
+    bool keepLists_;  // updates follow: neighbour lists kept (indexed only; brute force is the reference)
     std::optional<PhotonMap> map_;
 };
 

@@ -35,7 +35,7 @@ FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSo
     : scene_(scene), settings_(settings), bvh_(device, scene),
       tracer_(scene, bvh_, aimedAtEstimator(settings.trace, settings.estimator)) {
     if (needsDiscRegions(settings_.estimator)) regions_.emplace(makeDiscRegions(settings_.estimator));
-    estimator_ = Estimator::create(settings_.estimator, EstimatorContext{scene_, bvh_, device, regions()});
+    estimator_ = Estimator::create(settings_.estimator, EstimatorContext{scene_, bvh_, device, regions(), !settings_.fullRecompute});
 }
 
 FrameSolver::~FrameSolver() = default;
