@@ -1,6 +1,7 @@
 // The photon map follows a changing photon set (DESIGN §6.4): after update() its estimates equal,
 // bit for bit, those of a map built from scratch over the same impacts and those of brute force;
-// and recomputing only the vertices ballsHolding() names gives the full estimate of the new set.
+// and recomputing only the vertices ballsHolding() names, or those whose neighbour lists
+// editLists() edits, gives the full estimate of the new set.
 // Ties (equal distances) occur on purpose: some added impacts copy a live one exactly.
 #include <gtest/gtest.h>
 
@@ -270,6 +271,88 @@ TEST(PhotonMapUpdate, RecomputingTheBallsHoldingAChangeEqualsAFullEstimate) {
         EXPECT_GT(changed, 0u);
         EXPECT_LT(recomputed, 6 * f.scene.vertexCount() / 2);
     }
+}
+
+// With neighbour lists (what an animation's frames use), a change edits the lists that hold its
+// impacts, and only the vertices editLists() names are estimated again — from their lists, or by
+// a fresh query where a list fell short. The result equals a full estimate of the new set, round
+// after round, ties and impacts beside uncounted clusters included. Checked once by breaking it:
+// leaving the added impacts out of the lists makes every case fail ("round 0: … differ").
+TEST(PhotonMapUpdate, EstimatesFromEditedNeighbourListsEqualAFullEstimate) {
+    Fixture f;
+    for (const EstimateCase& e : kCases) {
+        SCOPED_TRACE(e.name());
+        const DiscRegions covered = f.regionsFor(e.radius);
+        const DiscRegions* regions = e.regions ? &covered : nullptr;
+        ChangingPhotons photons(f.full, f.scene, 151);
+        PhotonMap map(photons.liveCache(), f.scene, &f.bvh);
+        map.keepLists(true);
+        std::vector<Vec3f> current = map.irradiance(f.scene, regions, e.radius, e.k, f.all);
+        size_t estimated = 0, queried = 0, changed = 0;
+        for (size_t round = 0; round < 6; ++round) {
+            const ChangingPhotons::Change change = photons.next(round);
+            std::vector<uint32_t> vertices = map.editLists(f.scene, regions, change.removed, false, e.k);
+            map.update(change.removed, change.added, f.scene);
+            const std::vector<uint32_t> entered = map.editLists(f.scene, regions, change.added, true, e.k);
+            ASSERT_TRUE(std::is_sorted(vertices.begin(), vertices.end()));
+            ASSERT_TRUE(std::is_sorted(entered.begin(), entered.end()));
+            vertices.insert(vertices.end(), entered.begin(), entered.end());
+            std::sort(vertices.begin(), vertices.end());
+            vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+            const std::vector<Vec3f> before = current;
+            map.irradianceAt(f.scene, regions, e.radius, e.k, vertices, current);
+            const auto expected = PhotonMap(photons.liveCache(), f.scene, &f.bvh).irradiance(f.scene, regions, e.radius, e.k, f.all);
+            EXPECT_TRUE(sameBits(current, expected)) << "round " << round << ": " << differing(current, expected) << " differ";
+            estimated += vertices.size();
+            queried += map.lastQueries();
+            changed += differing(before, expected);
+        }
+        // The test means something: estimates changed, and the lists answered most of them.
+        EXPECT_GT(changed, 0u);
+        EXPECT_LT(queried, estimated / 2);
+    }
+}
+
+// Removing every impact near a vertex drains its list below k (k = 4 here, the bound far short
+// of the radius): the bound no longer reaches the k-th, and the vertex must be queried again
+// (skipping that check makes this fail).
+TEST(PhotonMapUpdate, AListDrainedBelowKIsQueriedAgain) {
+    Fixture f;
+    const DiscRegions covered = f.regionsFor(0.15f);
+    // A floor vertex in the open: the vertex nearest (0.5, 0, 0.5).
+    uint32_t centre = 0;
+    for (uint32_t v = 0; v < f.scene.vertexCount(); ++v)
+        if (length(f.scene.positions[v] - Vec3f(0.5f, 0.0f, 0.5f)) < length(f.scene.positions[centre] - Vec3f(0.5f, 0.0f, 0.5f)))
+            centre = v;
+    PhotonMap map(f.full, f.scene, &f.bvh);
+    map.keepLists(true);
+    std::vector<Vec3f> current = map.irradiance(f.scene, &covered, 0.15f, 4, f.all);
+    RayCache rest = f.full;
+    rest.segments.clear();
+    std::vector<Segment> removed;
+    for (const Segment& s : f.full.segments)
+        (s.hasImpact() && length(s.impactPoint() - f.scene.positions[centre]) < 0.12f ? removed : rest.segments).push_back(s);
+    ASSERT_GT(removed.size(), 8u);  // twice k: more than the list's bound held
+    std::vector<uint32_t> vertices = map.editLists(f.scene, &covered, removed, false, 4);
+    map.update(removed, {}, f.scene);
+    ASSERT_TRUE(std::binary_search(vertices.begin(), vertices.end(), centre));
+    map.irradianceAt(f.scene, &covered, 0.15f, 4, vertices, current);
+    EXPECT_GT(map.lastQueries(), 0u);
+    EXPECT_TRUE(sameBits(current, PhotonMap(rest, f.scene, &f.bvh).irradiance(f.scene, &covered, 0.15f, 4, f.all)));
+}
+
+// A vertex whose filter changed (it moved, or its regions did) is forgotten and queried afresh.
+TEST(PhotonMapUpdate, AForgottenListIsQueriedAgain) {
+    Fixture f;
+    const DiscRegions covered = f.regionsFor(0.15f);
+    PhotonMap map(f.full, f.scene, &f.bvh);
+    map.keepLists(true);
+    std::vector<Vec3f> current = map.irradiance(f.scene, &covered, 0.15f, 50, f.all);
+    map.irradianceAt(f.scene, &covered, 0.15f, 50, {0, 1, 2}, current);
+    EXPECT_EQ(map.lastQueries(), 0u);
+    map.forget({1});
+    map.irradianceAt(f.scene, &covered, 0.15f, 50, {0, 1, 2}, current);
+    EXPECT_EQ(map.lastQueries(), 1u);
 }
 
 // update() takes the triangles' front normals of the pose it is given (a turned triangle changes
