@@ -178,7 +178,8 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
         stats.trackedBytes = tracked_->bytes();
         stats.segments = foldedSegments_ + tracked_->trackedSegments();
     }
-    stats.estimatorStateBytes = estimator_->stateBytes();
+    // The regions' kept static answers are incremental state too.
+    stats.estimatorStateBytes = estimator_->stateBytes() + (regions_ ? regions_->keptAnswerBytes() : 0);
     if (regions_) {
         stats.ownSurfaceFallbacks = regions_->fallbackVertices();
         stats.buriedVertices = regions_->buriedVertices();
