@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "estimate/own_surface.h"
+#include "estimate/point_grid.h"
 
 namespace qsgi {
 
@@ -130,8 +131,9 @@ bool PhotonMap::counts(const VertexFilter& f, const Impact& impact) const {
                           x, y, bvh_);
 }
 
-Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, const VertexDisc* disc, float radius, int k) const {
-    const size_t found = std::min(sortedFront.size(), size_t(k));
+Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, size_t sorted, const VertexDisc* disc, float radius,
+                          int k) const {
+    const size_t found = std::min(sorted, size_t(k));
     if (found == 0) return Vec3f(0.0f);
     // With k neighbours, the k-th only marks the radius r_k: it lies on the disc's rim, and
     // counting it biases the estimate by k/(k−1) for a uniform density (E[(k−1)/(π r_k²)] = λ).
@@ -172,20 +174,20 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
                 continue;
             }
             const VertexFilter filter = filterFor(scene, regions, v);
-            if (keepLists_ && lists_[v].valid) {
-                // Every counted impact nearer than the list's bound is in it; at least k are,
-                // or the bound is the search radius: the k nearest are the list's.
-                front = lists_[v].counted;
-            } else {
+            // Every counted impact nearer than a valid list's bound is in it; at least k are, or
+            // the bound is the search radius: the k nearest are the list's (sorted in place: a
+            // list's order is free).
+            const bool fromList = keepLists_ && lists_[v].valid;
+            if (!fromList) {
                 queried[q] = 1;
                 nearestCounted(scene.positions[v], filter, radiusSquared, k, bigLive, smallLive, most, scratch, front,
                                keepLists_ ? &lists_[v] : nullptr);
             }
-            const size_t keep = std::min(front.size(), size_t(k));
-            std::partial_sort(front.begin(), front.begin() + keep, front.end());
-            front.resize(keep);
-            out[v] = estimate(front, filter.disc, radius, k);
-            ballsSquared_[v] = keep == size_t(k) ? front[keep - 1].distanceSquared : radiusSquared;
+            std::vector<Neighbour>& counted = fromList ? lists_[v].counted : front;
+            const size_t keep = std::min(counted.size(), size_t(k));
+            std::partial_sort(counted.begin(), counted.begin() + keep, counted.end());
+            out[v] = estimate(counted, keep, filter.disc, radius, k);
+            ballsSquared_[v] = keep == size_t(k) ? counted[keep - 1].distanceSquared : radiusSquared;
         }
     });
     lastQueries_ = size_t(std::count(queried.begin(), queried.end(), 1));
@@ -298,8 +300,7 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
             }
             const size_t keep = std::min(front.size(), size_t(k));
             std::partial_sort(front.begin(), front.begin() + keep, front.end());
-            front.resize(keep);
-            out[v] = estimate(front, filter.disc, radius, k);
+            out[v] = estimate(front, keep, filter.disc, radius, k);
         }
     });
     return out;
@@ -347,23 +348,26 @@ std::vector<uint32_t> PhotonMap::editLists(const Scene& scene, const DiscRegions
             points.push_back(impacts.back().point);
         }
     std::vector<uint8_t> edited(scene.vertexCount(), 0);
-    std::unique_ptr<PointIndex> index = impacts.empty() ? nullptr : std::make_unique<PointIndex>(std::move(points));
+    // A grid a list's bound across (a linear-time build: the changed impacts are many, the
+    // queries one per vertex).
+    float widest = 0;
+    for (const NeighbourList& list : lists_)
+        if (list.valid) widest = std::max(widest, list.bound);
+    const PointGrid grid(points, std::sqrt(widest));
     tbb::parallel_for(tbb::blocked_range<size_t>(0, scene.vertexCount(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<size_t> found;
-        std::vector<float> d2;
+        std::vector<uint32_t> found;
         for (size_t v = r.begin(); v != r.end(); ++v) {
             NeighbourList& list = lists_[v];
             if (!list.valid) {
                 edited[v] = 1;
                 continue;
             }
-            if (!index) continue;
             const Vec3f& p = scene.positions[v];
-            // A hair wider than the bound, so that the tree's own comparison at the rim cannot
-            // leave out an impact the list's test keeps.
-            index->withinRadius(p, list.bound * (1.0f + 1e-5f) + std::numeric_limits<float>::min(), found, d2);
+            found.clear();
+            grid.visitNear(p, std::sqrt(list.bound), [&](uint32_t i) { found.push_back(i); });
+            if (found.empty()) continue;
             const VertexFilter filter = filterFor(scene, regions, v);
-            for (size_t i : found) {
+            for (uint32_t i : found) {
                 const float dd = PointIndex::distanceSquared(p, impacts[i].point);
                 if (!list.holds(dd) || !counts(filter, impacts[i])) continue;
                 edited[v] = 1;
@@ -385,6 +389,12 @@ std::vector<uint32_t> PhotonMap::editLists(const Scene& scene, const DiscRegions
     for (size_t v = 0; v < edited.size(); ++v)
         if (edited[v]) vertices.push_back(uint32_t(v));
     return vertices;
+}
+
+size_t PhotonMap::listBytes() const {
+    size_t bytes = lists_.capacity() * sizeof(NeighbourList);
+    for (const NeighbourList& list : lists_) bytes += list.counted.capacity() * sizeof(Neighbour);
+    return bytes;
 }
 
 void PhotonMap::forget(const std::vector<uint32_t>& vertices) {

@@ -84,6 +84,8 @@ public:
     void forget(const std::vector<uint32_t>& vertices);
     // Of the vertices the last irradianceAt() estimated, how many it queried the trees for.
     size_t lastQueries() const { return lastQueries_; }
+    // Bytes of the neighbour lists.
+    size_t listBytes() const;
 
     size_t size() const { return impacts_.size() - bigRemoved_; }  // live impacts
 
@@ -116,8 +118,9 @@ private:
     };
     VertexFilter filterFor(const Scene& scene, const DiscRegions* regions, size_t v) const;
     bool counts(const VertexFilter& f, const Impact& impact) const;
-    // E from the counted neighbours, nearest first.
-    Vec3f estimate(const std::vector<Neighbour>& sortedCounted, const VertexDisc* disc, float radius, int k) const;
+    // E from the counted neighbours, the first `sorted` of them nearest first (at least min(k,
+    // all) of them).
+    Vec3f estimate(const std::vector<Neighbour>& sortedCounted, size_t sorted, const VertexDisc* disc, float radius, int k) const;
     void estimateAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
                     const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) const;
     struct NeighbourList;

@@ -79,6 +79,8 @@ public:
         stats.verticesRecomputed = e.useIndex ? map_->lastQueries() : vertices.size();
     }
 
+    size_t stateBytes() const override { return map_ && keepLists_ ? map_->listBytes() : 0; }
+
 private:
     // Morton order of the given vertices (coherent queries), unless input order was asked for.
     std::vector<uint32_t> queryOrder(const std::vector<uint32_t>& vertices) const {
