@@ -6,7 +6,8 @@ For every case it renders the same frames twice (incremental, then --full-recomp
 and reports from the two timing.json files:
 - the median and slowest frame after the first, each way, and their ratio;
 - where an incremental frame's time goes (find, retrace, estimator update, disc regions,
-  recompute), the paths and segments changed, the vertices recomputed;
+  recompute; writing the PLY apart, outside the frame's time), the paths and segments changed,
+  the vertices recomputed;
 - the price of the frame's changed work at the full frame's own rates: the added segments at the
   full frame's seconds per segment (tracing plus estimation) and the recomputed vertices at its
   estimation seconds per vertex; overhead = frame time / price - 1;
@@ -91,7 +92,7 @@ def measure(name, args, qsgi):
         "ratio": full_median / statistics.median(frame_time(f) for f in fi),
         "from_scratch": {str(f["frame"]): f["from_scratch_reason"] for f in fi if f["from_scratch"]},
         "find_s": med("find_affected_s"), "retrace_s": med("retrace_s"), "update_s": med("estimator_update_s"),
-        "regions_s": med("disc_regions_s"), "recompute_s": med("recompute_s"),
+        "regions_s": med("disc_regions_s"), "recompute_s": med("recompute_s"), "write_s": med("write_s", fi),
         "paths_retraced": med("paths_retraced"), "segments_removed": med("segments_removed"),
         "segments_added": med("segments_added"), "segments": mid["segments"],
         "vertices_recomputed": med("vertices_recomputed"), "vertices_updated": med("vertices_updated"),
@@ -119,7 +120,7 @@ def main():
         results.append(r)
         print(f"| {r['case']} | {r['ratio']:.2f}x | {r['incremental_median_s']:.3f} / {r['incremental_max_s']:.3f} s | "
               f"{r['full_median_s']:.3f} s | find {r['find_s']:.3f}, retrace {r['retrace_s']:.3f}, update {r['update_s']:.3f}, "
-              f"regions {r['regions_s']:.3f}, recompute {r['recompute_s']:.3f} | "
+              f"regions {r['regions_s']:.3f}, recompute {r['recompute_s']:.3f}, writing {r['write_s']:.3f} apart | "
               f"{r['paths_retraced']:.0f} paths, {r['segments_added']:.0f}/{r['segments']} segments, "
               f"{r['vertices_recomputed']:.0f}/{r['vertices']} vertices | price {r['price_s']:.3f} s, overhead {100 * r['overhead']:.0f} % | "
               f"{r['state_bytes_per_tracked_segment']:.0f} B/seg, RSS {r['peak_rss_incremental'] / 2**20:.0f}/{r['peak_rss_full'] / 2**20:.0f} MiB | "
