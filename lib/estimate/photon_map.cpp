@@ -55,11 +55,12 @@ void PhotonMap::rebuildBig() {
     big_ = std::make_unique<PointIndex>(std::move(points));
 }
 
-void PhotonMap::rebuildSmall() {
+void PhotonMap::rebuildSmall(float cell) const {
     std::vector<Vec3f> points;
     points.reserve(impacts_.size() - bigCount_);
     for (size_t i = bigCount_; i < impacts_.size(); ++i) points.push_back(impacts_[i].point);
-    small_ = points.empty() ? nullptr : std::make_unique<PointIndex>(std::move(points));
+    small_ = points.empty() ? nullptr : std::make_unique<PointGrid>(points, cell);
+    smallCell_ = cell;
     smallStale_ = false;
 }
 
@@ -71,7 +72,8 @@ int64_t PhotonMap::bigSlot(uint64_t key) const {
 
 void PhotonMap::removeImpact(uint64_t key) {
     if (const auto it = smallSlots_.find(key); it != smallSlots_.end()) {
-        // The added part is re-indexed at every update, so it stays packed: the last one fills the hole.
+        // The added part is re-indexed before the next query, so it stays packed: the last one
+        // fills the hole.
         const uint32_t slot = it->second;
         smallSlots_.erase(it);
         if (slot + 1 != impacts_.size()) {
@@ -107,7 +109,6 @@ void PhotonMap::update(const std::vector<Segment>& removed, const std::vector<Se
     // impacts. Past a quarter added, or more dead than live, the big tree is rebuilt.
     const size_t bigLive = bigCount_ - bigRemoved_, addedCount = impacts_.size() - bigCount_;
     if (addedCount > bigLive / 4 || bigRemoved_ > bigLive) rebuildBig();
-    else if (smallStale_) rebuildSmall();
 }
 
 // Estimates
@@ -161,7 +162,8 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
     if (keepLists_ && lists_.size() != scene.vertexCount()) lists_.assign(scene.vertexCount(), NeighbourList());
     const float radiusSquared = radius * radius;
     std::vector<uint8_t> queried(vertices.size(), 0);
-    const size_t bigLive = big_ ? big_->liveSize() : 0, smallLive = small_ ? small_->liveSize() : 0;
+    const size_t bigLive = big_ ? big_->liveSize() : 0, smallLive = impacts_.size() - bigCount_;
+    if (smallLive > 0 && (smallStale_ || !small_ || smallCell_ != radius)) rebuildSmall(radius);
     const size_t most = std::max(bigLive, smallLive);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
         std::vector<Neighbour> front;
@@ -180,7 +182,7 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
             const bool fromList = keepLists_ && lists_[v].valid;
             if (!fromList) {
                 queried[q] = 1;
-                nearestCounted(scene.positions[v], filter, radiusSquared, k, bigLive, smallLive, most, scratch, front,
+                nearestCounted(scene.positions[v], filter, radiusSquared, k, bigLive, most, scratch, front,
                                keepLists_ ? &lists_[v] : nullptr);
             }
             std::vector<Neighbour>& counted = fromList ? lists_[v].counted : front;
@@ -194,20 +196,29 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
 }
 
 void PhotonMap::nearestCounted(const Vec3f& p, const VertexFilter& filter, float radiusSquared, int k, size_t bigLive,
-                               size_t smallLive, size_t most, QueryScratch& scratch, std::vector<Neighbour>& front,
-                               NeighbourList* list) const {
+                               size_t most, QueryScratch& scratch, std::vector<Neighbour>& front, NeighbourList* list) const {
     std::vector<size_t>& indices = scratch.indices;
     std::vector<float>& d2 = scratch.d2;
     std::vector<std::pair<float, uint32_t>>& candidates = scratch.candidates;  // distance², slot
-    // Impacts that do not count are skipped: ask the trees for twice k neighbours, and if
-    // fewer than k of them count, for all within the radius. Distances are recomputed as
-    // bruteForce computes them.
+    // Impacts that do not count are skipped: ask the big tree for twice k neighbours (and the
+    // grid for the added impacts within the radius), and if fewer than k of them count, the
+    // tree for all within the radius. Distances are recomputed as bruteForce computes them.
     const size_t want = std::min(most, 2 * size_t(k));
+    // The added impacts within the radius, every one (the grid has no nearest-first order).
+    const float radius = std::sqrt(radiusSquared);
+    const auto withinSmall = [&](std::vector<std::pair<float, uint32_t>>& out) {
+        if (!small_) return;
+        small_->visitNear(p, radius, [&](uint32_t i) {
+            const uint32_t slot = uint32_t(bigCount_ + i);
+            const float dd = PointIndex::distanceSquared(p, impacts_[slot].point);
+            if (dd <= radiusSquared) out.emplace_back(dd, slot);
+        });
+    };
     candidates.clear();
-    // Every live impact nearer than `complete` is among the candidates; beyond it a
+    // Every live impact nearer than `complete` is among the candidates; beyond it the
     // tree may hold impacts it did not return (ties with its farthest one included).
     float complete = std::numeric_limits<float>::infinity();
-    bool all = true;  // both trees returned all their live impacts
+    bool all = true;  // the tree returned all its live impacts
     const auto ask = [&](const PointIndex* tree, size_t live, size_t firstSlot, size_t count) {
         const size_t n = std::min(count, live);
         if (n == 0) return;
@@ -225,12 +236,11 @@ void PhotonMap::nearestCounted(const Vec3f& p, const VertexFilter& filter, float
         }
     };
     ask(big_.get(), bigLive, 0, want);
-    // The small tree is sparser: as many as the big tree's would reach much farther,
-    // each a candidate to test. Twice its share covers about as far.
-    ask(small_.get(), smallLive, bigCount_, 8 + 2 * want * smallLive / std::max<size_t>(bigLive, 1));
+    // The added impacts: every one within the radius (complete there, so `complete` is the
+    // big tree's alone).
+    withinSmall(candidates);
     // Only the candidates nearer than `complete` are tested: past it the k nearest
-    // could be missing an impact, and a sparse tree's far candidates cost tests for
-    // nothing.
+    // could be missing an impact.
     front.clear();
     for (const auto& [dd, slot] : candidates)
         if ((all || dd < complete) && dd <= radiusSquared && counts(filter, impacts_[slot]))
@@ -259,7 +269,7 @@ void PhotonMap::nearestCounted(const Vec3f& p, const VertexFilter& filter, float
         }
     };
     within(big_.get(), bigLive, 0);
-    within(small_.get(), smallLive, bigCount_);
+    withinSmall(candidates);
     front.clear();
     for (const auto& [dd, slot] : candidates)
         if (dd <= radiusSquared && counts(filter, impacts_[slot]))

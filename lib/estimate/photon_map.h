@@ -11,9 +11,11 @@
 //
 // The map owns a copy of its impacts and follows a changing photon set (DESIGN §6.4): update()
 // takes a frame's removed and added segments, and ballsHolding() names the vertices whose last
-// estimate such a change can alter, so irradianceAt() recomputes only those. Two kd-trees answer
-// the queries: a big one, built rarely, whose removed impacts are marked and skipped, and a small
-// one over the impacts added since, rebuilt at each update. Every answer is bit-identical to a
+// estimate such a change can alter, so irradianceAt() recomputes only those. Two indexes answer
+// the queries: a big kd-tree, built rarely, whose removed impacts are marked and skipped, and a
+// uniform grid (a search radius across) over the impacts added since, rebuilt in linear time
+// when they have changed: they churn every frame, where a tree's build would cost more than the
+// queries it saves. Every answer is bit-identical to a
 // map built from scratch over the same impacts, and to bruteForce(), the index-free reference.
 #pragma once
 
@@ -24,6 +26,7 @@
 
 #include "estimate/disc_regions.h"
 #include "estimate/fixed_point_power.h"
+#include "estimate/point_grid.h"
 #include "estimate/point_index.h"
 #include "scene/scene.h"
 #include "trace/ray_cache.h"
@@ -132,15 +135,16 @@ private:
     // The counted impacts a query of the trees finds for a vertex at p (at least the k nearest
     // within the radius), unsorted; and, if given, the list they make.
     void nearestCounted(const Vec3f& p, const VertexFilter& filter, float radiusSquared, int k, size_t bigLive,
-                        size_t smallLive, size_t most, QueryScratch& scratch, std::vector<Neighbour>& front,
-                        NeighbourList* list) const;
+                        size_t most, QueryScratch& scratch, std::vector<Neighbour>& front, NeighbourList* list) const;
 
     // Slot of the live impact with this key in the big tree, or -1.
     int64_t bigSlot(uint64_t key) const;
     void removeImpact(uint64_t key);
     void addImpact(const Segment& s);
     void rebuildBig();    // every live impact into the big tree; the small one empties
-    void rebuildSmall();  // the small tree over the impacts added since rebuildBig()
+    // The grid over the impacts added since rebuildBig(), cells `cell` across (queries ask it
+    // for every added impact within their radius).
+    void rebuildSmall(float cell) const;
 
     // [0, bigCount_): the big tree's points, tree index = slot; then the added ones, small tree
     // index = slot − bigCount_. Removed slots of the big part stay until the next rebuildBig().
@@ -150,8 +154,11 @@ private:
     size_t bigRemoved_ = 0;                              // dead big slots
     std::vector<std::pair<uint64_t, uint32_t>> bigKeys_;  // (key, big slot), sorted
     std::unordered_map<uint64_t, uint32_t> smallSlots_;   // key → slot of an added impact
-    std::unique_ptr<PointIndex> big_, small_;
-    bool smallStale_ = false;
+    std::unique_ptr<PointIndex> big_;
+    // Built when a query needs it (estimates are const for their one-shot callers).
+    mutable std::unique_ptr<PointGrid> small_;
+    mutable float smallCell_ = 0;
+    mutable bool smallStale_ = false;
 
     // Per vertex, r_k² of its last estimate; +inf: never estimated; < 0: no ball (k ≤ 0).
     // irradiance() is const for its one-shot callers; recording changes none of its answers.
