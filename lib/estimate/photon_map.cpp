@@ -318,15 +318,19 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
 
 // Which estimates a change can alter
 
-std::vector<uint32_t> PhotonMap::ballsHolding(const Scene& scene, const DiscRegions* regions,
-                                              const std::vector<Segment>& changed) const {
-    std::vector<Impact> impacts;
-    std::vector<Vec3f> points;
-    for (const Segment& s : changed)
+void PhotonMap::impactsOf(const std::vector<Segment>& segments, std::vector<Impact>& impacts, std::vector<Vec3f>& points) {
+    for (const Segment& s : segments)
         if (s.hasImpact()) {
             impacts.push_back(impactOf(s));
             points.push_back(impacts.back().point);
         }
+}
+
+std::vector<uint32_t> PhotonMap::ballsHolding(const Scene& scene, const DiscRegions* regions,
+                                              const std::vector<Segment>& changed) const {
+    std::vector<Impact> impacts;
+    std::vector<Vec3f> points;
+    impactsOf(changed, impacts, points);
     if (impacts.empty()) return {};
     const PointIndex index(std::move(points));
     std::vector<uint8_t> holds(scene.vertexCount(), 0);
@@ -352,11 +356,7 @@ std::vector<uint32_t> PhotonMap::editLists(const Scene& scene, const DiscRegions
     if (lists_.size() != scene.vertexCount()) lists_.assign(scene.vertexCount(), NeighbourList());
     std::vector<Impact> impacts;
     std::vector<Vec3f> points;
-    for (const Segment& s : changed)
-        if (s.hasImpact()) {
-            impacts.push_back(impactOf(s));
-            points.push_back(impacts.back().point);
-        }
+    impactsOf(changed, impacts, points);
     std::vector<uint8_t> edited(scene.vertexCount(), 0);
     // A grid a list's bound across (a linear-time build: the changed impacts are many, the
     // queries one per vertex).

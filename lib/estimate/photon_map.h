@@ -102,6 +102,8 @@ private:
     };
     static uint64_t keyOf(const Segment& s) { return uint64_t(s.path) << 16 | s.bounce; }
     static Impact impactOf(const Segment& s);
+    // The impacts of the segments that have one, and their points.
+    static void impactsOf(const std::vector<Segment>& segments, std::vector<Impact>& impacts, std::vector<Vec3f>& points);
 
     // Equal distances are ordered by (path, bounce), never by where the impacts are stored: the k
     // nearest are the same set whatever order the cache holds them in or updates left them in.

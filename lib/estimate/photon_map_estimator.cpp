@@ -55,10 +55,12 @@ public:
             vertices = map_->editLists(scene_, regions_, change.removed, false, e.k);
             map_->update(change.removed, change.added, scene_);
             entered = map_->editLists(scene_, regions_, change.added, true, e.k);
-        } else {
+        } else if (e.useIndex) {
             vertices = map_->ballsHolding(scene_, regions_, change.removed);
             map_->update(change.removed, change.added, scene_);
             entered = map_->ballsHolding(scene_, regions_, change.added);
+        } else {
+            map_->update(change.removed, change.added, scene_);  // brute force estimates every vertex below
         }
         vertices.insert(vertices.end(), entered.begin(), entered.end());
         vertices.insert(vertices.end(), change.touched.begin(), change.touched.end());
