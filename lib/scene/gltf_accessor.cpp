@@ -84,8 +84,7 @@ void AccessorReader::checkFormat(const tinygltf::Accessor& acc, const AccessorFo
     throw InputError(file_, place, what + " components are not allowed here by the glTF 2.0 specification");
 }
 
-void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
-                const std::string& place) const {
+const tinygltf::BufferView& AccessorReader::checkedView(int viewIndex, const std::string& place) const {
     if (viewIndex < 0 || viewIndex >= int(model_.bufferViews.size()))
         throw InputError(file_, place, "refers to bufferView " + std::to_string(viewIndex) + ", which does not exist");
     const std::string viewPlace = gltfPlace("bufferViews", viewIndex);
@@ -96,10 +95,24 @@ void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, 
         throw InputError(file_, viewPlace, "reads buffer " + std::to_string(view.buffer) +
                                                ", which has no uri and so no data");
     const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
-    if (uint64_t(view.byteOffset) + uint64_t(view.byteLength) > buffer.data.size())
+    const uint64_t end = saturatingAdd(view.byteOffset, view.byteLength);
+    if (end > buffer.data.size())
         throw InputError(file_, viewPlace,
-                         "reaches byte " + std::to_string(uint64_t(view.byteOffset) + view.byteLength) + " of buffer " +
-                             std::to_string(view.buffer) + ", which holds only " + std::to_string(buffer.data.size()));
+                         "reaches byte " + (end == UINT64_MAX ? std::string("2^64 or beyond") : std::to_string(end)) +
+                             " of buffer " + std::to_string(view.buffer) + ", which holds only " +
+                             std::to_string(buffer.data.size()));
+    return view;
+}
+
+AccessorReader::Bytes AccessorReader::viewBytes(int viewIndex, const std::string& usedBy) const {
+    const tinygltf::BufferView& view = checkedView(viewIndex, usedBy);
+    return {model_.buffers[view.buffer].data.data() + view.byteOffset, view.byteLength};
+}
+
+void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
+                const std::string& place) const {
+    const tinygltf::BufferView& view = checkedView(viewIndex, place);
+    const std::string viewPlace = gltfPlace("bufferViews", viewIndex);
     const uint64_t componentSize = uint64_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
     const uint64_t elementSize = componentSize * uint64_t(components);
     if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
@@ -112,7 +125,8 @@ void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, 
         throw InputError(file_, place, "byteOffset is not a multiple of its " + std::to_string(componentSize) +
                                            "-byte component size");
     const uint64_t stride = view.byteStride ? view.byteStride : elementSize;
-    if (count > 0 && uint64_t(byteOffset) + saturatingMultiply(stride, count - 1) + elementSize > view.byteLength)
+    if (count > 0 && saturatingAdd(saturatingAdd(byteOffset, saturatingMultiply(stride, count - 1)), elementSize) >
+                         view.byteLength)
         throw InputError(file_, place, "reads past the end of bufferView " + std::to_string(viewIndex));
 }
 

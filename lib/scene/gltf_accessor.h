@@ -48,7 +48,17 @@ public:
     // Throws InputError naming the file and the place.
     AccessorData read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const;
 
+    // The bytes of a whole buffer view (an embedded image, say), after checking that the view and
+    // its buffer exist and that the view lies inside the buffer. `usedBy` names the referring place.
+    struct Bytes {
+        const unsigned char* data = nullptr;
+        size_t size = 0;
+    };
+    Bytes viewBytes(int viewIndex, const std::string& usedBy) const;
+
 private:
+    // The view, checked as viewBytes checks it.
+    const tinygltf::BufferView& checkedView(int viewIndex, const std::string& place) const;
     void checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const;
     // Checks that `count` elements from a buffer view lie inside the view and its buffer, with
     // the alignment and stride the specification requires.

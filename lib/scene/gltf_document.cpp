@@ -129,6 +129,16 @@ std::string readBytes(const std::string& path) {
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+// tinygltf's image callback: nothing is decoded here (see texture_colour.h). The encoded bytes of a
+// uri's file are kept, since tinygltf drops them after this call; an embedded image is left in its
+// buffer view, which tinygltf has not range-checked yet, so its bytes are not touched here.
+bool keepEncodedImage(tinygltf::Image* image, int, std::string*, std::string*, int, int, const unsigned char* bytes,
+                      int size, void*) {
+    image->as_is = true;
+    if (image->bufferView < 0 && bytes && size > 0) image->image.assign(bytes, bytes + size);
+    return true;
+}
+
 std::string firstLine(const std::string& s) {
     std::string out = s.substr(0, s.find('\n'));
     return out.empty() ? s : out;
@@ -181,6 +191,7 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     }
 
     tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(keepEncodedImage, nullptr);
     std::string err, warn;
     bool ok = false;
     try {

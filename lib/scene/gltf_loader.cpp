@@ -14,6 +14,7 @@
 #include "scene/gltf_accessor.h"
 #include "scene/gltf_animation.h"
 #include "scene/gltf_document.h"
+#include "scene/texture_colour.h"
 #include "util/memory.h"
 
 namespace qsgi {
@@ -57,39 +58,42 @@ const AccessorFormat kIndexFormat{
 
 
 // Textures and Materials
-double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 
-// Mean linear colour of a decoded image, or nullopt if it was not loaded (e.g. file missing).
-std::optional<Vec3f> meanImageColour(const tinygltf::Image& image) {
-    const int channels = image.component;
-    const int bytesPerChannel = image.bits == 16 ? 2 : 1;
-    const size_t pixels = size_t(std::max(image.width, 0)) * size_t(std::max(image.height, 0));
-    if (pixels == 0 || channels <= 0 || image.image.size() < pixels * channels * bytesPerChannel) return std::nullopt;
-    const double maxValue = bytesPerChannel == 2 ? 65535.0 : 255.0;
-    double sum[3] = {0, 0, 0};
-    for (size_t p = 0; p < pixels; ++p)
-        for (int c = 0; c < 3; ++c) {
-            const int channel = channels >= 3 ? c : 0;
-            const size_t offset = (p * channels + channel) * bytesPerChannel;
-            uint32_t v = image.image[offset];
-            if (bytesPerChannel == 2) v |= uint32_t(image.image[offset + 1]) << 8;
-            sum[c] += srgbToLinear(v / maxValue);
-        }
-    return Vec3f(float(sum[0] / pixels), float(sum[1] / pixels), float(sum[2] / pixels));
-}
-
-std::optional<Vec3f> textureMean(const tinygltf::Model& model, int textureIndex) {
-    if (textureIndex < 0 || textureIndex >= int(model.textures.size())) return std::nullopt;
+// The mean colour of texture `textureIndex`, decoded from a buffer view or from the bytes of its
+// uri's file that gltf_document.cpp kept.
+TextureColour textureColour(const tinygltf::Model& model, const AccessorReader& reader, int textureIndex,
+                            const std::string& usedBy) {
+    TextureColour none;
+    if (textureIndex < 0 || textureIndex >= int(model.textures.size())) {
+        none.problem = "refers to texture " + std::to_string(textureIndex) + ", which does not exist";
+        return none;
+    }
     const int source = model.textures[textureIndex].source;
-    if (source < 0 || source >= int(model.images.size())) return std::nullopt;
-    return meanImageColour(model.images[source]);
+    if (source < 0 || source >= int(model.images.size())) {
+        none.problem = gltfPlace("textures", textureIndex) + " has no image qsgi can read";
+        return none;
+    }
+    const tinygltf::Image& image = model.images[source];
+    const std::string imagePlace = gltfPlace("images", source);
+    TextureColour colour;
+    if (image.bufferView >= 0) {
+        const auto bytes = reader.viewBytes(image.bufferView, usedBy + " -> " + imagePlace);
+        colour = meanTextureColour(bytes.data, bytes.size);
+    } else if (!image.image.empty()) {
+        colour = meanTextureColour(image.image.data(), image.image.size());
+    } else {
+        colour.problem = "its file '" + image.uri.substr(0, 200) + "' could not be read";
+    }
+    if (!colour.mean) colour.problem = imagePlace + " " + colour.problem;
+    return colour;
 }
 
 Vec3f vec3FromFactor(const std::vector<double>& f, Vec3f fallback) {
     return f.size() >= 3 ? Vec3f(float(f[0]), float(f[1]), float(f[2])) : fallback;
 }
 
-Material convertMaterial(const tinygltf::Model& model, int index, const std::string& file, Warnings& warnings) {
+Material convertMaterial(const tinygltf::Model& model, const AccessorReader& reader, int index, const std::string& file,
+                         Warnings& warnings) {
     const tinygltf::Material& m = model.materials[index];
     const std::string place = gltfPlace("materials", index);
     Material out;
@@ -97,8 +101,10 @@ Material convertMaterial(const tinygltf::Model& model, int index, const std::str
     const auto& pbr = m.pbrMetallicRoughness;
     out.albedo = vec3FromFactor(pbr.baseColorFactor, Vec3f(1.0f));
     if (pbr.baseColorTexture.index >= 0) {
-        if (auto mean = textureMean(model, pbr.baseColorTexture.index)) out.albedo = out.albedo * *mean;
-        else warnings.add(file + ": " + place + ": base colour texture could not be read; using baseColorFactor alone");
+        const std::string texturePlace = place + ".pbrMetallicRoughness.baseColorTexture";
+        const TextureColour base = textureColour(model, reader, pbr.baseColorTexture.index, texturePlace);
+        if (base.mean) out.albedo = out.albedo * *base.mean;
+        else warnings.add(file + ": " + texturePlace + ": " + base.problem + "; using baseColorFactor alone");
     }
     if (!isFinite(out.albedo) || out.albedo.x < 0 || out.albedo.y < 0 || out.albedo.z < 0 || maxComponent(out.albedo) > 1) {
         warnings.add(file + ": " + place + ": albedo outside [0,1] clamped (energy must not grow)");
@@ -110,7 +116,10 @@ Material convertMaterial(const tinygltf::Model& model, int index, const std::str
 
     Vec3f emissive = vec3FromFactor(m.emissiveFactor, Vec3f(0.0f));
     if (m.emissiveTexture.index >= 0 && maxComponent(emissive) > 0) {
-        if (auto mean = textureMean(model, m.emissiveTexture.index)) emissive = emissive * *mean;
+        const std::string texturePlace = place + ".emissiveTexture";
+        const TextureColour texture = textureColour(model, reader, m.emissiveTexture.index, texturePlace);
+        if (texture.mean) emissive = emissive * *texture.mean;
+        else warnings.add(file + ": " + texturePlace + ": " + texture.problem + "; using emissiveFactor alone");
     }
     auto strength = m.extensions.find("KHR_materials_emissive_strength");
     if (strength != m.extensions.end() && strength->second.Has("emissiveStrength")) {
@@ -204,7 +213,7 @@ public:
         scene.sourcePath = file_;
         scene.nodes = buildHierarchy(model_, file_);
         for (size_t i = 0; i < model_.materials.size(); ++i)
-            scene.materials.push_back(convertMaterial(model_, int(i), file_, warnings_));
+            scene.materials.push_back(convertMaterial(model_, reader_, int(i), file_, warnings_));
         defaultMaterial_ = uint32_t(scene.materials.size());
         scene.materials.push_back(Material{"(default)", Vec3f(1.0f), Vec3f(0.0f)});
 

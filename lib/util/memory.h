@@ -23,4 +23,8 @@ inline uint64_t saturatingMultiply(uint64_t a, uint64_t b) {
     return (a != 0 && b > UINT64_MAX / a) ? UINT64_MAX : a * b;
 }
 
+// a+b, saturating at UINT64_MAX instead of wrapping (a hostile byteOffset near 2^64 must not wrap
+// a range check around to pass).
+inline uint64_t saturatingAdd(uint64_t a, uint64_t b) { return b > UINT64_MAX - a ? UINT64_MAX : a + b; }
+
 }  // namespace qsgi

@@ -10,6 +10,7 @@ import copy
 import json
 import os
 import struct
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 rows = []  # (kind, relative path, expected words, the file the message names)
@@ -85,6 +86,44 @@ def glb(doc, binary):
     return b"glTF" + struct.pack("<II", 2, 12 + len(chunks)) + chunks
 
 
+def png(width, height, rgb_rows):
+    """An 8-bit RGB PNG (no filter, one IDAT), so the tests need no image library to make one. The
+    header may claim more rows than rgb_rows holds (a truncated or hostile file)."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    raw = b"".join(b"\0" + bytes(row) for row in rgb_rows)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+# The 2 x 2 texture of good/texture_*.gltf; hostile_input_test.cpp expects its mean linear colour.
+TEXTURE_PIXELS = [[255, 0, 0, 0, 255, 0], [0, 0, 255, 128, 128, 128]]
+
+
+def textured(embedded):
+    """The floor with a base colour texture: embedded in the buffer (a bufferView) or as a data
+    URI, beside a second image that is garbage and that no material uses."""
+    m = scene()
+    image = png(2, 2, TEXTURE_PIXELS)
+    data = POS + IDX + b"\0" * (-len(POS + IDX) % 4)
+    garbage_at = len(data)
+    data += b"not an image at all"
+    if embedded:
+        image_at = len(data)
+        data += image
+        images = [{"bufferView": 3, "mimeType": "image/png"}]
+        m["bufferViews"].append({"buffer": 0, "byteOffset": image_at, "byteLength": len(image)})
+    else:
+        images = [{"uri": "data:image/png;base64," + base64.b64encode(image).decode()}]
+    m["bufferViews"].insert(2, {"buffer": 0, "byteOffset": garbage_at, "byteLength": 19})
+    images.append({"bufferView": 2, "mimeType": "image/png"})
+    m["buffers"][0] = {"byteLength": len(data), "uri": b64(data)}
+    m.update(images=images, textures=[{"source": 0}, {"source": 1}],
+             materials=[{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [1, 1, 1, 1]}}])
+    m["meshes"][0]["primitives"][0]["material"] = 0
+    return m
+
+
 # ---- valid edge cases (good/) ----
 write("good/base.gltf", json.dumps(scene(normals=NRM), indent=1))
 
@@ -128,6 +167,26 @@ m = scene()
 m["buffers"] = [{"byteLength": len(POS + IDX)}, {"byteLength": 64}]
 write("good/glb_with_unused_second_buffer.glb", glb(m, POS + IDX))
 
+write("good/texture_embedded.gltf", json.dumps(textured(True), indent=1))
+write("good/texture_data_uri.gltf", json.dumps(textured(False), indent=1))
+
+# Base colour textures that cannot be read render with their material's factor and a warning each:
+# a header claiming 30000 x 30000 pixels (skipped before decoding), a PNG cut in half, garbage.
+m = textured(True)
+whole = png(2, 2, TEXTURE_PIXELS)
+unreadable = [png(30000, 30000, [[7] * 90000]), whole[:len(whole) // 2], b"GIF89a and then nothing"]
+data = base64.b64decode(m["buffers"][0]["uri"].split(",")[1])
+for i, image in enumerate(unreadable):
+    data += b"\0" * (-len(data) % 4)
+    m["bufferViews"].append({"buffer": 0, "byteOffset": len(data), "byteLength": len(image)})
+    data += image
+    m["images"][i:i + 1] = [{"bufferView": len(m["bufferViews"]) - 1, "mimeType": "image/png"}]
+m["buffers"][0] = {"byteLength": len(data), "uri": b64(data)}
+m["textures"] = [{"source": 0}, {"source": 1}, {"source": 2}]
+m["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": i}, "baseColorFactor": [0.5, 0.25, 1, 1]}}
+                  for i in range(3)]
+write("good/texture_unreadable.gltf", json.dumps(m, indent=1))
+
 # ---- glTF files that break the specification (bad/gltf) ----
 def accessor(i, **kw):
     return lambda m: m["accessors"][i].update(kw)
@@ -158,6 +217,10 @@ bad("gltf", "indices_vec3.gltf", edited(accessor(1, type="VEC3", count=2)), "SCA
 bad("gltf", "index_beyond_vertices.gltf", scene(indices=struct.pack("<6H", 0, 1, 2, 0, 2, 4)), "beyond")
 bad("gltf", "index_primitive_restart.gltf", scene(indices=struct.pack("<6H", 0, 1, 2, 0, 2, 65535)), "primitive-restart")
 bad("gltf", "view_past_buffer.gltf", edited(lambda m: m["bufferViews"][1].update(byteLength=40)), "reaches byte")
+bad("gltf", "view_offset_wraps_around.gltf",
+    edited(lambda m: m["bufferViews"][1].update(byteOffset=2**64 - 8)), "reaches byte")
+bad("gltf", "texture_view_past_buffer.gltf",
+    edited(lambda m: m["bufferViews"][3].update(byteOffset=2**62), textured(True)), "reaches byte")
 bad("gltf", "view_missing_buffer.gltf", edited(lambda m: m["bufferViews"][1].update(buffer=7)), "buffer")
 bad("gltf", "stride_smaller_than_element.gltf", edited(lambda m: m["bufferViews"][0].update(byteStride=8)), "smaller than")
 bad("gltf", "stride_not_multiple_of_4.gltf", edited(lambda m: m["bufferViews"][0].update(byteStride=14)), "multiple of 4")
@@ -326,4 +389,4 @@ with open(os.path.join(HERE, "bad", "generated.tsv"), "w") as f:
     f.write("# Written by tests/data/make_inputs.py; files found by fuzzing go to found.tsv.\n")
     for kind, rel, words, names in rows:
         f.write(f"{kind}\t{rel}\t{words}\t{names}\n")
-print(f"{len(rows)} hostile files, 6 valid edge cases")
+print(f"{len(rows)} hostile files, {len(os.listdir(os.path.join(HERE, 'good')))} valid edge cases")

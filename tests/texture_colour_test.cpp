@@ -1,0 +1,126 @@
+// Base colour textures count through their mean linear colour (texture_colour.h): decoded with
+// OpenImageIO, only when a material uses them, and never read outside their bytes. The expected
+// means are worked out here from the pixels with the sRGB curve of the glTF specification.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "scene/gltf_loader.h"
+#include "scene/texture_colour.h"
+#include "test_support.h"
+
+using namespace qsgi;
+namespace fs = std::filesystem;
+
+namespace {
+
+double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+
+// Writes `pixels` (channels interleaved, 8 or 16 bits) with OIIO and returns the encoded bytes.
+template <typename T>
+std::string encoded(const std::string& name, int width, int height, int channels, const std::vector<T>& pixels,
+                    int quality = 100) {
+    const fs::path path = fs::path(testScratchDir("texture_colour")) / name;
+    OIIO::ImageSpec spec(width, height, channels, sizeof(T) == 1 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+    spec.attribute("CompressionQuality", quality);
+    if (channels == 4) spec.attribute("oiio:UnassociatedAlpha", 1);  // the colour as given, not over alpha
+    auto out = OIIO::ImageOutput::create(path.string());
+    EXPECT_TRUE(out && out->open(path.string(), spec)) << OIIO::geterror();
+    EXPECT_TRUE(out->write_image(sizeof(T) == 1 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16, pixels.data()));
+    out->close();
+    return readFileBytes(path);
+}
+
+TextureColour meanOf(const std::string& bytes) {
+    return meanTextureColour(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+}
+
+// The 2 x 2 texture of tests/data/good/texture_*.gltf (make_inputs.py, TEXTURE_PIXELS).
+Vec3f meanOfTheTestTexture() {
+    const int pixels[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {128, 128, 128}};
+    double sum[3] = {0, 0, 0};
+    for (const auto& p : pixels)
+        for (int c = 0; c < 3; ++c) sum[c] += srgbToLinear(p[c] / 255.0);
+    return Vec3f(float(sum[0] / 4), float(sum[1] / 4), float(sum[2] / 4));
+}
+
+}  // namespace
+
+TEST(TextureColour, EmbeddedAndDataUriTexturesGiveTheirMeanLinearColourAndUnusedGarbageIsNeverRead) {
+    const Vec3f expected = meanOfTheTestTexture();
+    for (const char* name : {"texture_embedded.gltf", "texture_data_uri.gltf"}) {
+        SCOPED_TRACE(name);
+        Warnings warnings;
+        const Scene scene = loadGltfScene((sourceDir() / "tests/data/good" / name).string(), warnings);
+        ASSERT_GE(scene.materials.size(), 1u);
+        EXPECT_FLOAT_EQ(scene.materials[0].albedo.x, expected.x);
+        EXPECT_FLOAT_EQ(scene.materials[0].albedo.y, expected.y);
+        EXPECT_FLOAT_EQ(scene.materials[0].albedo.z, expected.z);
+        // images[1] is garbage that no material uses: not decoded, so not warned about.
+        for (const auto& w : warnings.messages) EXPECT_EQ(w.find("images[1]"), std::string::npos) << w;
+    }
+}
+
+TEST(TextureColour, UnreadableTexturesLeaveTheFactorAndSayWhy) {
+    Warnings warnings;
+    const Scene scene =
+        loadGltfScene((sourceDir() / "tests/data/good/texture_unreadable.gltf").string(), warnings);
+    ASSERT_GE(scene.materials.size(), 3u);
+    for (int m = 0; m < 3; ++m) {
+        EXPECT_EQ(scene.materials[m].albedo.x, 0.5f) << m;
+        EXPECT_EQ(scene.materials[m].albedo.y, 0.25f) << m;
+        EXPECT_EQ(scene.materials[m].albedo.z, 1.0f) << m;
+    }
+    const std::vector<std::pair<std::string, std::string>> expected = {
+        {"materials[0]", "30000 x 30000 pixels"}, {"materials[1]", "truncated PNG"}, {"materials[2]", "neither PNG nor JPEG"}};
+    for (const auto& [place, words] : expected) {
+        bool said = false;
+        for (const auto& w : warnings.messages)
+            said = said || (w.find(place) != std::string::npos && w.find(words) != std::string::npos);
+        EXPECT_TRUE(said) << place << " should be warned about: " << words;
+    }
+}
+
+TEST(TextureColour, SixteenBitsAndAlphaAreReadAsStored) {
+    // 16-bit RGBA: the colour is not multiplied by alpha (glTF's alpha is coverage, not premultiplied).
+    const std::vector<uint16_t> pixels = {65535, 0, 30000, 0, 1000, 65535, 2, 65535};
+    const TextureColour colour = meanOf(encoded("rgba16.png", 2, 1, 4, pixels));
+    ASSERT_TRUE(colour.mean) << colour.problem;
+    EXPECT_FLOAT_EQ(colour.mean->x, float((srgbToLinear(1.0) + srgbToLinear(1000 / 65535.0)) / 2));
+    EXPECT_FLOAT_EQ(colour.mean->y, float((srgbToLinear(0.0) + srgbToLinear(1.0)) / 2));
+    EXPECT_FLOAT_EQ(colour.mean->z, float((srgbToLinear(30000 / 65535.0) + srgbToLinear(2 / 65535.0)) / 2));
+}
+
+TEST(TextureColour, GreyImagesGiveGrey) {
+    const std::vector<uint8_t> pixels = {0, 64, 200};
+    const TextureColour colour = meanOf(encoded("grey.png", 3, 1, 1, pixels));
+    ASSERT_TRUE(colour.mean) << colour.problem;
+    const float grey = float((srgbToLinear(0) + srgbToLinear(64 / 255.0) + srgbToLinear(200 / 255.0)) / 3);
+    EXPECT_FLOAT_EQ(colour.mean->x, grey);
+    EXPECT_FLOAT_EQ(colour.mean->y, grey);
+    EXPECT_FLOAT_EQ(colour.mean->z, grey);
+}
+
+TEST(TextureColour, AFlatJpegGivesItsColourWithinOneQuantisationStep) {
+    // JPEG is lossy: a flat 8 x 8 block of one colour comes back within a level or two of it.
+    const uint8_t rgb[3] = {200, 100, 30};
+    std::vector<uint8_t> pixels;
+    for (int p = 0; p < 64; ++p) pixels.insert(pixels.end(), rgb, rgb + 3);
+    const std::string bytes = encoded("flat.jpg", 8, 8, 3, pixels);
+    const TextureColour colour = meanOf(bytes);
+    ASSERT_TRUE(colour.mean) << colour.problem;
+    const float got[3] = {colour.mean->x, colour.mean->y, colour.mean->z};
+    for (int c = 0; c < 3; ++c) {
+        const double slope = (srgbToLinear((rgb[c] + 2) / 255.0) - srgbToLinear((rgb[c] - 2) / 255.0));
+        EXPECT_NEAR(got[c], srgbToLinear(rgb[c] / 255.0), slope) << "channel " << c;
+    }
+    // Cut short, it is reported, not read past its end.
+    const TextureColour cut = meanOf(bytes.substr(0, bytes.size() / 3));
+    EXPECT_FALSE(cut.mean);
+    EXPECT_FALSE(cut.problem.empty());
+}
