@@ -55,6 +55,13 @@ struct CornellFixture {
         if (!c) c = std::make_unique<RayCache>(PhotonTracer(scene, *bvh, TraceSettings{photons, 1, 32, EmissionAim{}, PhotonSampling{}}).traceAll());
         return *c;
     }
+    // The cache's segments decoded, for the ceilings: plain rays prepared before any timed loop.
+    const std::vector<Segment>& decoded(uint64_t photons) {
+        auto& d = decodedSegments[photons];
+        if (d.empty()) d = cache(photons).decodeAll();
+        return d;
+    }
+    std::map<uint64_t, std::vector<Segment>> decodedSegments;
     const std::vector<Vec3f>& exact(uint64_t photons, int radiusMm) {
         auto& e = exactDetp[{photons, radiusMm}];
         if (e.empty()) {
@@ -97,7 +104,7 @@ void BM_Estimate(benchmark::State& state) {
         result = estimateVertexRadiosity(f.scene, *f.bvh, cache, s, f.device, regions);
         benchmark::DoNotOptimize(result.irradiance.data());
     }
-    state.counters["segments"] = double(cache.segments.size());
+    state.counters["segments"] = double(cache.segmentCount());
     if (kind == EstimatorKind::Detp && mode == kFlannCandidates) {
         const ErrorStats e = errorStats(result.irradiance, f.exact(photons, radiusMm));
         state.counters["rel_rms_vs_exact"] = e.relativeRms;
@@ -135,13 +142,25 @@ void BM_TracePhotons(benchmark::State& state) {
     size_t segments = 0;
     for (auto _ : state) {
         const RayCache cache = tracer.traceAll();
-        segments = cache.segments.size();
+        segments = cache.segmentCount();
     }
     state.counters["segments_per_s"] = benchmark::Counter(double(segments), benchmark::Counter::kIsIterationInvariantRate);
-    // What the ray cache holds per segment: the record, and its path's share of the path index.
+    // What the ray cache holds per segment, its records and path index together.
     const RayCache& cache = f.cache(photons);
-    state.counters["bytes_per_segment"] =
-        double(sizeof(Segment)) + double(cache.pathBegin.size() * sizeof(uint64_t)) / double(cache.segments.size());
+    state.counters["bytes_per_segment"] = double(cache.bytes()) / double(cache.segmentCount());
+}
+
+// Reading the whole cache: every segment decoded in (path, bounce) order, in parallel, as the
+// estimators read it.
+void BM_DecodeRayCache(benchmark::State& state) {
+    CornellFixture& f = fixture();
+    const RayCache& cache = f.cache(uint64_t(state.range(0)));
+    for (auto _ : state) {
+        const std::vector<Segment> all = cache.decodeAll();
+        benchmark::DoNotOptimize(all.data());
+    }
+    state.counters["segments_per_s"] =
+        benchmark::Counter(double(cache.segmentCount()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 // The ceiling BM_TracePhotons is read against: Embree's own closest-hit rate on the same
@@ -150,7 +169,7 @@ void BM_TracePhotons(benchmark::State& state) {
 // tracer runs. Tracer segments/s over this rays/s is the share of the hardware's pace we reach.
 void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
     CornellFixture& f = fixture();
-    const RayCache& cache = f.cache(uint64_t(state.range(0)));
+    const std::vector<Segment>& segments = f.decoded(uint64_t(state.range(0)));
     RTCScene scene = rtcNewScene(f.device.get());
     RTCGeometry geometry = rtcNewGeometry(f.device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -168,10 +187,10 @@ void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
     const float epsilon = f.bvh->rayEpsilon();
     for (auto _ : state) {
         const size_t hits = tbb::parallel_reduce(
-            tbb::blocked_range<size_t>(0, cache.segments.size(), 4096), size_t(0),
+            tbb::blocked_range<size_t>(0, segments.size(), 4096), size_t(0),
             [&](const tbb::blocked_range<size_t>& range, size_t count) {
                 for (size_t i = range.begin(); i < range.end(); ++i) {
-                    const Segment& s = cache.segments[i];
+                    const Segment& s = segments[i];
                     RTCRayHit rayHit{};
                     rayHit.ray.org_x = s.origin.x, rayHit.ray.org_y = s.origin.y, rayHit.ray.org_z = s.origin.z;
                     rayHit.ray.dir_x = s.direction.x, rayHit.ray.dir_y = s.direction.y, rayHit.ray.dir_z = s.direction.z;
@@ -191,7 +210,7 @@ void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
     }
     rtcReleaseScene(scene);
     state.counters["rays_per_s"] =
-        benchmark::Counter(double(cache.segments.size()), benchmark::Counter::kIsIterationInvariantRate);
+        benchmark::Counter(double(segments.size()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 // DETP's own rate: every segment traced through the vertices' discs with the exact test, in the
@@ -201,16 +220,17 @@ void BM_DetpSegments(benchmark::State& state) {
     const RayCache& cache = f.cache(uint64_t(state.range(0)));
     const float radius = float(state.range(1)) / 1000.0f;
     const DetpDiscs discs(f.device, f.scene, radius, DetpBoundary::Clip, &f.discRegions(int(state.range(1)), false), f.bvh.get());
-    const std::vector<uint32_t> order = segmentMortonOrder(cache);
+    const PowerQuantizer q(cache.maxPhotonPower);
     DetpQueryStats stats;
     for (auto _ : state) {
         stats = DetpQueryStats();
-        const auto sums = discs.sums(cache, order, &stats);
+        // As the estimator reads the cache: decoded into Morton order, then traced.
+        const auto sums = discs.sums(segmentsInQueryOrder(cache, true), q, &stats);
         benchmark::DoNotOptimize(sums.data());
     }
     state.counters["segments_per_s"] =
-        benchmark::Counter(double(cache.segments.size()), benchmark::Counter::kIsIterationInvariantRate);
-    state.counters["disc_hits_per_segment"] = double(stats.discHits) / double(cache.segments.size());
+        benchmark::Counter(double(cache.segmentCount()), benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["disc_hits_per_segment"] = double(stats.discHits) / double(cache.segmentCount());
 }
 
 // What Embree alone does with the same rays through the same discs: one BVH of oriented discs at
@@ -257,9 +277,7 @@ void BM_EmbreeAllHitsCeiling(benchmark::State& state) {
     rtcAttachGeometry(scene, geometry);
     rtcReleaseGeometry(geometry);
     rtcCommitScene(scene);
-    const std::vector<uint32_t> order = segmentMortonOrder(cache);
-    std::vector<Segment> ordered(order.size());
-    for (size_t i = 0; i < order.size(); ++i) ordered[i] = cache.segments[order[i]];
+    const std::vector<Segment> ordered = segmentsInQueryOrder(cache, true);
     size_t hits = 0;
     for (auto _ : state) {
         hits = tbb::parallel_reduce(
@@ -383,14 +401,15 @@ void BM_FlightHelmetDetpWaste(benchmark::State& state) {
         const RayCache cache = f->trace(EmissionAim{true, radius});
         missed = cache.pathsMissingScene();
         wasted = 0;
-        std::vector<Segment> firstMisses;
-        for (size_t path = 0; path < cache.pathCount(); ++path) {
-            if (cache.pathBegin[path] == cache.pathBegin[path + 1]) {  // a spot light's photon outside its cone
+        std::vector<Segment> firstMisses, path;
+        for (size_t p = 0; p < cache.pathCount(); ++p) {
+            path.clear();
+            cache.appendPath(p, path);
+            if (path.empty()) {  // a spot light's photon outside its cone
                 ++wasted;
                 continue;
             }
-            const Segment& first = cache.segments[cache.pathBegin[path]];
-            if (!first.hasImpact()) firstMisses.push_back(first);
+            if (!path.front().hasImpact()) firstMisses.push_back(path.front());
         }
         std::vector<SegmentCrossing> crossings;
         discs.findCrossings(firstMisses, DetpDiscs::Discs::All, crossings);
@@ -412,6 +431,7 @@ BENCHMARK(BM_TracePhotons)
     ->ArgsProduct({{100000, 1000000, 10000000}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_DecodeRayCache)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EmbreeClosestHitCeiling)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DetpSegments)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -108,14 +108,14 @@ TEST(DetpBoundary, CeilingAboveALightPanelSeesOnlyTheGap) {
     ASSERT_GT(above.size(), 10u);
     // Noise of a region mean: impacts on the ceiling within the region grown by r.
     double sum = 0, sumSq = 0;
-    for (const Segment& s : cache.segments) {
-        if (!s.hasImpact()) continue;
+    cache.forEachSegment([&](const Segment& s) {
+        if (!s.hasImpact()) return;
         const Vec3d h = Vec3d(s.impactPoint()) + scene.worldOrigin;
         if (std::fabs(h.y - 2.0) < 1e-4 && std::fabs(h.x) < 0.2 + r && std::fabs(h.z) < 0.2 + r) {
             sum += s.power.y;
             sumSq += double(s.power.y) * s.power.y;
         }
-    }
+    });
     ASSERT_GT(sum, 0.0) << "no light reaches the ceiling through the gap: the test would prove nothing";
     const double relativeSigma = std::sqrt(sumSq) / sum;
     auto regionMean = [&](const std::vector<Vec3f>& E) {
@@ -321,7 +321,7 @@ TEST(DetpBoundary, CreaseVerticesFallBackAndLeaveTheirNeighboursAlone) {
     Scene split = testscenes::creasedSheet(cells, false, Vec3f(0.0f));
     for (Scene* s : {&welded, &split}) testscenes::addPointLight(*s, Vec3f(0.2f, 0.7f, 0.6f), Vec3f(1.0f));
     const RayCache cw = trace(welded, 300000), cs = trace(split, 300000);
-    ASSERT_EQ(cw.segments.size(), cs.segments.size());
+    ASSERT_EQ(cw.segmentCount(), cs.segmentCount());
     EmbreeDevice device;
     const SceneBvh bvh(device, welded);
     DiscRegions regions(r, false);

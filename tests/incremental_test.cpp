@@ -362,23 +362,25 @@ TEST(Incremental, AnEstimatorWithoutAnUpdateLogsItsFramesAsFromScratch) {
 TEST(PhotonMapOrder, KNearestDoNotDependOnTheCacheOrder) {
     Scene s = testscenes::boxOnFloor(8, 2, Vec3f(0.6f));
     testscenes::addPointLight(s, Vec3f(0.2f, 1.5f, 0.1f), Vec3f(10.0f));
-    RayCache cache = traceScene(s, 4000, 3);
+    const RayCache traced = traceScene(s, 4000, 3);
+    std::vector<Segment> segments = traced.decodeAll();
     // Duplicate every impact, so that every distance ties with another.
-    const size_t n = cache.segments.size();
+    const size_t n = segments.size();
     for (size_t i = 0; i < n; ++i) {
-        Segment copy = cache.segments[i];
+        Segment copy = segments[i];
         copy.path += 1000000;
         copy.power = copy.power * 0.5f;  // a different choice among the ties gives a different sum
-        cache.segments.push_back(copy);
+        segments.push_back(copy);
     }
+    const auto cache = [&] { return RayCache::ofSegments(segments, traced.maxPhotonPower); };
     EstimatorSettings settings;
     settings.kind = EstimatorKind::PhotonMap;
     settings.radius = 0.3f;
     settings.k = 16;  // 15 summed: one of a tied pair is in, the other out
-    const std::vector<Vec3f> forward = estimateWith(s, cache, settings).irradiance;
-    std::reverse(cache.segments.begin(), cache.segments.end());
-    EXPECT_TRUE(sameBits(forward, estimateWith(s, cache, settings).irradiance));
-    std::rotate(cache.segments.begin(), cache.segments.begin() + int64_t(n / 3), cache.segments.end());
+    const std::vector<Vec3f> forward = estimateWith(s, cache(), settings).irradiance;
+    std::reverse(segments.begin(), segments.end());
+    EXPECT_TRUE(sameBits(forward, estimateWith(s, cache(), settings).irradiance));
+    std::rotate(segments.begin(), segments.begin() + int64_t(n / 3), segments.end());
     settings.useIndex = false;
-    EXPECT_TRUE(sameBits(forward, estimateWith(s, cache, settings).irradiance));
+    EXPECT_TRUE(sameBits(forward, estimateWith(s, cache(), settings).irradiance));
 }

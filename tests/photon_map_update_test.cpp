@@ -59,7 +59,11 @@ public:
     };
 
     ChangingPhotons(const RayCache& full, const Scene& scene, int spread)
-        : full_(full), front_(scene.frontFaceNormals()), spread_(size_t(spread)) {
+        : maxPhotonPower_(full.maxPhotonPower), paths_(full.pathCount()), segments_(full.decodeAll()),
+          front_(scene.frontFaceNormals()), spread_(size_t(spread)) {
+        pathBegin_.assign(paths_ + 1, segments_.size());
+        for (size_t i = segments_.size(); i-- > 0;) pathBegin_[segments_[i].path] = i;
+        for (size_t p = paths_; p-- > 0;) pathBegin_[p] = std::min(pathBegin_[p], pathBegin_[p + 1]);
         float floorY = scene.positions[0].y;  // positions are re-centred on the scene
         for (const Vec3f& p : scene.positions) floorY = std::min(floorY, p.y);
         for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
@@ -70,38 +74,37 @@ public:
         for (uint32_t t = 0; t < front_.size() && floorTriangle_ == kNoTriangle; ++t)
             if (front_[t].y > 0.9f) floorTriangle_ = t;
         // At the start a quarter of the paths miss their tail from bounce 1 on.
-        for (size_t p = 0; p < full_.pathCount(); ++p)
-            for (uint64_t i = full_.pathBegin[p]; i < full_.pathBegin[p + 1]; ++i)
-                if (p % 4 != 1 || full_.segments[i].bounce < 1) live_[keyOf(full_.segments[i])] = full_.segments[i];
+        for (size_t p = 0; p < paths_; ++p)
+            for (uint64_t i = pathBegin_[p]; i < pathBegin_[p + 1]; ++i)
+                if (p % 4 != 1 || segments_[i].bounce < 1) live_[keyOf(segments_[i])] = segments_[i];
     }
 
     RayCache liveCache() const {
-        RayCache c;
-        c.maxPhotonPower = full_.maxPhotonPower;
-        for (const auto& [key, s] : live_) c.segments.push_back(s);
+        std::vector<Segment> live;
+        for (const auto& [key, s] : live_) live.push_back(s);
         // Not in key order: the map may not rely on the order it is given.
-        std::reverse(c.segments.begin(), c.segments.end());
-        return c;
+        std::reverse(live.begin(), live.end());
+        return RayCache::ofSegments(std::move(live), maxPhotonPower_);
     }
 
     Change next(size_t round) {
         Change c;
-        const size_t paths = full_.pathCount();
+        const size_t paths = paths_;
         // Made-up segments leave (half of those live), from the small tree or the big one.
         for (const auto& [key, s] : live_)
             if (s.path >= kMadeUp && (s.path + round) % 2 == 0) c.removed.push_back(s);
         // Tails leave: from bounce (p / spread) % 3 on.
         for (size_t p = round % spread_; p < paths; p += spread_)
-            for (uint64_t i = full_.pathBegin[p]; i < full_.pathBegin[p + 1]; ++i) {
-                const Segment& s = full_.segments[i];
+            for (uint64_t i = pathBegin_[p]; i < pathBegin_[p + 1]; ++i) {
+                const Segment& s = segments_[i];
                 if (s.bounce >= (p / spread_) % 3 && live_.count(keyOf(s))) c.removed.push_back(s);
             }
         // Missing tails come back (some left just above: the same keys return, as a retrace does).
         std::unordered_set<uint64_t> leaving;
         for (const Segment& s : c.removed) leaving.insert(keyOf(s));
         for (size_t p = round % (spread_ + 2); p < paths; p += spread_ + 2)
-            for (uint64_t i = full_.pathBegin[p]; i < full_.pathBegin[p + 1]; ++i) {
-                const Segment& s = full_.segments[i];
+            for (uint64_t i = pathBegin_[p]; i < pathBegin_[p + 1]; ++i) {
+                const Segment& s = segments_[i];
                 if (!live_.count(keyOf(s)) || leaving.count(keyOf(s))) c.added.push_back(s);
             }
         // Made-up impacts beside and on top of live ones.
@@ -124,7 +127,7 @@ public:
             c.added.push_back(beside);
         }
         const Vec3f centre = floorVertices_[(round * 131 + 17) % floorVertices_.size()] + Vec3f(0.02f, 0, 0.01f);
-        const Vec3f power = full_.segments.front().power * 0.25f;
+        const Vec3f power = segments_.front().power * 0.25f;
         const auto madeUp = [&](Vec3f at, bool fromAbove) {
             Segment s;
             s.direction = Vec3f(0, fromAbove ? -1.0f : 1.0f, 0);
@@ -156,7 +159,10 @@ public:
 
 private:
     static constexpr uint32_t kMadeUp = 1u << 24;  // beyond the traced paths
-    const RayCache& full_;
+    float maxPhotonPower_;
+    size_t paths_;
+    std::vector<Segment> segments_;   // the traced cache's, decoded
+    std::vector<uint64_t> pathBegin_;  // path p owns segments_[pathBegin_[p], pathBegin_[p + 1])
     std::vector<Vec3f> front_;
     size_t spread_;
     std::vector<Vec3f> floorVertices_;
@@ -199,9 +205,10 @@ std::pair<size_t, size_t> fewerAndMore(const Scene& scene, const RayCache& cache
     size_t fewer = 0;
     for (size_t v = 0; v < scene.vertexCount(); ++v) {
         int n = 0;
-        for (const Segment& s : cache.segments)
+        cache.forEachSegment([&](const Segment& s) {
             n += s.hasImpact() && dot(s.direction, scene.normals[v]) < 0 &&
                  PointIndex::distanceSquared(scene.positions[v], s.impactPoint()) <= radius * radius;
+        });
         fewer += n < k;
     }
     return {fewer, scene.vertexCount() - fewer};
@@ -327,11 +334,11 @@ TEST(PhotonMapUpdate, AListDrainedBelowKIsQueriedAgain) {
     PhotonMap map(f.full, f.scene, &f.bvh);
     map.keepLists(true);
     std::vector<Vec3f> current = map.irradiance(f.scene, &covered, 0.15f, 4, f.all);
-    RayCache rest = f.full;
-    rest.segments.clear();
-    std::vector<Segment> removed;
-    for (const Segment& s : f.full.segments)
-        (s.hasImpact() && length(s.impactPoint() - f.scene.positions[centre]) < 0.12f ? removed : rest.segments).push_back(s);
+    std::vector<Segment> removed, kept;
+    f.full.forEachSegment([&](const Segment& s) {
+        (s.hasImpact() && length(s.impactPoint() - f.scene.positions[centre]) < 0.12f ? removed : kept).push_back(s);
+    });
+    const RayCache rest = RayCache::ofSegments(std::move(kept), f.full.maxPhotonPower);
     ASSERT_GT(removed.size(), 8u);  // twice k: more than the list's bound held
     std::vector<uint32_t> vertices = map.editLists(f.scene, &covered, removed, false, 4);
     map.update(removed, {}, f.scene);
@@ -377,8 +384,8 @@ TEST(PhotonMapUpdate, UpdateTakesTheFrontNormalsOfTheNewPose) {
 TEST(PhotonMapUpdate, RejectsRemovingAnAbsentImpactAndAddingAPresentOne) {
     Fixture f;
     PhotonMap map(f.full, f.scene, &f.bvh);
-    const Segment& present = *std::find_if(f.full.segments.begin(), f.full.segments.end(),
-                                           [](const Segment& s) { return s.hasImpact(); });
+    const std::vector<Segment> segments = f.full.decodeAll();
+    const Segment& present = *std::find_if(segments.begin(), segments.end(), [](const Segment& s) { return s.hasImpact(); });
     EXPECT_THROW(map.update({}, {present}, f.scene), std::logic_error);
     Segment absent = present;
     absent.path = 1u << 30;

@@ -341,3 +341,21 @@ void GltfWriter::write(const std::string& path) const {
 }
 
 }  // namespace testscenes
+
+bool sameBits(const qsgi::Segment& a, const qsgi::Segment& b) {
+    const auto floats = [](const qsgi::Segment& s) {
+        return std::array<float, 10>{s.origin.x, s.origin.y, s.origin.z, s.direction.x, s.direction.y, s.direction.z,
+                                     s.length, s.power.x, s.power.y, s.power.z};
+    };
+    const auto fa = floats(a), fb = floats(b);
+    return std::memcmp(fa.data(), fb.data(), sizeof(float) * fa.size()) == 0 && a.triangle == b.triangle &&
+           a.path == b.path && a.bounce == b.bounce && a.impactDynamic == b.impactDynamic;
+}
+
+bool sameSegments(const qsgi::RayCache& a, const qsgi::RayCache& b) {
+    if (a.pathCount() != b.pathCount() || a.segmentCount() != b.segmentCount()) return false;
+    const std::vector<qsgi::Segment> sa = a.decodeAll(), sb = b.decodeAll();
+    for (size_t i = 0; i < sa.size(); ++i)
+        if (!sameBits(sa[i], sb[i])) return false;
+    return true;
+}

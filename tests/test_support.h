@@ -23,6 +23,11 @@ CommandResult runQsgi(const std::string& arguments);     // the qsgi executable 
 CommandResult runCommand(const std::string& commandLine);  // any shell command line
 std::string readFileBytes(const std::filesystem::path& path);  // "" if unreadable
 
+// Every field of the two segments has the same bits.
+bool sameBits(const qsgi::Segment& a, const qsgi::Segment& b);
+// The two caches hold the same paths and, decoded, segments with the same bits in the same order.
+bool sameSegments(const qsgi::RayCache& a, const qsgi::RayCache& b);
+
 // An estimator and its boundary rule, named for test messages.
 struct NamedEstimator {
     const char* name;

@@ -342,43 +342,25 @@ void DetpDiscs::recompute(const std::vector<const Segment*>& segments, const Pow
         for (const Hit& h : hits) sums[h.at.vertex].add(segments[h.segment]->power, h.at.at, q, moments);
 }
 
-std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, const std::vector<uint32_t>& order,
+std::vector<DetpVertexSums> DetpDiscs::sums(const std::vector<Segment>& segments, const PowerQuantizer& q,
                                             DetpQueryStats* stats) const {
     const size_t vertices = scene_.vertexCount();
-    const PowerQuantizer q(cache.maxPhotonPower);
     const bool moments = rule_ == DetpBoundary::Linear;
     tbb::enumerable_thread_specific<VertexSums> perThread([&] { return VertexSums(vertices); });
     tbb::enumerable_thread_specific<uint64_t> hitCount(0);
-    // A reordering is gathered into a copy first, so tracing streams through memory instead of
-    // jumping through the cache by index (which costs more than the coherence gains).
-    bool inputOrder = order.size() == cache.segments.size();
-    for (size_t i = 0; i < order.size() && inputOrder; ++i) inputOrder = order[i] == i;
-    std::vector<Segment> gathered;
-    if (!inputOrder) {
-        gathered.resize(order.size());
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i != r.end(); ++i) gathered[i] = cache.segments[order[i]];
-        });
-    }
-    const Segment* ordered = inputOrder ? cache.segments.data() : gathered.data();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, order.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         VertexSums& sums = perThread.local();
         uint64_t& hits = hitCount.local();
         std::vector<Crossed> crossed;
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            crossings(ordered[i], crossed);
-            for (const Crossed& c : crossed) sums[c.vertex].add(ordered[i].power, c.at, q, moments);
+            crossings(segments[i], crossed);
+            for (const Crossed& c : crossed) sums[c.vertex].add(segments[i].power, c.at, q, moments);
             hits += crossed.size();
         }
     });
     if (stats)
         for (uint64_t h : hitCount) stats->discHits += h;
     return combine(perThread, vertices);
-}
-
-std::vector<Vec3f> DetpDiscs::irradiance(const RayCache& cache, const std::vector<uint32_t>& order,
-                                         DetpQueryStats* stats) const {
-    return toIrradiance(sums(cache, order, stats), regions_, radius_, rule_, PowerQuantizer(cache.maxPhotonPower));
 }
 
 void DetpDiscs::findCrossings(const std::vector<Segment>& segments, Discs which, std::vector<SegmentCrossing>& out) const {
@@ -417,13 +399,14 @@ DetpVertexSums detpVertexSums(const Scene& scene, uint32_t v, const std::vector<
 std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
                                   const DiscRegions* regions, const SceneBvh* bvh) {
     const PowerQuantizer q(cache.maxPhotonPower);
+    const std::vector<Segment> segments = cache.decodeAll();
     const bool moments = rule == DetpBoundary::Linear;
     VertexSums sums(scene.vertexCount());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, scene.vertexCount(), 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             const VertexDisc& disc = discOf(regions, v);
             DiscCrossing at;
-            for (const Segment& s : cache.segments)
+            for (const Segment& s : segments)
                 if (detpCounts(s, scene.positions[v], scene.normals[v], disc, radius, rule, bvh, at))
                     sums[v].add(s.power, at, q, moments);
         }
@@ -436,7 +419,8 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
                                        const std::vector<uint32_t>& vertexOrder) {
     const PowerQuantizer q(cache.maxPhotonPower);
     const bool moments = rule == DetpBoundary::Linear;
-    const ImpactIndex index(cache);
+    const std::vector<Segment> segments = cache.decodeAll();
+    const ImpactIndex index(segments);
     VertexSums sums(scene.vertexCount());
     const float searchRadius = radius * (1 + kFlannCandidateMargin);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexOrder.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
@@ -448,7 +432,7 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
             index.withinRadius(scene.positions[v], searchRadius * searchRadius, candidates, d2);
             DiscCrossing at;
             for (size_t c : candidates) {
-                const Segment& s = cache.segments[index.segment(c)];
+                const Segment& s = segments[index.segment(c)];
                 if (detpCounts(s, scene.positions[v], scene.normals[v], disc, radius, rule, bvh, at))
                     sums[v].add(s.power, at, q, moments);
             }
@@ -457,12 +441,31 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
     return toIrradiance(sums, regions, radius, rule, q);
 }
 
-std::vector<uint32_t> segmentMortonOrder(const RayCache& cache) {
-    // Most discs a segment crosses sit around its end (the surface it hits), so segments are
-    // ordered by where they end.
-    std::vector<Vec3f> ends(cache.segments.size());
-    for (size_t i = 0; i < cache.segments.size(); ++i) ends[i] = cache.segments[i].impactPoint();
-    return mortonOrder(ends);
+std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, bool morton) {
+    std::vector<Segment> segments = cache.decodeAll();
+    if (!morton) return segments;
+    std::vector<Vec3f> ends(segments.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) ends[i] = segments[i].impactPoint();
+    });
+    std::vector<uint32_t> order = mortonOrder(ends);
+    std::vector<Vec3f>().swap(ends);
+    // Segment i becomes segments[order[i]], cycle by cycle, in place (a gathered copy would hold
+    // every segment twice); a visited place is marked by pointing it at itself.
+    for (size_t start = 0; start < order.size(); ++start) {
+        if (order[start] == start) continue;
+        const Segment first = segments[start];
+        size_t at = start;
+        while (order[at] != start) {
+            const size_t from = order[at];
+            segments[at] = segments[from];
+            order[at] = uint32_t(at);
+            at = from;
+        }
+        segments[at] = first;
+        order[at] = uint32_t(at);
+    }
+    return segments;
 }
 
 }  // namespace qsgi

@@ -93,12 +93,9 @@ public:
     // Moves the refitted discs to the scene's current pose.
     void updateDynamic();
 
-    // Every vertex's sums from the given segments (in that order), in parallel.
-    std::vector<DetpVertexSums> sums(const RayCache& cache, const std::vector<uint32_t>& segmentOrder,
+    // Every vertex's sums from the given segments (traced in that order), in parallel.
+    std::vector<DetpVertexSums> sums(const std::vector<Segment>& segments, const PowerQuantizer& q,
                                      DetpQueryStats* stats = nullptr) const;
-    // Irradiance at every vertex from the given segments (in that order).
-    std::vector<Vec3f> irradiance(const RayCache& cache, const std::vector<uint32_t>& segmentOrder,
-                                  DetpQueryStats* stats = nullptr) const;
 
     // Every crossing of the given segments with the discs of `which`, decided exactly. Found in
     // parallel; the list is in segment order, each segment's crossings by vertex, the same for
@@ -155,7 +152,9 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
                                        const DiscRegions* regions, const SceneBvh* bvh,
                                        const std::vector<uint32_t>& vertexOrder);
 
-// Segment order for coherent tracing: Morton order of the segments' end points.
-std::vector<uint32_t> segmentMortonOrder(const RayCache& cache);
+// The cache's segments in the order DETP traces them through the discs: Morton order of their end
+// points (coherent tracing: most discs a segment crosses sit around its end), or the cache's own
+// (path, bounce) order. Decoded once and reordered in place.
+std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, bool morton);
 
 }  // namespace qsgi

@@ -45,8 +45,9 @@ public:
         quantizer_ = PowerQuantizer(cache.maxPhotonPower);
         const EstimatorSettings& e = settings_;
         if (!e.useIndex) {
-            std::vector<const Segment*> all(cache.segments.size());
-            for (size_t i = 0; i < all.size(); ++i) all[i] = &cache.segments[i];
+            const std::vector<Segment> segments = cache.decodeAll();
+            std::vector<const Segment*> all(segments.size());
+            for (size_t i = 0; i < all.size(); ++i) all[i] = &segments[i];
             sums_.assign(scene_.vertexCount(), DetpVertexSums());
             bruteForceSums(allVertices(), all);
         } else if (e.detpIndex == DetpIndex::Flann) {
@@ -57,7 +58,7 @@ public:
             return;
         } else {
             discs().updateDynamic();
-            sums_ = discs_->sums(cache, e.sortQueries ? segmentMortonOrder(cache) : inputOrder(cache.segments.size()));
+            sums_ = discs_->sums(segmentsInQueryOrder(cache, e.sortQueries), quantizer_);
         }
         out.irradiance.resize(scene_.vertexCount());
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v) out.irradiance[v] = irradianceAt(v);

@@ -41,8 +41,9 @@ bool ImpactCount::counts(const Segment& s) const {
 void ImpactCount::accumulate(const RayCache& cache) {
     std::fill(sums_.begin(), sums_.end(), PowerSum{});
     const PowerQuantizer q(cache.maxPhotonPower);
-    for (const Segment& s : cache.segments)
+    cache.forEachSegment([&](const Segment& s) {
         if (counts(s)) sums_[s.triangle].add(s.power, q);
+    });
 }
 
 void ImpactCount::add(const Segment& s, const PowerQuantizer& q) {

@@ -1,4 +1,4 @@
-// The impact points of the ray cache in a kd-tree (PointIndex), each with the segment it ends.
+// The impact points of a ray cache's decoded segments in a kd-tree (PointIndex), each with the segment it ends.
 #pragma once
 
 #include <vector>
@@ -10,12 +10,13 @@ namespace qsgi {
 
 class ImpactIndex : public PointIndex {
 public:
-    explicit ImpactIndex(const RayCache& cache) : PointIndex(impactPoints(cache)), segments_(impactSegments(cache)) {}
-    uint32_t segment(size_t i) const { return segments_[i]; }  // index into cache.segments
+    explicit ImpactIndex(const std::vector<Segment>& segments)
+        : PointIndex(impactPoints(segments)), segments_(impactSegments(segments)) {}
+    uint32_t segment(size_t i) const { return segments_[i]; }  // index into the segments given
 
 private:
-    static std::vector<Vec3f> impactPoints(const RayCache& cache);
-    static std::vector<uint32_t> impactSegments(const RayCache& cache);
+    static std::vector<Vec3f> impactPoints(const std::vector<Segment>& segments);
+    static std::vector<uint32_t> impactSegments(const std::vector<Segment>& segments);
     std::vector<uint32_t> segments_;
 };
 

@@ -23,8 +23,9 @@ PhotonMap::Impact PhotonMap::impactOf(const Segment& s) {
 
 PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh)
     : frontNormals_(scene.frontFaceNormals()), bvh_(bvh), quantizer_(cache.maxPhotonPower) {
-    for (const Segment& s : cache.segments)
+    cache.forEachSegment([&](const Segment& s) {
         if (s.hasImpact()) impacts_.push_back(impactOf(s));
+    });
     rebuildBig();
 }
 

@@ -120,13 +120,17 @@ bool FrameSolver::changeTooLarge(const PoseChange& change, size_t touched) const
         listed = tracked_->segmentsListedOn(change.movedTriangles);
         segments = foldedSegments_ + tracked_->trackedSegments();
     } else {
-        const std::vector<Segment>& all = lastCache_->segments;
-        segments = all.size();
+        const RayCache& cache = *lastCache_;
+        segments = cache.segmentCount();
         listed = tbb::parallel_reduce(
-            tbb::blocked_range<size_t>(0, all.size(), 1 << 16), uint64_t(0),
+            tbb::blocked_range<size_t>(0, cache.blockCount(), 1), uint64_t(0),
             [&](const tbb::blocked_range<size_t>& r, uint64_t n) {
-                for (size_t i = r.begin(); i != r.end(); ++i)
-                    n += all[i].hasImpact() && all[i].impactDynamic && change.triangleMoved[all[i].triangle];
+                std::vector<Segment> block;
+                for (size_t b = r.begin(); b != r.end(); ++b) {
+                    cache.decodeBlock(b, block);
+                    for (const Segment& s : block)
+                        n += s.hasImpact() && s.impactDynamic && change.triangleMoved[s.triangle];
+                }
                 return n;
             },
             [](uint64_t a, uint64_t b) { return a + b; });
@@ -194,10 +198,10 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
     Stopwatch clock;
     RayCache cache = tracer_.traceAll();
     stats.photonSimulationSeconds = clock.seconds();
-    stats.segments = cache.segments.size();
+    stats.segments = cache.segmentCount();
     stats.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
     stats.pathsRetraced = cache.pathCount();
-    stats.segmentsAdded = cache.segments.size();
+    stats.segmentsAdded = cache.segmentCount();
 
     clock.restart();
     estimator_->solve(cache, result_, stats);
@@ -221,7 +225,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     const float divisions = (reach > 0 ? 32.0f : 8.0f) / (envelope.isEverything() ? 2.0f : 1.0f);
     const float cellSize = std::max(4 * reach, gridBounds.extent() / divisions);
     tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize);
-    foldedSegments_ = cache.segments.size() - tracked_->trackedSegments();
+    foldedSegments_ = cache.segmentCount() - tracked_->trackedSegments();
     stats.photonSimulationSeconds += clock.seconds();
     clock.restart();
     estimator_->prepareUpdates(*tracked_, stats);

@@ -12,32 +12,20 @@ namespace qsgi {
 
 PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings)
     : bvh_(bvh), settings_(settings),
-      lights_(scene, settings.photons, bvh.rayEpsilon(), settings.aim,
-              settings.sampling.kind == SamplerKind::Sobol ? std::optional<uint64_t>(settings.seed) : std::nullopt),
-      bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {
-    surfaces_.resize(scene.triangleCount());
-    for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
-        const Vec3f albedo = scene.materials[scene.triangleMaterial[t]].albedo;
-        surfaces_[t] = Surface{albedo, maxComponent(albedo), scene.triangleDynamic[t]};
-    }
-}
-
-PathNumbers PhotonTracer::numbersFor(uint64_t path) const {
-    if (settings_.sampling.kind == SamplerKind::Random) return PathNumbers(settings_.seed, path);
-    const LightSampler::Deal deal = lights_.dealt(path);
-    return PathNumbers(settings_.seed, path, deal.emitter, deal.index, settings_.sampling.qmcBounces);
-}
+      source_(std::make_shared<const PhotonSource>(scene, settings.photons, settings.seed, bvh.rayEpsilon(), settings.aim,
+                                                   settings.sampling)),
+      bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {}
 
 void PhotonTracer::tracePath(uint64_t path, std::vector<Segment>& out) const {
-    const PathNumbers numbers = numbersFor(path);
-    const PhotonEmission e = lights_.sample(numbers);
+    const PathNumbers numbers = source_->numbersFor(path);
+    const PhotonEmission e = source_->lights().sample(numbers);
     if (!(maxComponent(e.power) > 0)) return;  // a spot light's photon outside its cone: nothing sent
     follow(numbers, path, 0, e.origin, e.direction, e.power, 0.0f, out);
 }
 
 void PhotonTracer::continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power,
                                 float tnear, std::vector<Segment>& out) const {
-    follow(numbersFor(path), path, bounce, origin, direction, power, tnear, out);
+    follow(source_->numbersFor(path), path, bounce, origin, direction, power, tnear, out);
 }
 
 void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction,
@@ -57,7 +45,7 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
             out.push_back(s);
             return;
         }
-        const Surface& surface = surfaces_[hit->triangle];
+        const PhotonSource::Surface& surface = source_->surface(hit->triangle);
         s.length = hit->t;
         s.triangle = hit->triangle;
         s.impactDynamic = surface.dynamic;
@@ -65,7 +53,7 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
 
         // Russian roulette on the albedo, then a cosine-weighted bounce on the incoming side.
         if (!(rng.uniform(bounce + 1, kSurvival) < surface.survival)) return;
-        power = power * surface.albedo / surface.survival;
+        power = source_->powerAfter(power, hit->triangle);
         // The hit's own normal (first traces and retraces both take it from Embree).
         Vec3f n = normalize(hit->ng);
         if (dot(n, direction) > 0) n = -n;
@@ -76,14 +64,13 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
 }
 
 RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& progress) const {
-    RayCache cache;
-    cache.maxPhotonPower = lights_.maxPhotonPower();
+    const LightSampler& lights = source_->lights();
     const uint64_t n = settings_.photons;
-    // Fixed chunks, concatenated in chunk order: the cache is the same for any thread count.
+    // Fixed chunks of paths, each written as one block of the cache: the cache is the same for
+    // any thread count, and the blocks are kept as they are (no concatenation).
     constexpr uint64_t kChunk = 4096;
     const uint64_t chunks = (n + kChunk - 1) / kChunk;
-    std::vector<std::vector<Segment>> chunkSegments(chunks);
-    std::vector<std::vector<uint32_t>> chunkPathLengths(chunks);
+    std::vector<RayCache::BlockWriter> blocks(chunks);
     std::atomic<uint64_t> done{0}, stored{0};
     std::atomic<bool> finished{false};
     std::thread reporter;
@@ -96,26 +83,27 @@ RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& p
         });
     }
     auto work = [&](const tbb::blocked_range<uint64_t>& r) {
+        std::vector<Segment> path;
         for (uint64_t c = r.begin(); c != r.end(); ++c) {
-            auto& segs = chunkSegments[c];
-            auto& lengths = chunkPathLengths[c];
-            const uint64_t end = std::min(n, (c + 1) * kChunk);
+            RayCache::BlockWriter& block = blocks[c];
+            const uint64_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
             // Room for the segments the chunks so far averaged, and a quarter more: growing a
-            // chunk from empty copied it several times over.
+            // block from empty copied it several times over.
             const double perPhoton = double(stored.load()) / double(std::max<uint64_t>(done.load(), 1));
-            segs.reserve(size_t(double(end - c * kChunk) * std::max(perPhoton, 1.0) * 1.25));
-            lengths.reserve(end - c * kChunk);
-            for (uint64_t p = c * kChunk; p < end; ++p) {
-                const size_t before = segs.size();
-                tracePath(p, segs);
-                lengths.push_back(uint32_t(segs.size() - before));
+            block.reserve(end - begin, size_t(double(end - begin) * std::max(perPhoton, 1.0) * 1.25));
+            for (uint64_t p = begin; p < end; ++p) {
+                block.beginPath();
+                if (lights.empty()) continue;
+                path.clear();
+                tracePath(p, path);
+                for (const Segment& s : path) block.add(s);
             }
-            stored += segs.size();
-            done += end - c * kChunk;
+            stored += block.segments();
+            done += end - begin;
         }
     };
     try {
-        if (!lights_.empty()) tbb::parallel_for(tbb::blocked_range<uint64_t>(0, chunks, 1), work);
+        tbb::parallel_for(tbb::blocked_range<uint64_t>(0, chunks, 1), work);
     } catch (...) {
         finished = true;
         if (reporter.joinable()) reporter.join();
@@ -124,22 +112,7 @@ RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& p
     finished = true;
     if (reporter.joinable()) reporter.join();
     if (progress) progress(n, n);
-
-    // Chunks are concatenated in chunk order, copied in parallel: a serial copy was a tenth of
-    // the time at 10^6 photons.
-    std::vector<uint64_t> chunkBegin(chunks + 1, 0);
-    for (uint64_t c = 0; c < chunks; ++c) chunkBegin[c + 1] = chunkBegin[c] + chunkSegments[c].size();
-    cache.segments.resize(chunkBegin[chunks]);
-    cache.pathBegin.resize(n + 1);
-    cache.pathBegin[0] = 0;
-    tbb::parallel_for(uint64_t(0), chunks, [&](uint64_t c) {
-        std::copy(chunkSegments[c].begin(), chunkSegments[c].end(), cache.segments.begin() + int64_t(chunkBegin[c]));
-        std::vector<Segment>().swap(chunkSegments[c]);
-        uint64_t at = chunkBegin[c], path = c * kChunk;
-        for (uint32_t len : chunkPathLengths[c]) cache.pathBegin[++path] = (at += len);
-    });
-    if (lights_.empty()) cache.pathBegin.assign(n + 1, 0);
-    return cache;
+    return RayCache::ofBlocks(std::move(blocks), kChunk, source_, lights.maxPhotonPower());
 }
 
 }  // namespace qsgi

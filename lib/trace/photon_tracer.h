@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 #include "scene/scene.h"
 #include "trace/light_sampler.h"
+#include "trace/photon_source.h"
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
 
@@ -35,24 +37,16 @@ public:
     void continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power, float tnear,
                       std::vector<Segment>& out) const;
 
-    const LightSampler& lights() const { return lights_; }
+    const LightSampler& lights() const { return source_->lights(); }
 
 private:
-    PathNumbers numbersFor(uint64_t path) const;
     void follow(const PathNumbers& numbers, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power,
                 float tnear, std::vector<Segment>& out) const;
 
     const SceneBvh& bvh_;
     TraceSettings settings_;
-    LightSampler lights_;
-    // What a bounce reads of the triangle it hit, in one place: three scattered lookups
-    // (material index, material, dynamic flag) per bounce were a tenth of the tracer's time.
-    struct Surface {
-        Vec3f albedo;
-        float survival;  // Russian roulette: the albedo's largest component
-        uint8_t dynamic;
-    };
-    std::vector<Surface> surfaces_;  // per scene triangle
+    // Shared with the caches it writes, which decode with it.
+    std::shared_ptr<const PhotonSource> source_;
     Bounds3f bounds_;  // the animation's, padded: escaping segments end where they leave it
 };
 

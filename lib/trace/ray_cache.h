@@ -1,16 +1,34 @@
-// The ray cache (DESIGN §4): every segment of every photon path, grouped by path so that "path i
-// from bounce k on" is one contiguous range.
+// The ray cache (DESIGN §4): every segment of every photon path, in (path, bounce) order, stored
+// in about 23 bytes a segment instead of the 52 of a Segment, and decoded to exactly the segments
+// the tracer followed.
+//
+// What it leaves out is what the photon source can say again (photon_source.h): a path's first
+// segment starts where its emission does, power follows from the emission's and the albedo and
+// survival of the triangles hit before (the tracer's own arithmetic: the same bits), and path,
+// bounce and the dynamic flag from where a record sits and which triangle it hit. A first
+// segment keeps its length and triangle (8 bytes); a later one its origin, direction, length and
+// triangle (32 bytes: a bounce's origin is lifted along the normal of the triangle it left, which
+// may move, so it is stored rather than rebuilt from the current pose). An n-segment path costs
+// 12 + 32(n − 1) bytes with its 4-byte index entry: under 32 per segment for any n.
+//
+// The tracer writes one block per chunk of paths, in parallel, and the cache keeps them as they
+// are (no concatenation copy). Caches made by hand (tests) keep their segments verbatim.
+// Consumers read segments only through the accessors below, never by field.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "util/vecmath.h"
 
 namespace qsgi {
 
+class PhotonSource;
+
 constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;
 
+// One segment, decoded.
 struct Segment {
     Vec3f origin;
     Vec3f direction;    // unit
@@ -25,22 +43,89 @@ struct Segment {
     Vec3f impactPoint() const { return origin + direction * length; }
 };
 
-struct RayCache {
-    std::vector<Segment> segments;
-    std::vector<uint64_t> pathBegin;  // path i owns segments [pathBegin[i], pathBegin[i+1])
+class RayCache {
+public:
+    RayCache() = default;
+    // A cache holding these segments as they are. `pathBegin` groups them by path as the
+    // tracer's do (path i owns [pathBegin[i], pathBegin[i+1])); empty, the cache has no paths,
+    // only segments.
+    static RayCache ofSegments(std::vector<Segment> segments, float maxPhotonPower,
+                               std::vector<uint64_t> pathBegin = {});
+
     // Largest RGB component any photon starts with: the scale of fixed-point power sums.
     float maxPhotonPower = 0;
 
-    size_t pathCount() const { return pathBegin.empty() ? 0 : pathBegin.size() - 1; }
+    size_t pathCount() const { return paths_; }
+    uint64_t segmentCount() const { return segments_; }
+    size_t bytes() const;  // memory the records and the path index hold
 
     // Photons whose first segment hit nothing (lights pointing away from, or far from, the scene),
     // and photons with no segment (an aimed spot light's outside its cone).
-    uint64_t pathsMissingScene() const {
-        uint64_t missed = 0;
-        for (size_t path = 0; path < pathCount(); ++path)
-            if (pathBegin[path] == pathBegin[path + 1] || !segments[pathBegin[path]].hasImpact()) ++missed;
-        return missed;
+    uint64_t pathsMissingScene() const;
+
+    // The segments, block by block: blocks hold consecutive paths and can be decoded in
+    // parallel. decodeBlock replaces `out` with block b's segments in (path, bounce) order;
+    // blockFirstSegment(b) is the index of its first in the whole cache's order.
+    size_t blockCount() const { return blocks_.size(); }
+    uint64_t blockFirstSegment(size_t b) const { return blocks_[b].firstSegment; }
+    void decodeBlock(size_t b, std::vector<Segment>& out) const;
+
+    // Appends the segments of `path`, in bounce order.
+    void appendPath(uint64_t path, std::vector<Segment>& out) const;
+    // Every segment in (path, bounce) order, decoded block by block (serial).
+    template <class Visit>
+    void forEachSegment(Visit&& visit) const {
+        std::vector<Segment> block;
+        for (size_t b = 0; b < blocks_.size(); ++b) {
+            decodeBlock(b, block);
+            for (const Segment& s : block) visit(s);
+        }
     }
+    // Every segment, decoded in parallel into one vector in (path, bounce) order: for consumers
+    // that reorder or index the segments.
+    std::vector<Segment> decodeAll() const;
+
+    // Written by the tracer: block b holds the paths [firstPath, firstPath + paths). Segments are
+    // added path by path, each path's in bounce order, from `source`'s emissions.
+    class BlockWriter {
+    public:
+        void beginPath();
+        void add(const Segment& s);  // the current path's next segment
+        size_t segments() const { return segments_; }
+        void reserve(size_t paths, size_t segments);
+
+    private:
+        friend class RayCache;
+        struct First {
+            float length;
+            uint32_t triangle;  // kNoTriangle if it escaped, kNoSegment if the path sent nothing
+        };
+        struct Later {
+            Vec3f origin, direction;
+            float length;
+            uint32_t triangle;
+        };
+        std::vector<First> first_;           // per path
+        std::vector<Later> later_;           // bounces ≥ 1, path after path
+        std::vector<uint32_t> laterBegin_;   // per path and one more: its first later record
+        size_t segments_ = 0;
+    };
+    static RayCache ofBlocks(std::vector<BlockWriter> blocks, uint64_t firstPathPerBlock,
+                             std::shared_ptr<const PhotonSource> source, float maxPhotonPower);
+
+private:
+    static constexpr uint32_t kNoSegment = 0xFFFFFFFEu;
+    struct Block {
+        uint64_t firstPath = 0;
+        uint64_t firstSegment = 0;
+        BlockWriter records;                // traced paths
+        std::vector<Segment> verbatim;      // or segments kept as they are
+        std::vector<uint64_t> verbatimPathBegin;
+    };
+    std::vector<Block> blocks_;
+    std::shared_ptr<const PhotonSource> source_;  // what decoding traced blocks needs
+    size_t paths_ = 0;
+    uint64_t segments_ = 0;
 };
 
 }  // namespace qsgi

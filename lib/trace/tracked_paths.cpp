@@ -15,32 +15,47 @@ TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, floa
                            float cellSize)
     : envelope_(envelope), extension_(extension), grid_(gridBounds, cellSize) {
     const size_t n = cache.pathCount();
-    // Per path, the first segment that meets the envelope (or none).
-    std::vector<uint32_t> first(n, std::numeric_limits<uint32_t>::max());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t p = r.begin(); p != r.end(); ++p)
-            for (uint64_t i = cache.pathBegin[p]; i < cache.pathBegin[p + 1]; ++i)
-                if (envelope_.meets(cache.segments[i], extension_)) {
-                    first[p] = uint32_t(i - cache.pathBegin[p]);
+    // Per block of paths, the tails from the first segment that meets the envelope on, found in
+    // parallel and then taken in path order.
+    struct Tail {
+        uint32_t path, firstBounce, count;
+    };
+    std::vector<std::vector<Tail>> tails(cache.blockCount());
+    std::vector<std::vector<Segment>> kept(cache.blockCount());
+    tbb::parallel_for(size_t(0), cache.blockCount(), [&](size_t b) {
+        std::vector<Segment> block;
+        cache.decodeBlock(b, block);
+        for (size_t i = 0; i < block.size();) {
+            size_t end = i + 1;
+            while (end < block.size() && block[end].path == block[i].path) ++end;
+            for (size_t j = i; j < end; ++j)
+                if (envelope_.meets(block[j], extension_)) {
+                    tails[b].push_back({block[i].path, block[j].bounce, uint32_t(end - j)});
+                    kept[b].insert(kept[b].end(), block.begin() + int64_t(j), block.begin() + int64_t(end));
                     break;
                 }
+            i = end;
+        }
     });
     slot_.assign(n, -1);
-    for (size_t p = 0; p < n; ++p) {
-        if (first[p] == std::numeric_limits<uint32_t>::max()) continue;
-        Tracked t;
-        t.path = uint32_t(p);
-        t.firstBounce = cache.segments[cache.pathBegin[p] + first[p]].bounce;
-        t.begin = segments_.size();
-        t.count = t.capacity = uint32_t(cache.pathBegin[p + 1] - cache.pathBegin[p] - first[p]);
-        segments_.insert(segments_.end(), cache.segments.begin() + int64_t(cache.pathBegin[p] + first[p]),
-                         cache.segments.begin() + int64_t(cache.pathBegin[p + 1]));
-        generation_.resize(segments_.size(), 0);
-        cellCount_.resize(segments_.size(), 0);
-        slot_[p] = int32_t(paths_.size());
-        paths_.push_back(t);
-        liveSegments_ += t.count;
-        index(t);
+    for (size_t b = 0; b < tails.size(); ++b) {
+        size_t from = 0;
+        for (const Tail& tail : tails[b]) {
+            Tracked t;
+            t.path = tail.path;
+            t.firstBounce = tail.firstBounce;
+            t.begin = segments_.size();
+            t.count = t.capacity = tail.count;
+            segments_.insert(segments_.end(), kept[b].begin() + int64_t(from), kept[b].begin() + int64_t(from + tail.count));
+            from += tail.count;
+            generation_.resize(segments_.size(), 0);
+            cellCount_.resize(segments_.size(), 0);
+            slot_[t.path] = int32_t(paths_.size());
+            paths_.push_back(t);
+            liveSegments_ += t.count;
+            index(t);
+        }
+        std::vector<Segment>().swap(kept[b]);
     }
 }
 

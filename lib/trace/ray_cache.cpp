@@ -1,0 +1,162 @@
+#include "trace/ray_cache.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "trace/photon_source.h"
+
+namespace qsgi {
+
+void RayCache::BlockWriter::reserve(size_t paths, size_t segments) {
+    first_.reserve(paths);
+    laterBegin_.reserve(paths + 1);
+    later_.reserve(segments > paths ? segments - paths : 0);
+}
+
+void RayCache::BlockWriter::beginPath() {
+    if (laterBegin_.empty()) laterBegin_.push_back(0);
+    first_.push_back({0.0f, kNoSegment});
+    laterBegin_.push_back(uint32_t(later_.size()));
+}
+
+void RayCache::BlockWriter::add(const Segment& s) {
+    First& first = first_.back();
+    if (first.triangle == kNoSegment) {
+        first = {s.length, s.triangle};
+    } else {
+        later_.push_back({s.origin, s.direction, s.length, s.triangle});
+        laterBegin_.back() = uint32_t(later_.size());
+    }
+    ++segments_;
+}
+
+RayCache RayCache::ofSegments(std::vector<Segment> segments, float maxPhotonPower, std::vector<uint64_t> pathBegin) {
+    RayCache cache;
+    cache.maxPhotonPower = maxPhotonPower;
+    cache.segments_ = segments.size();
+    cache.paths_ = pathBegin.empty() ? 0 : pathBegin.size() - 1;
+    Block block;
+    block.verbatim = std::move(segments);
+    block.verbatimPathBegin = std::move(pathBegin);
+    cache.blocks_.push_back(std::move(block));
+    return cache;
+}
+
+RayCache RayCache::ofBlocks(std::vector<BlockWriter> blocks, uint64_t firstPathPerBlock,
+                            std::shared_ptr<const PhotonSource> source, float maxPhotonPower) {
+    RayCache cache;
+    cache.maxPhotonPower = maxPhotonPower;
+    cache.source_ = std::move(source);
+    cache.blocks_.resize(blocks.size());
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        Block& block = cache.blocks_[b];
+        block.firstPath = b * firstPathPerBlock;
+        block.firstSegment = cache.segments_;
+        block.records = std::move(blocks[b]);
+        if (block.records.laterBegin_.empty()) block.records.laterBegin_.push_back(0);
+        cache.segments_ += block.records.segments_;
+        cache.paths_ += block.records.first_.size();
+    }
+    return cache;
+}
+
+size_t RayCache::bytes() const {
+    size_t total = 0;
+    for (const Block& b : blocks_)
+        total += b.records.first_.capacity() * sizeof(BlockWriter::First) +
+                 b.records.later_.capacity() * sizeof(BlockWriter::Later) +
+                 b.records.laterBegin_.capacity() * sizeof(uint32_t) + b.verbatim.capacity() * sizeof(Segment) +
+                 b.verbatimPathBegin.capacity() * sizeof(uint64_t);
+    return total;
+}
+
+uint64_t RayCache::pathsMissingScene() const {
+    uint64_t missed = 0;
+    for (const Block& b : blocks_) {
+        for (const BlockWriter::First& f : b.records.first_) missed += f.triangle == kNoTriangle || f.triangle == kNoSegment;
+        const auto& begin = b.verbatimPathBegin;
+        for (size_t p = 0; p + 1 < begin.size(); ++p)
+            missed += begin[p] == begin[p + 1] || !b.verbatim[begin[p]].hasImpact();
+    }
+    return missed;
+}
+
+namespace {
+
+// Appends path `path`'s segments from its records: the first from the emission, the later ones
+// from their records, power carried on with the tracer's own arithmetic.
+template <class First, class Later>
+void decodeRecords(const PhotonSource& source, uint64_t path, const First& first, const Later* later, const Later* end,
+                   std::vector<Segment>& out) {
+    const PhotonEmission e = source.emission(path);
+    Segment s;
+    s.origin = e.origin;
+    s.direction = e.direction;
+    s.power = e.power;
+    s.length = first.length;
+    s.triangle = first.triangle;
+    s.path = uint32_t(path);
+    s.bounce = 0;
+    s.impactDynamic = s.hasImpact() ? source.surface(s.triangle).dynamic : 0;
+    out.push_back(s);
+    for (; later != end; ++later) {
+        s.power = source.powerAfter(s.power, s.triangle);
+        s.origin = later->origin;
+        s.direction = later->direction;
+        s.length = later->length;
+        s.triangle = later->triangle;
+        ++s.bounce;
+        s.impactDynamic = s.hasImpact() ? source.surface(s.triangle).dynamic : 0;
+        out.push_back(s);
+    }
+}
+
+}  // namespace
+
+void RayCache::decodeBlock(size_t b, std::vector<Segment>& out) const {
+    const Block& block = blocks_[b];
+    if (!block.verbatim.empty() || !source_) {
+        out = block.verbatim;
+        return;
+    }
+    out.clear();
+    out.reserve(block.records.segments_);
+    const BlockWriter& r = block.records;
+    for (size_t p = 0; p < r.first_.size(); ++p) {
+        if (r.first_[p].triangle == kNoSegment) continue;
+        decodeRecords(*source_, block.firstPath + p, r.first_[p], r.later_.data() + r.laterBegin_[p],
+                      r.later_.data() + r.laterBegin_[p + 1], out);
+    }
+}
+
+void RayCache::appendPath(uint64_t path, std::vector<Segment>& out) const {
+    // The last block that starts at or before the path.
+    const auto after = std::upper_bound(blocks_.begin(), blocks_.end(), path,
+                                        [](uint64_t p, const Block& b) { return p < b.firstPath; });
+    if (after == blocks_.begin()) return;
+    const Block& block = *(after - 1);
+    const uint64_t local = path - block.firstPath;
+    if (!block.verbatimPathBegin.empty()) {
+        if (local + 1 >= block.verbatimPathBegin.size()) return;
+        out.insert(out.end(), block.verbatim.begin() + int64_t(block.verbatimPathBegin[local]),
+                   block.verbatim.begin() + int64_t(block.verbatimPathBegin[local + 1]));
+        return;
+    }
+    const BlockWriter& r = block.records;
+    if (!source_ || local >= r.first_.size() || r.first_[local].triangle == kNoSegment) return;
+    decodeRecords(*source_, path, r.first_[local], r.later_.data() + r.laterBegin_[local],
+                  r.later_.data() + r.laterBegin_[local + 1], out);
+}
+
+std::vector<Segment> RayCache::decodeAll() const {
+    std::vector<Segment> all(segments_);
+    tbb::parallel_for(size_t(0), blocks_.size(), [&](size_t b) {
+        std::vector<Segment> block;
+        decodeBlock(b, block);
+        std::copy(block.begin(), block.end(), all.begin() + int64_t(blocks_[b].firstSegment));
+    });
+    return all;
+}
+
+}  // namespace qsgi
