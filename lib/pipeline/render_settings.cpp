@@ -26,9 +26,9 @@ int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string&
 
 uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place) {
     const uint64_t photons = uint64_t(checkedInteger(value, 1, kMaxPhotons, source, place, " (2^32: the path index is 32 bits)"));
-    refuseBeyondMemory(photons * (sizeof(Segment) + sizeof(uint64_t)), source, place,
-                       std::to_string(photons) + " photons (at least one " + std::to_string(sizeof(Segment)) +
-                           "-byte segment each)");
+    refuseBeyondMemory(photons * RayCache::kBytesPerPath, source, place,
+                       std::to_string(photons) + " photons (at least " + std::to_string(RayCache::kBytesPerPath) +
+                           " bytes each in the ray cache)");
     return photons;
 }
 

@@ -1,5 +1,6 @@
 #include "trace/photon_tracer.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
@@ -71,7 +72,7 @@ RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& p
     constexpr uint64_t kChunk = 4096;
     const uint64_t chunks = (n + kChunk - 1) / kChunk;
     std::vector<RayCache::BlockWriter> blocks(chunks);
-    std::atomic<uint64_t> done{0}, stored{0};
+    std::atomic<uint64_t> done{0};
     std::atomic<bool> finished{false};
     std::thread reporter;
     if (progress) {
@@ -82,15 +83,14 @@ RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& p
             }
         });
     }
+    // Each thread writes its chunks into one writer and keeps an exact-size copy of each.
+    tbb::enumerable_thread_specific<RayCache::BlockWriter> writers;
     auto work = [&](const tbb::blocked_range<uint64_t>& r) {
+        RayCache::BlockWriter& block = writers.local();
         std::vector<Segment> path;
         for (uint64_t c = r.begin(); c != r.end(); ++c) {
-            RayCache::BlockWriter& block = blocks[c];
             const uint64_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
-            // Room for the segments the chunks so far averaged, and a quarter more: growing a
-            // block from empty copied it several times over.
-            const double perPhoton = double(stored.load()) / double(std::max<uint64_t>(done.load(), 1));
-            block.reserve(end - begin, size_t(double(end - begin) * std::max(perPhoton, 1.0) * 1.25));
+            block.clear();
             for (uint64_t p = begin; p < end; ++p) {
                 block.beginPath();
                 if (lights.empty()) continue;
@@ -98,7 +98,7 @@ RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& p
                 tracePath(p, path);
                 for (const Segment& s : path) block.add(s);
             }
-            stored += block.segments();
+            blocks[c] = block.exactCopy();
             done += end - begin;
         }
     };

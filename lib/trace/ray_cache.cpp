@@ -8,10 +8,20 @@
 
 namespace qsgi {
 
-void RayCache::BlockWriter::reserve(size_t paths, size_t segments) {
-    first_.reserve(paths);
-    laterBegin_.reserve(paths + 1);
-    later_.reserve(segments > paths ? segments - paths : 0);
+void RayCache::BlockWriter::clear() {
+    first_.clear();
+    later_.clear();
+    laterBegin_.clear();
+    segments_ = 0;
+}
+
+RayCache::BlockWriter RayCache::BlockWriter::exactCopy() const {
+    BlockWriter copy;
+    copy.first_.assign(first_.begin(), first_.end());
+    copy.later_.assign(later_.begin(), later_.end());
+    copy.laterBegin_.assign(laterBegin_.begin(), laterBegin_.end());
+    copy.segments_ = segments_;
+    return copy;
 }
 
 void RayCache::BlockWriter::beginPath() {

@@ -55,6 +55,10 @@ public:
     // Largest RGB component any photon starts with: the scale of fixed-point power sums.
     float maxPhotonPower = 0;
 
+    // What a traced path costs at the least (its first segment's record and its index entry), and
+    // each segment after the first.
+    static constexpr size_t kBytesPerPath = 12, kBytesPerLaterSegment = 32;
+
     size_t pathCount() const { return paths_; }
     uint64_t segmentCount() const { return segments_; }
     size_t bytes() const;  // memory the records and the path index hold
@@ -92,7 +96,10 @@ public:
         void beginPath();
         void add(const Segment& s);  // the current path's next segment
         size_t segments() const { return segments_; }
-        void reserve(size_t paths, size_t segments);
+        // Empties it, keeping its memory: a tracer thread writes every chunk into one writer and
+        // keeps an exact-size copy of each (no slack held for the cache's lifetime).
+        void clear();
+        BlockWriter exactCopy() const;
 
     private:
         friend class RayCache;
@@ -110,6 +117,8 @@ public:
         std::vector<uint32_t> laterBegin_;   // per path and one more: its first later record
         size_t segments_ = 0;
     };
+    static_assert(sizeof(BlockWriter::First) + sizeof(uint32_t) == kBytesPerPath, "the record sizes named above");
+    static_assert(sizeof(BlockWriter::Later) == kBytesPerLaterSegment, "the record sizes named above");
     static RayCache ofBlocks(std::vector<BlockWriter> blocks, uint64_t firstPathPerBlock,
                              std::shared_ptr<const PhotonSource> source, float maxPhotonPower);
 
