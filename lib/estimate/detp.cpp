@@ -442,29 +442,32 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
 }
 
 std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, bool morton) {
-    std::vector<Segment> segments = cache.decodeAll();
-    if (!morton) return segments;
-    std::vector<Vec3f> ends(segments.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) ends[i] = segments[i].impactPoint();
-    });
-    std::vector<uint32_t> order = mortonOrder(ends);
-    std::vector<Vec3f>().swap(ends);
-    // Segment i becomes segments[order[i]], cycle by cycle, in place (a gathered copy would hold
-    // every segment twice); a visited place is marked by pointing it at itself.
-    for (size_t start = 0; start < order.size(); ++start) {
-        if (order[start] == start) continue;
-        const Segment first = segments[start];
-        size_t at = start;
-        while (order[at] != start) {
-            const size_t from = order[at];
-            segments[at] = segments[from];
-            order[at] = uint32_t(at);
-            at = from;
-        }
-        segments[at] = first;
-        order[at] = uint32_t(at);
+    if (!morton) return cache.decodeAll();
+    // Decoded twice, block by block in parallel: once for the end points that order them, once
+    // into their places. Neither a decoded copy in cache order nor a gathered one is ever held
+    // beside the result.
+    const size_t n = cache.segmentCount();
+    std::vector<uint32_t> place(n);
+    {
+        std::vector<Vec3f> ends(n);
+        tbb::parallel_for(size_t(0), cache.blockCount(), [&](size_t b) {
+            std::vector<Segment> block;
+            cache.decodeBlock(b, block);
+            const size_t first = cache.blockFirstSegment(b);
+            for (size_t k = 0; k < block.size(); ++k) ends[first + k] = block[k].impactPoint();
+        });
+        const std::vector<uint32_t> order = mortonOrder(ends);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) place[order[i]] = uint32_t(i);
+        });
     }
+    std::vector<Segment> segments(n);
+    tbb::parallel_for(size_t(0), cache.blockCount(), [&](size_t b) {
+        std::vector<Segment> block;
+        cache.decodeBlock(b, block);
+        const size_t first = cache.blockFirstSegment(b);
+        for (size_t k = 0; k < block.size(); ++k) segments[place[first + k]] = block[k];
+    });
     return segments;
 }
 

@@ -1,5 +1,9 @@
 #include "pipeline/frame_solver.h"
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
@@ -9,6 +13,18 @@
 #include "util/stopwatch.h"
 
 namespace qsgi {
+
+namespace {
+// The ray cache is written by every tracer thread into its own malloc arena, in blocks too small
+// to be mapped apart; freed, they stay resident inside the arenas, where the tracked paths and
+// estimator state growing afterwards (in other arenas) cannot use them. Handing them back keeps
+// the run's peak at what it holds (data/cornell, 10^7 photons, six DETP frames: 4.17 -> 4.04 GB).
+void returnFreedMemory() {
+#ifdef __GLIBC__
+    malloc_trim(0);
+#endif
+}
+}  // namespace
 
 namespace {
 
@@ -231,6 +247,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     estimator_->prepareUpdates(*tracked_, stats);
     stats.estimationSeconds += clock.seconds();
     lastCache_.reset();
+    returnFreedMemory();
 }
 
 void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats) {

@@ -6,15 +6,6 @@
 
 namespace qsgi {
 
-namespace {
-
-// One closest-hit query's state for the tie rule: the hit accepted so far.
-struct TieBreakContext {
-    RTCIntersectContext base;  // first member: Embree hands back a pointer to it
-    float bestT = std::numeric_limits<float>::infinity();
-    unsigned bestPrim = RTC_INVALID_GEOMETRY_ID;
-};
-
 // Embree accepts a candidate at t equal to the current closest (and hands the filter the
 // candidate's t as the ray's tfar), so without this the winner of a tie would be whichever
 // triangle traversal met last. With it, equal t goes to the lowest primitive id; primitive ids
@@ -33,6 +24,8 @@ void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args) {
         ctx->bestPrim = prim;
     }
 }
+
+namespace {
 
 RTCRayHit makeRay(const Vec3f& o, const Vec3f& d, float tnear, float tfar) {
     RTCRayHit rh;

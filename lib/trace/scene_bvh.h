@@ -6,6 +6,7 @@
 // retraces and camera rays all go through intersect(), so they see identical hits.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -20,6 +21,16 @@ struct SurfaceHit {
     float u = 0, v = 0;     // barycentrics of vertices 1 and 2 of that triangle
     Vec3f ng;               // Embree's geometric normal: unnormalised, out of the front (CCW) side
 };
+
+// The tie rule's per-query state and filter, as SceneBvh installs them on its triangles: a
+// closest-hit query passes a TieBreakContext (rtcInitIntersectContext on `base`). Public so that
+// the benchmarks' Embree ceiling traces with exactly the tracer's configuration.
+struct TieBreakContext {
+    RTCIntersectContext base;  // first member: Embree hands back a pointer to it
+    float bestT = std::numeric_limits<float>::infinity();
+    unsigned bestPrim = RTC_INVALID_GEOMETRY_ID;
+};
+void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args);
 
 class SceneBvh {
 public:
