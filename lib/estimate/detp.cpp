@@ -450,9 +450,7 @@ std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, bool morton) {
     std::vector<uint32_t> place(n);
     {
         std::vector<Vec3f> ends(n);
-        tbb::parallel_for(size_t(0), cache.blockCount(), [&](size_t b) {
-            std::vector<Segment> block;
-            cache.decodeBlock(b, block);
+        cache.forEachBlock([&](size_t b, const std::vector<Segment>& block) {
             const size_t first = cache.blockFirstSegment(b);
             for (size_t k = 0; k < block.size(); ++k) ends[first + k] = block[k].impactPoint();
         });
@@ -462,9 +460,7 @@ std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, bool morton) {
         });
     }
     std::vector<Segment> segments(n);
-    tbb::parallel_for(size_t(0), cache.blockCount(), [&](size_t b) {
-        std::vector<Segment> block;
-        cache.decodeBlock(b, block);
+    cache.forEachBlock([&](size_t b, const std::vector<Segment>& block) {
         const size_t first = cache.blockFirstSegment(b);
         for (size_t k = 0; k < block.size(); ++k) segments[place[first + k]] = block[k];
     });

@@ -1,5 +1,7 @@
 #include "estimate/impact_count.h"
 
+#include <tbb/enumerable_thread_specific.h>
+
 namespace qsgi {
 
 ImpactCount::ImpactCount(const Scene& scene) : sums_(scene.triangleCount()) {
@@ -41,9 +43,15 @@ bool ImpactCount::counts(const Segment& s) const {
 void ImpactCount::accumulate(const RayCache& cache) {
     std::fill(sums_.begin(), sums_.end(), PowerSum{});
     const PowerQuantizer q(cache.maxPhotonPower);
-    cache.forEachSegment([&](const Segment& s) {
-        if (counts(s)) sums_[s.triangle].add(s.power, q);
+    // Fixed-point sums do not depend on the order they are added in: per-thread sums, joined.
+    tbb::enumerable_thread_specific<std::vector<PowerSum>> perThread([&] { return std::vector<PowerSum>(sums_.size()); });
+    cache.forEachBlock([&](size_t, const std::vector<Segment>& block) {
+        std::vector<PowerSum>& sums = perThread.local();
+        for (const Segment& s : block)
+            if (counts(s)) sums[s.triangle].add(s.power, q);
     });
+    for (const auto& sums : perThread)
+        for (size_t t = 0; t < sums_.size(); ++t) sums_[t] += sums[t];
 }
 
 void ImpactCount::add(const Segment& s, const PowerQuantizer& q) {

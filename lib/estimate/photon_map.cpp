@@ -23,9 +23,19 @@ PhotonMap::Impact PhotonMap::impactOf(const Segment& s) {
 
 PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh)
     : frontNormals_(scene.frontFaceNormals()), bvh_(bvh), quantizer_(cache.maxPhotonPower) {
-    cache.forEachSegment([&](const Segment& s) {
-        if (s.hasImpact()) impacts_.push_back(impactOf(s));
+    // Per block in parallel, joined in block order: the cache's (path, bounce) order.
+    std::vector<std::vector<Impact>> perBlock(cache.blockCount());
+    cache.forEachBlock([&](size_t b, const std::vector<Segment>& block) {
+        for (const Segment& s : block)
+            if (s.hasImpact()) perBlock[b].push_back(impactOf(s));
     });
+    size_t total = 0;
+    for (const auto& impacts : perBlock) total += impacts.size();
+    impacts_.reserve(total);
+    for (auto& impacts : perBlock) {
+        impacts_.insert(impacts_.end(), impacts.begin(), impacts.end());
+        std::vector<Impact>().swap(impacts);
+    }
     rebuildBig();
 }
 

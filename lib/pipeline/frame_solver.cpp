@@ -4,10 +4,8 @@
 #include <malloc.h>
 #endif
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
-
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 
 #include "util/stopwatch.h"
@@ -138,18 +136,13 @@ bool FrameSolver::changeTooLarge(const PoseChange& change, size_t touched) const
     } else {
         const RayCache& cache = *lastCache_;
         segments = cache.segmentCount();
-        listed = tbb::parallel_reduce(
-            tbb::blocked_range<size_t>(0, cache.blockCount(), 1), uint64_t(0),
-            [&](const tbb::blocked_range<size_t>& r, uint64_t n) {
-                std::vector<Segment> block;
-                for (size_t b = r.begin(); b != r.end(); ++b) {
-                    cache.decodeBlock(b, block);
-                    for (const Segment& s : block)
-                        n += s.hasImpact() && s.impactDynamic && change.triangleMoved[s.triangle];
-                }
-                return n;
-            },
-            [](uint64_t a, uint64_t b) { return a + b; });
+        std::atomic<uint64_t> onMoved{0};
+        cache.forEachBlock([&](size_t, const std::vector<Segment>& block) {
+            uint64_t n = 0;
+            for (const Segment& s : block) n += s.hasImpact() && s.impactDynamic && change.triangleMoved[s.triangle];
+            onMoved += n;
+        });
+        listed = onMoved.load();
     }
     const double segmentShare = double(listed) * kSegmentsPerListedImpact * kRemoveAndAdd / double(std::max<uint64_t>(segments, 1));
     const double vertexShare = double(touched) * kRecomputedVertex / double(std::max<size_t>(scene_.vertexCount(), 1));

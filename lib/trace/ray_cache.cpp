@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <iterator>
 
 #include "trace/photon_source.h"
 
@@ -96,9 +97,9 @@ namespace {
 
 // Appends path `path`'s segments from its records: the first from the emission, the later ones
 // from their records, power carried on with the tracer's own arithmetic.
-template <class First, class Later>
+template <class First, class Later, class Out>
 void decodeRecords(const PhotonSource& source, uint64_t path, const First& first, const Later* later, const Later* end,
-                   std::vector<Segment>& out) {
+                   Out out) {
     const PhotonEmission e = source.emission(path);
     Segment s;
     s.origin = e.origin;
@@ -109,7 +110,7 @@ void decodeRecords(const PhotonSource& source, uint64_t path, const First& first
     s.path = uint32_t(path);
     s.bounce = 0;
     s.impactDynamic = s.hasImpact() ? source.surface(s.triangle).dynamic : 0;
-    out.push_back(s);
+    *out++ = s;
     for (; later != end; ++later) {
         s.power = source.powerAfter(s.power, s.triangle);
         s.origin = later->origin;
@@ -118,25 +119,30 @@ void decodeRecords(const PhotonSource& source, uint64_t path, const First& first
         s.triangle = later->triangle;
         ++s.bounce;
         s.impactDynamic = s.hasImpact() ? source.surface(s.triangle).dynamic : 0;
-        out.push_back(s);
+        *out++ = s;
     }
 }
 
 }  // namespace
 
 void RayCache::decodeBlock(size_t b, std::vector<Segment>& out) const {
+    out.resize(blocks_[b].verbatim.empty() && source_ ? blocks_[b].records.segments_ : blocks_[b].verbatim.size());
+    decodeBlockInto(b, out.data());
+}
+
+void RayCache::decodeBlockInto(size_t b, Segment* out) const {
     const Block& block = blocks_[b];
     if (!block.verbatim.empty() || !source_) {
-        out = block.verbatim;
+        std::copy(block.verbatim.begin(), block.verbatim.end(), out);
         return;
     }
-    out.clear();
-    out.reserve(block.records.segments_);
     const BlockWriter& r = block.records;
     for (size_t p = 0; p < r.first_.size(); ++p) {
         if (r.first_[p].triangle == kNoSegment) continue;
+        const size_t count = 1 + r.laterBegin_[p + 1] - r.laterBegin_[p];
         decodeRecords(*source_, block.firstPath + p, r.first_[p], r.later_.data() + r.laterBegin_[p],
                       r.later_.data() + r.laterBegin_[p + 1], out);
+        out += count;
     }
 }
 
@@ -156,16 +162,20 @@ void RayCache::appendPath(uint64_t path, std::vector<Segment>& out) const {
     const BlockWriter& r = block.records;
     if (!source_ || local >= r.first_.size() || r.first_[local].triangle == kNoSegment) return;
     decodeRecords(*source_, path, r.first_[local], r.later_.data() + r.laterBegin_[local],
-                  r.later_.data() + r.laterBegin_[local + 1], out);
+                  r.later_.data() + r.laterBegin_[local + 1], std::back_inserter(out));
+}
+
+void RayCache::forEachBlock(const std::function<void(size_t, const std::vector<Segment>&)>& visit) const {
+    tbb::parallel_for(size_t(0), blocks_.size(), [&](size_t b) {
+        std::vector<Segment> block;
+        decodeBlock(b, block);
+        visit(b, block);
+    });
 }
 
 std::vector<Segment> RayCache::decodeAll() const {
     std::vector<Segment> all(segments_);
-    tbb::parallel_for(size_t(0), blocks_.size(), [&](size_t b) {
-        std::vector<Segment> block;
-        decodeBlock(b, block);
-        std::copy(block.begin(), block.end(), all.begin() + int64_t(blocks_[b].firstSegment));
-    });
+    tbb::parallel_for(size_t(0), blocks_.size(), [&](size_t b) { decodeBlockInto(b, all.data() + blocks_[b].firstSegment); });
     return all;
 }
 

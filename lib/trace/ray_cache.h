@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -76,7 +77,12 @@ public:
 
     // Appends the segments of `path`, in bounce order.
     void appendPath(uint64_t path, std::vector<Segment>& out) const;
-    // Every segment in (path, bounce) order, decoded block by block (serial).
+    // visit(b, segments of block b) for every block, in parallel (each call with its own
+    // decoded copy): the way to read the whole cache fast; results gathered per block and joined
+    // in block order are in (path, bounce) order.
+    void forEachBlock(const std::function<void(size_t, const std::vector<Segment>&)>& visit) const;
+    // Every segment in (path, bounce) order, decoded block by block (serial: tests and small
+    // caches; whole-cache passes use forEachBlock).
     template <class Visit>
     void forEachSegment(Visit&& visit) const {
         std::vector<Segment> block;
@@ -124,6 +130,7 @@ public:
 
 private:
     static constexpr uint32_t kNoSegment = 0xFFFFFFFEu;
+    void decodeBlockInto(size_t b, Segment* out) const;  // writes the block's segmentCount segments
     struct Block {
         uint64_t firstPath = 0;
         uint64_t firstSegment = 0;

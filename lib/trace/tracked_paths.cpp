@@ -22,9 +22,7 @@ TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, floa
     };
     std::vector<std::vector<Tail>> tails(cache.blockCount());
     std::vector<std::vector<Segment>> kept(cache.blockCount());
-    tbb::parallel_for(size_t(0), cache.blockCount(), [&](size_t b) {
-        std::vector<Segment> block;
-        cache.decodeBlock(b, block);
+    cache.forEachBlock([&](size_t b, const std::vector<Segment>& block) {
         for (size_t i = 0; i < block.size();) {
             size_t end = i + 1;
             while (end < block.size() && block[end].path == block[i].path) ++end;
