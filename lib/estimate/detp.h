@@ -18,6 +18,8 @@
 // fixed-point sums make them equal to the last bit.
 #pragma once
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <initializer_list>
 #include <utility>
 #include <vector>
@@ -96,6 +98,12 @@ public:
     // Every vertex's sums from the given segments (traced in that order), in parallel.
     std::vector<DetpVertexSums> sums(const std::vector<Segment>& segments, const PowerQuantizer& q,
                                      DetpQueryStats* stats = nullptr) const;
+    // The same from every segment of the cache, decoded a group of blocks at a time and, with
+    // `morton`, traced in the Morton order of their end points within the group (coherent
+    // tracing: most discs a segment crosses sit around its end). Integer sums: the bits do not
+    // depend on the order.
+    std::vector<DetpVertexSums> sums(const RayCache& cache, bool morton, const PowerQuantizer& q,
+                                     DetpQueryStats* stats = nullptr) const;
 
     // Every crossing of the given segments with the discs of `which`, decided exactly. Found in
     // parallel; the list is in segment order, each segment's crossings by vertex, the same for
@@ -110,6 +118,9 @@ public:
 
 private:
     struct Crossed;
+    void addCrossings(const std::vector<Segment>& segments, const PowerQuantizer& q,
+                      tbb::enumerable_thread_specific<std::vector<DetpVertexSums>>& perThread,
+                      tbb::enumerable_thread_specific<uint64_t>& hitCount) const;
     struct Part {
         std::vector<uint32_t> vertices;  // primID -> scene vertex
         unsigned geomId = RTC_INVALID_GEOMETRY_ID;
@@ -152,9 +163,8 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
                                        const DiscRegions* regions, const SceneBvh* bvh,
                                        const std::vector<uint32_t>& vertexOrder);
 
-// The cache's segments in the order DETP traces them through the discs: Morton order of their end
-// points (coherent tracing: most discs a segment crosses sit around its end), or the cache's own
-// (path, bounce) order. Decoded once and reordered in place.
-std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, bool morton);
+// The segments of blocks [beginBlock, endBlock) of the cache, decoded, in the order DETP traces
+// them through the discs: the Morton order of their end points, or the cache's own.
+std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, size_t beginBlock, size_t endBlock, bool morton);
 
 }  // namespace qsgi

@@ -58,7 +58,7 @@ public:
             return;
         } else {
             discs().updateDynamic();
-            sums_ = discs_->sums(segmentsInQueryOrder(cache, e.sortQueries), quantizer_);
+            sums_ = discs_->sums(cache, e.sortQueries, quantizer_);
         }
         out.irradiance.resize(scene_.vertexCount());
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v) out.irradiance[v] = irradianceAt(v);

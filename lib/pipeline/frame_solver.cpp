@@ -149,7 +149,7 @@ bool FrameSolver::changeTooLarge(const PoseChange& change, size_t touched) const
     return segmentShare + vertexShare > kWorthUpdatingBelow;
 }
 
-const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats) {
+const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats, bool updateFollows) {
     stats = FrameTiming();
     const PoseChange change = pose(target);
     Stopwatch clock;
@@ -175,7 +175,8 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
         // After the first frame the tracking state is made at once, so that the frames after it
         // pay only their updates; after a fallback, only once a frame updates again.
         std::string noUpdate;
-        if (why == "first-frame" && !settings_.fullRecompute && estimator_->canUpdate(noUpdate)) startTracking(stats);
+        if (why == "first-frame" && updateFollows && !settings_.fullRecompute && estimator_->canUpdate(noUpdate))
+            startTracking(stats);
         stats.fromScratchReason = solved_ ? why : "";
         solved_ = true;
     } else {

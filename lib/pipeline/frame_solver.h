@@ -38,7 +38,10 @@ public:
 
     // Poses the scene as the frame shows it and computes its radiosity. Every counter of the
     // frame's record except frame, render and write times is filled here, by the stage it counts.
-    const VertexRadiosity& solve(const Pose& pose, FrameTiming& stats);
+    // `updateFollows`: another frame will be solved after this one; when none will (the last
+    // frame of a run), a frame from scratch builds no state for updates (tracked paths, the
+    // estimator's), which would cost time and, at 10^7 photons, most of the run's memory.
+    const VertexRadiosity& solve(const Pose& pose, FrameTiming& stats, bool updateFollows = true);
     // The next solve starts from scratch, disc regions included.
     void reset();
 

@@ -281,7 +281,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     };
     if (start > 0) {
         FrameTiming ignored;
-        fixPreviews(solver.solve(animation_.poseAt(0), ignored), solver.bvh());
+        fixPreviews(solver.solve(animation_.poseAt(0), ignored, false), solver.bvh());
         solver.reset();
     }
 
@@ -289,7 +289,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     for (int frame = start; frame <= last_; ++frame) {
         Stopwatch frameClock;
         FrameTiming timing;
-        const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), timing);
+        const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), timing, frame < last_);
         timing.frame = frame;
         if (!tonemap) fixPreviews(result, solver.bvh());
         if (frame == start) {

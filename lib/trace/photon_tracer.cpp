@@ -17,7 +17,16 @@ PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceS
                                                    settings.sampling)),
       bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {}
 
-void PhotonTracer::tracePath(uint64_t path, std::vector<Segment>& out) const {
+namespace {
+// Where the kernel puts a segment: a retrace's list, or the cache block a first trace writes.
+void append(std::vector<Segment>& out, const Segment& s) { out.push_back(s); }
+void append(RayCache::BlockWriter& out, const Segment& s) { out.add(s); }
+}  // namespace
+
+void PhotonTracer::tracePath(uint64_t path, std::vector<Segment>& out) const { tracePathInto(path, out); }
+
+template <class Out>
+void PhotonTracer::tracePathInto(uint64_t path, Out& out) const {
     const PathNumbers numbers = source_->numbersFor(path);
     const PhotonEmission e = source_->lights().sample(numbers);
     if (!(maxComponent(e.power) > 0)) return;  // a spot light's photon outside its cone: nothing sent
@@ -29,8 +38,9 @@ void PhotonTracer::continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Ve
     follow(source_->numbersFor(path), path, bounce, origin, direction, power, tnear, out);
 }
 
+template <class Out>
 void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction,
-                          Vec3f power, float tnear, std::vector<Segment>& out) const {
+                          Vec3f power, float tnear, Out& out) const {
     using namespace rng_dim;
     const float eps = bvh_.rayEpsilon();
     for (; bounce < settings_.maxBounces; ++bounce) {
@@ -43,14 +53,14 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
         const auto hit = bvh_.intersect(origin, direction, tnear, std::numeric_limits<float>::infinity());
         if (!hit) {
             s.length = bounds_.exitDistance(origin, direction);
-            out.push_back(s);
+            append(out, s);
             return;
         }
         const PhotonSource::Surface& surface = source_->surface(hit->triangle);
         s.length = hit->t;
         s.triangle = hit->triangle;
         s.impactDynamic = surface.dynamic;
-        out.push_back(s);
+        append(out, s);
 
         // Russian roulette on the albedo, then a cosine-weighted bounce on the incoming side.
         if (!(rng.uniform(bounce + 1, kSurvival) < surface.survival)) return;
@@ -87,16 +97,12 @@ RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& p
     tbb::enumerable_thread_specific<RayCache::BlockWriter> writers;
     auto work = [&](const tbb::blocked_range<uint64_t>& r) {
         RayCache::BlockWriter& block = writers.local();
-        std::vector<Segment> path;
         for (uint64_t c = r.begin(); c != r.end(); ++c) {
             const uint64_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
             block.clear();
             for (uint64_t p = begin; p < end; ++p) {
                 block.beginPath();
-                if (lights.empty()) continue;
-                path.clear();
-                tracePath(p, path);
-                for (const Segment& s : path) block.add(s);
+                if (!lights.empty()) tracePathInto(p, block);
             }
             blocks[c] = block.exactCopy();
             done += end - begin;

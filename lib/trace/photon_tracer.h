@@ -40,8 +40,12 @@ public:
     const LightSampler& lights() const { return source_->lights(); }
 
 private:
+    // The one kernel of first traces and retraces, writing to a segment list or a cache block.
+    template <class Out>
+    void tracePathInto(uint64_t path, Out& out) const;
+    template <class Out>
     void follow(const PathNumbers& numbers, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power,
-                float tnear, std::vector<Segment>& out) const;
+                float tnear, Out& out) const;
 
     const SceneBvh& bvh_;
     TraceSettings settings_;
