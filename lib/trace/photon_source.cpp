@@ -1,6 +1,8 @@
 #include "trace/photon_source.h"
 
+#include <map>
 #include <optional>
+#include <utility>
 
 namespace qsgi {
 
@@ -9,10 +11,16 @@ PhotonSource::PhotonSource(const Scene& scene, uint64_t photons, uint64_t seed, 
     : seed_(seed), sampling_(sampling),
       lights_(scene, photons, rayEpsilon, aim,
               sampling.kind == SamplerKind::Sobol ? std::optional<uint64_t>(seed) : std::nullopt) {
-    surfaces_.resize(scene.triangleCount());
+    surfaceOf_.resize(scene.triangleCount());
+    std::map<std::pair<uint32_t, uint8_t>, uint32_t> index;  // (material, dynamic) -> surface
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
-        const Vec3f albedo = scene.materials[scene.triangleMaterial[t]].albedo;
-        surfaces_[t] = Surface{albedo, maxComponent(albedo), scene.triangleDynamic[t]};
+        const auto key = std::make_pair(uint32_t(scene.triangleMaterial[t]), uint8_t(scene.triangleDynamic[t]));
+        auto [at, added] = index.emplace(key, uint32_t(surfaces_.size()));
+        if (added) {
+            const Vec3f albedo = scene.materials[key.first].albedo;
+            surfaces_.push_back(Surface{albedo, maxComponent(albedo), key.second});
+        }
+        surfaceOf_[t] = at->second;
     }
 }
 
