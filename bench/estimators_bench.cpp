@@ -221,41 +221,27 @@ void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
 
 // DETP's own rate: every segment traced through the vertices' discs with the exact test, in the
 // Morton order the estimator uses (DESIGN §5). Its ceiling is BM_EmbreeAllHitsCeiling below.
+// Third argument: 0 times the pass alone, on segments decoded and ordered before the timed loop;
+// 1 runs it as the estimator does, decoding the cache a group of blocks at a time (what reading
+// the compact cache costs the pass).
 void BM_DetpSegments(benchmark::State& state) {
     CornellFixture& f = fixture();
     const RayCache& cache = f.cache(uint64_t(state.range(0)));
     const float radius = float(state.range(1)) / 1000.0f;
+    const bool fromCache = state.range(2) == 1;
     const DetpDiscs discs(f.device, f.scene, radius, DetpBoundary::Clip, &f.discRegions(int(state.range(1)), false), f.bvh.get());
     const PowerQuantizer q(cache.maxPhotonPower);
-    // Decoded into Morton order once, before the timed loop: the pass alone
-    // (BM_DetpSegmentsFromCache runs it as the estimator does, decoding included).
-    const std::vector<Segment> ordered = segmentsInQueryOrder(cache, 0, cache.blockCount(), true);
+    const std::vector<Segment> ordered =
+        fromCache ? std::vector<Segment>() : segmentsInQueryOrder(cache, 0, cache.blockCount(), true);
     DetpQueryStats stats;
     for (auto _ : state) {
         stats = DetpQueryStats();
-        const auto sums = discs.sums(ordered, q, &stats);
+        const auto sums = fromCache ? discs.sums(cache, true, q, &stats) : discs.sums(ordered, q, &stats);
         benchmark::DoNotOptimize(sums.data());
     }
     state.counters["segments_per_s"] =
         benchmark::Counter(double(cache.segmentCount()), benchmark::Counter::kIsIterationInvariantRate);
     state.counters["disc_hits_per_segment"] = double(stats.discHits) / double(cache.segmentCount());
-}
-
-// The crossing pass as the estimator runs it: decoded from the cache a group of blocks at a
-// time, ordered within the group, traced. Against BM_DetpSegments: what reading the compact
-// cache costs the pass.
-void BM_DetpSegmentsFromCache(benchmark::State& state) {
-    CornellFixture& f = fixture();
-    const RayCache& cache = f.cache(uint64_t(state.range(0)));
-    const float radius = float(state.range(1)) / 1000.0f;
-    const DetpDiscs discs(f.device, f.scene, radius, DetpBoundary::Clip, &f.discRegions(int(state.range(1)), false), f.bvh.get());
-    const PowerQuantizer q(cache.maxPhotonPower);
-    for (auto _ : state) {
-        const auto sums = discs.sums(cache, true, q);
-        benchmark::DoNotOptimize(sums.data());
-    }
-    state.counters["segments_per_s"] =
-        benchmark::Counter(double(cache.segmentCount()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 // What Embree alone does with the same rays through the same discs: one BVH of oriented discs at
@@ -456,11 +442,9 @@ BENCHMARK(BM_TracePhotons)
     ->ArgsProduct({{100000, 1000000, 10000000}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_DetpSegmentsFromCache)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_DecodeRayCache)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EmbreeClosestHitCeiling)->Arg(100000)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_DetpSegments)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
+BENCHMARK(BM_DetpSegments)->ArgsProduct({{100000, 1000000}, {20, 50}, {0, 1}})->ArgNames({"photons", "radius_mm", "decode"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_EmbreeAllHitsCeiling)->ArgsProduct({{100000, 1000000}, {20, 50}})->ArgNames({"photons", "radius_mm"})
     ->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -468,14 +468,7 @@ std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache
 }
 
 std::vector<Segment> segmentsInQueryOrder(const RayCache& cache, size_t beginBlock, size_t endBlock, bool morton) {
-    const uint64_t first = beginBlock < cache.blockCount() ? cache.blockFirstSegment(beginBlock) : cache.segmentCount();
-    const uint64_t last = endBlock < cache.blockCount() ? cache.blockFirstSegment(endBlock) : cache.segmentCount();
-    std::vector<Segment> decoded(last - first);
-    tbb::parallel_for(beginBlock, endBlock, [&](size_t b) {
-        std::vector<Segment> block;
-        cache.decodeBlock(b, block);
-        std::copy(block.begin(), block.end(), decoded.begin() + int64_t(cache.blockFirstSegment(b) - first));
-    });
+    std::vector<Segment> decoded = cache.decodeBlocks(beginBlock, endBlock);
     if (!morton) return decoded;
     std::vector<Vec3f> ends(decoded.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, decoded.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {

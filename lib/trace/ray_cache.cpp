@@ -173,10 +173,13 @@ void RayCache::forEachBlock(const std::function<void(size_t, const std::vector<S
     });
 }
 
-std::vector<Segment> RayCache::decodeAll() const {
-    std::vector<Segment> all(segments_);
-    tbb::parallel_for(size_t(0), blocks_.size(), [&](size_t b) { decodeBlockInto(b, all.data() + blocks_[b].firstSegment); });
-    return all;
+std::vector<Segment> RayCache::decodeBlocks(size_t beginBlock, size_t endBlock) const {
+    const uint64_t first = beginBlock < blocks_.size() ? blocks_[beginBlock].firstSegment : segments_;
+    const uint64_t end = endBlock < blocks_.size() ? blocks_[endBlock].firstSegment : segments_;
+    std::vector<Segment> segments(end - first);
+    tbb::parallel_for(beginBlock, endBlock,
+                      [&](size_t b) { decodeBlockInto(b, segments.data() + (blocks_[b].firstSegment - first)); });
+    return segments;
 }
 
 }  // namespace qsgi

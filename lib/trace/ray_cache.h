@@ -91,9 +91,10 @@ public:
             for (const Segment& s : block) visit(s);
         }
     }
-    // Every segment, decoded in parallel into one vector in (path, bounce) order: for consumers
-    // that reorder or index the segments.
-    std::vector<Segment> decodeAll() const;
+    // The segments of blocks [beginBlock, endBlock), decoded in parallel into one vector in
+    // (path, bounce) order: for consumers that reorder or index the segments.
+    std::vector<Segment> decodeBlocks(size_t beginBlock, size_t endBlock) const;
+    std::vector<Segment> decodeAll() const { return decodeBlocks(0, blocks_.size()); }
 
     // Written by the tracer: block b holds the paths [firstPath, firstPath + paths). Segments are
     // added path by path, each path's in bounce order, from `source`'s emissions.
