@@ -3,7 +3,8 @@
 # prints a table. Repetitions give medians on a noisy machine: BENCH_REPS=3 by default.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
+scripts/setup.sh --test
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DQSGI_BUILD_BENCHMARKS=ON > /dev/null
 cmake --build build --target qsgi_bench
 mkdir -p out/bench
 ./build/bench/qsgi_bench --benchmark_repetitions="${BENCH_REPS:-3}" --benchmark_report_aggregates_only=true \

@@ -12,6 +12,7 @@ seconds=${1:-60}
 harnesses=("${@:2}")
 [ ${#harnesses[@]} -eq 0 ] && harnesses=(transform_file config gltf)
 
+scripts/setup.sh --test
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
   -DQSGI_SANITIZE=ON -DQSGI_BUILD_FUZZERS=ON -DQSGI_BUILD_TESTS=OFF -DQSGI_BUILD_BENCHMARKS=OFF > /dev/null
 cmake --build build-fuzz --target "${harnesses[@]/%/_fuzzer}"

@@ -1,33 +1,50 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages qsgi builds and tests with, and the npm packages of scripts/gltf-check. Idempotent and non-interactive:
-# packages already installed are skipped; runs apt-get directly as root, through sudo otherwise.
+# Installs the Debian 12 packages qsgi needs, in two sets, so a first run waits only for what it uses:
+#   scripts/setup.sh          building and rendering (scripts/run.sh): compiler, CMake and the libraries
+#   scripts/setup.sh --test   the above, and what the test command adds: GoogleTest and Google Benchmark,
+#                             clang with libFuzzer (scripts/fuzz.sh), oiiotool, numpy and matplotlib
+#                             (scripts/sweep.py, reference checks) and the npm packages of scripts/gltf-check
+# Idempotent and non-interactive: packages already installed are skipped; runs apt-get directly as
+# root, through sudo otherwise. Slurm is installed by scripts/test-slurm.sh, which alone uses it.
 set -euo pipefail
 
-packages=(
-  build-essential cmake ninja-build pkg-config python3
+run_packages=(
+  build-essential cmake ninja-build pkg-config
   libembree-dev
-  libopenimageio-dev libopencv-core-dev openimageio-tools
+  libopenimageio-dev libopencv-core-dev   # OpenImageIO's CMake package asks for OpenCV's
   libopenexr-dev
   libtinygltf-dev libstb-dev
   libflann-dev liblz4-dev
   libtbb-dev
   nlohmann-json3-dev
   libcli11-dev
+)
+test_packages=(
+  python3 python3-numpy python3-matplotlib   # scripts/sweep.py, tests/data/make_inputs.py, reference checks
+  openimageio-tools
   libgtest-dev libgmock-dev
   libbenchmark-dev
   clang libclang-rt-14-dev    # libFuzzer (scripts/fuzz.sh)
-  python3-numpy python3-matplotlib   # scripts/sweep.py: error figures and plots
 )
 
-# scripts/gltf-check (the Khronos glTF-Validator for --gltf-out) needs node and npm: Debian's
-# nodejs and npm where the machine has none (a machine with NodeSource's nodejs has both, and
-# Debian's npm would conflict with it).
-command -v node >/dev/null 2>&1 || packages+=(nodejs)
-command -v npm >/dev/null 2>&1 || packages+=(npm)
+case "${1:-}" in
+  "") packages=("${run_packages[@]}"); with_tests=0 ;;
+  --test) packages=("${run_packages[@]}" "${test_packages[@]}"); with_tests=1 ;;
+  *) echo "usage: scripts/setup.sh [--test]" >&2; exit 2 ;;
+esac
+
+if [ "$with_tests" = 1 ]; then
+  # scripts/gltf-check (the Khronos glTF-Validator for --gltf-out) needs node and npm: Debian's
+  # nodejs and npm where the machine has none (a machine with NodeSource's nodejs has both, and
+  # Debian's npm would conflict with it).
+  command -v node >/dev/null 2>&1 || packages+=(nodejs)
+  command -v npm >/dev/null 2>&1 || packages+=(npm)
+fi
 
 # The glTF checkers (npm packages pinned by scripts/gltf-check/package-lock.json), after the
 # Debian packages; skipped when already installed at the locked versions.
 install_gltf_checkers() {
+  [ "$with_tests" = 1 ] || return 0
   local dir
   dir="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/gltf-check"
   if node -e 'const l = require(process.argv[1] + "/package-lock.json").packages;

@@ -19,6 +19,15 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+# numpy and matplotlib are the test set's (scripts/setup.sh --test), not the renderer's: name them
+# rather than fail with a traceback on a machine set up by scripts/run.sh.
+for module, package in (("numpy", "python3-numpy"), ("matplotlib", "python3-matplotlib")):
+    try:
+        __import__(module)
+    except ImportError:
+        sys.exit(f"sweep: needs the Python module {module} (Debian package {package}); "
+                 "scripts/setup.sh --test installs it")
+
 from qsgibatch import grid, plots, reference, runner, table  # noqa: E402
 from qsgibatch.qsgi import Qsgi, QsgiError  # noqa: E402
 

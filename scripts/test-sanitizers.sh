@@ -12,6 +12,7 @@
 # incremental updates, the sweep and resume CLIs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+scripts/setup.sh --test
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release -DQSGI_SANITIZE=ON -DQSGI_BUILD_BENCHMARKS=OFF
 cmake --build build-asan
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"

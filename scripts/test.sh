@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The test command (CI runs it through .ci/run): sets up the Debian packages, then
+# The test command (CI runs it through .ci/run): sets up the Debian packages (scripts/setup.sh --test), then
 #   1. builds from scratch (Release) and runs the whole test suite with ctest;
 #   2. tests the Slurm job arrays on a single-node cluster it starts (scripts/test-slurm.sh);
 #   3. builds with AddressSanitizer + UndefinedBehaviorSanitizer and runs the suite again
@@ -11,8 +11,8 @@
 # go to ctest in step 1.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+scripts/setup.sh --test
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DQSGI_BUILD_TESTS=ON -DQSGI_BUILD_BENCHMARKS=ON
 cmake --build build
 (cd build && ctest --output-on-failure -j 2 "$@")
 if [ "${QSGI_SKIP_SLURM:-0}" != 1 ]; then scripts/test-slurm.sh; fi
