@@ -57,9 +57,12 @@ struct Expected {
 
 }  // namespace
 
+// Pinned at 191e334 (issue 21's compact cache) and measured again when Embree was capped at AVX2
+// (EmbreeDevice): the first values came from a machine whose CPU had Embree pick other kernels,
+// which round differently; 191e334 and the change that capped it give these on an AVX2 machine.
 TEST(SegmentHash, CornellSegmentsKeepTheirBitsAtFrameZeroAndAfterFiveIncrementalFrames) {
-    const Expected cases[] = {{SamplerKind::Sobol, 0x82de0e4e79a2596dull, 0x47b09c275456aedeull},
-                              {SamplerKind::Random, 0x3a465a0efab5d7aeull, 0x7987be14c6306238ull}};
+    const Expected cases[] = {{SamplerKind::Sobol, 0xf0132fa94cf244b7ull, 0x59950a446fe1a6a1ull},
+                              {SamplerKind::Random, 0x75a3e5941d325fdaull, 0xe8214b68c8dbf6efull}};
     const std::string dir = (sourceDir() / "data/cornell").string();
     for (const Expected& expected : cases) {
         SCOPED_TRACE(samplerName(expected.sampler));

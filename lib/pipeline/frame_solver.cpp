@@ -234,7 +234,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     // whole scene (no envelope) gets half as many.
     const float divisions = (reach > 0 ? 32.0f : 8.0f) / (envelope.isEverything() ? 2.0f : 1.0f);
     const float cellSize = std::max(4 * reach, gridBounds.extent() / divisions);
-    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize);
+    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize, settings_.trackedGenerations);
     foldedSegments_ = cache.segmentCount() - tracked_->trackedSegments();
     stats.photonSimulationSeconds += clock.seconds();
     clock.restart();

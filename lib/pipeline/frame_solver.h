@@ -27,6 +27,8 @@ struct FrameSolverSettings {
     bool alwaysUpdate = false;   // never fall back to scratch for a large change (tests, measurements)
     bool useEnvelope = true;     // false: track every path (for tests and the memory comparison)
     bool gridForBlocking = true; // false: test every tracked segment for blocking (benchmark baseline)
+    // Retraces of one path before every tracked path is renumbered (TrackedPaths; tests lower it).
+    uint32_t trackedGenerations = TrackedPaths::kGenerations;
 };
 
 class FrameSolver {

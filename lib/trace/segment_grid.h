@@ -2,22 +2,28 @@
 // (with their extension). It answers "which segments pass near this box" without testing every
 // cached segment: the moved objects' new bounds (segments they may now block) and the discs an
 // update recomputes. Entries are never removed one by one: each carries its path's generation,
-// entries of a path that was retraced since are stale, skipped, and swept out when they outnumber
-// the live ones.
+// entries of a path that was retraced since are stale, skipped, and swept out once they are a
+// quarter of the live ones.
 #pragma once
+
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <vector>
 
+#include "util/modest_growth.h"
 #include "util/vecmath.h"
 
 namespace qsgi {
 
+// Eight bytes: the grid lists each tracked segment in about four cells, and its entries are most of
+// the tracked state. A path's generation wraps at 2^16 retraces; TrackedPaths renumbers every
+// path before one would (TrackedPaths::renumber).
 struct SegmentRef {
     uint32_t path = 0;
-    uint32_t generation = 0;
-    uint32_t bounce = 0;
+    uint16_t generation = 0;
+    uint16_t bounce = 0;  // a segment's bounce is below kMaxBounces = 2^16
     bool operator<(const SegmentRef& o) const { return path < o.path || (path == o.path && bounce < o.bounce); }
     bool operator==(const SegmentRef& o) const { return path == o.path && bounce == o.bounce; }
 };
@@ -34,13 +40,13 @@ public:
     // find them in parallel), then listing ref in them.
     void cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const;
     void insertInto(const uint32_t* cells, size_t count, const SegmentRef& ref) {
-        for (size_t i = 0; i < count; ++i) cells_[cells[i]].push_back(ref);
+        for (size_t i = 0; i < count; ++i) pushBackModestly(cells_[cells[i]], ref);
     }
     // The same for the cells of one shard only (cell % shards == shard): shards can be filled
     // in parallel, each cell still in the order its entries come.
     void insertIntoShard(const uint32_t* cells, size_t count, const SegmentRef& ref, uint32_t shard, uint32_t shards) {
         for (size_t i = 0; i < count; ++i)
-            if (cells[i] % shards == shard) cells_[cells[i]].push_back(ref);
+            if (cells[i] % shards == shard) pushBackModestly(cells_[cells[i]], ref);
     }
     // Calls visit(ref) for every live entry (isLive(ref)) of every cell that overlaps one of the
     // boxes, as often as it is listed in such cells, and drops the stale entries of those cells
@@ -70,16 +76,23 @@ public:
         }
         return dropped;
     }
-    // Drops stale entries everywhere.
+    // Drops every entry (the cells stay).
+    void clear() {
+        for (auto& cell : cells_) std::vector<SegmentRef>().swap(cell);
+    }
+    // Drops stale entries everywhere, cells in parallel (isLive must be safe to call from
+    // several threads). The cells keep their capacity: the next retraces fill them again.
     template <typename IsLive>
     void sweep(IsLive isLive) {
-        for (auto& cell : cells_) {
-            size_t kept = 0;
-            for (const SegmentRef& r : cell)
-                if (isLive(r)) cell[kept++] = r;
-            cell.resize(kept);
-            cell.shrink_to_fit();
-        }
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, cells_.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t c = range.begin(); c != range.end(); ++c) {
+                std::vector<SegmentRef>& cell = cells_[c];
+                size_t kept = 0;
+                for (const SegmentRef& r : cell)
+                    if (isLive(r)) cell[kept++] = r;
+                cell.resize(kept);
+            }
+        });
     }
 
     size_t bytes() const;

@@ -5,15 +5,18 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 #include <tuple>
 
+#include "util/modest_growth.h"
 #include "util/stopwatch.h"
 
 namespace qsgi {
 
 TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, float extension, const Bounds3f& gridBounds,
-                           float cellSize)
-    : envelope_(envelope), extension_(extension), grid_(gridBounds, cellSize) {
+                           float cellSize, uint32_t generations)
+    : envelope_(envelope), extension_(extension), generations_(std::clamp<uint32_t>(generations, 2, kGenerations)),
+      grid_(gridBounds, cellSize) {
     const size_t n = cache.pathCount();
     // Per block of paths, the tails from the first segment that meets the envelope on, found in
     // parallel and then taken in path order.
@@ -36,12 +39,23 @@ TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, floa
         }
     });
     slot_.assign(n, -1);
+    retracedSinceSweep_.assign((n + 63) / 64, 0);
+    // Exactly the room needed: the store is most of the tracked state.
+    size_t pathCount = 0, segmentCount = 0;
+    for (size_t b = 0; b < tails.size(); ++b) {
+        pathCount += tails[b].size();
+        segmentCount += kept[b].size();
+    }
+    paths_.reserve(pathCount);
+    segments_.reserve(segmentCount);
+    generation_.reserve(segmentCount);
+    cellCount_.reserve(segmentCount);
     for (size_t b = 0; b < tails.size(); ++b) {
         size_t from = 0;
         for (const Tail& tail : tails[b]) {
             Tracked t;
             t.path = tail.path;
-            t.firstBounce = tail.firstBounce;
+            t.firstBounce = uint16_t(tail.firstBounce);
             t.begin = segments_.size();
             t.count = t.capacity = tail.count;
             segments_.insert(segments_.end(), kept[b].begin() + int64_t(from), kept[b].begin() + int64_t(from + tail.count));
@@ -72,7 +86,7 @@ void TrackedPaths::index(const Tracked& t) {
 }
 
 void TrackedPaths::indexSegment(const Tracked& t, uint32_t j, const uint32_t* cells, size_t cellCount) {
-    grid_.insertInto(cells, cellCount, SegmentRef{t.path, generation_[t.begin + j], t.firstBounce + j});
+    grid_.insertInto(cells, cellCount, refOf(t, j));
     cellCount_[t.begin + j] = uint16_t(cellCount);
     gridEntries_ += cellCount;
     liveGridEntries_ += cellCount;
@@ -83,7 +97,7 @@ void TrackedPaths::listOnTriangle(const Tracked& t, uint32_t j) {
     const Segment& s = segments_[t.begin + j];
     if (!s.hasImpact() || !s.impactDynamic) return;
     if (byTriangle_.size() <= s.triangle) byTriangle_.resize(size_t(s.triangle) + 1);
-    byTriangle_[s.triangle].push_back(SegmentRef{t.path, generation_[t.begin + j], t.firstBounce + j});
+    pushBackModestly(byTriangle_[s.triangle], refOf(t, j));
 }
 
 bool TrackedPaths::isLive(const SegmentRef& r) const {
@@ -165,7 +179,7 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
                 for (const Bounds3f& b : newBounds) {
                     double t0 = 0, t1 = double(s.length) + double(eps);
                     if (b.expanded(eps).clip(s.origin, s.direction, t0, t1)) {
-                        candidates.push_back(SegmentRef{t.path, t.generation, t.firstBounce + j});
+                        candidates.push_back(refOf(t, j));
                         break;
                     }
                 }
@@ -210,6 +224,12 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
 void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes,
                            FrameTiming& stats) {
     Stopwatch clock;
+    for (const AffectedPath& a : affected)
+        if (paths_[size_t(slot_[a.path])].generation + 1u >= generations_) {
+            renumber();
+            break;
+        }
+    for (const AffectedPath& a : affected) retracedSinceSweep_[a.path >> 6] |= uint64_t(1) << (a.path & 63);
     // New tails and the grid cells each new segment passes, found in parallel; fixed chunks of
     // paths, so nothing depends on the schedule. The kept heads stay listed as they are.
     struct Chunk {
@@ -286,7 +306,7 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
         }
     }
     if (segments_.capacity() < end) {
-        const size_t room = std::max<size_t>(end, segments_.capacity() + segments_.capacity() / 2);
+        const size_t room = std::max<size_t>(end, segments_.capacity() + segments_.capacity() / 4);
         segments_.reserve(room);
         generation_.reserve(room);
         cellCount_.reserve(room);
@@ -318,7 +338,7 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
             for (uint32_t j = 0; j < m.tailEnd - m.tailBegin; ++j) {
                 const size_t n = m.cellsAt + j;
                 const uint32_t from = n ? chunk.cellsEnd[n - 1] : 0;
-                generation_[m.begin + m.keep + j] = t.generation + 1;
+                generation_[m.begin + m.keep + j] = uint16_t(t.generation + 1);
                 cellCount_[m.begin + m.keep + j] = uint16_t(chunk.cellsEnd[n] - from);
             }
         }
@@ -350,7 +370,7 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
                     const size_t n = m.cellsAt + j;
                     const uint32_t from = n ? chunk.cellsEnd[n - 1] : 0;
                     grid_.insertIntoShard(chunk.cells.data() + from, chunk.cellsEnd[n] - from,
-                                          SegmentRef{t.path, t.generation, t.firstBounce + m.keep + j}, shard, kShards);
+                                          refOf(t, m.keep + j), shard, kShards);
                 }
             }
         }
@@ -366,36 +386,51 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
 
 void TrackedPaths::sweepIfStale() {
     auto live = [&](const SegmentRef& r) { return isLive(r); };
-    if (gridEntries_ > 2 * liveGridEntries_) {
-        grid_.sweep(live);
+    // At half the live ones stale, a sweep runs every fifth frame or so on data/cornell. Only
+    // entries of paths retraced since the last sweep can be stale: the rest are kept on a look
+    // at a bitmap that stays in cache, not at three scattered records.
+    if (2 * gridEntries_ > 3 * liveGridEntries_) {
+        grid_.sweep([&](const SegmentRef& r) { return !(retracedSinceSweep_[r.path >> 6] >> (r.path & 63) & 1) || isLive(r); });
+        std::fill(retracedSinceSweep_.begin(), retracedSinceSweep_.end(), uint64_t(0));
         for (auto& list : byTriangle_)
             list.erase(std::remove_if(list.begin(), list.end(), [&](const SegmentRef& r) { return !live(r); }), list.end());
         gridEntries_ = liveGridEntries_;
     }
-    if (garbage_ > segments_.size() - garbage_) {
+    if (4 * garbage_ > segments_.size() - garbage_) {
+        // In place, taking the paths in the order they sit in the store: each moves down or
+        // stays, so nothing is overwritten before it has moved, and no second store is needed.
         // References name (path, generation, bounce), not places: moving paths keeps them.
-        std::vector<Segment> segments;
-        std::vector<uint32_t> generation;
-        std::vector<uint16_t> cellCount;
-        const size_t room = segments_.size() - garbage_;
-        segments.reserve(room);
-        generation.reserve(room);
-        cellCount.reserve(room);
-        for (Tracked& t : paths_) {
-            const uint64_t begin = segments.size();
-            segments.insert(segments.end(), segments_.begin() + int64_t(t.begin), segments_.begin() + int64_t(t.begin + t.count));
-            generation.insert(generation.end(), generation_.begin() + int64_t(t.begin), generation_.begin() + int64_t(t.begin + t.count));
-            cellCount.insert(cellCount.end(), cellCount_.begin() + int64_t(t.begin), cellCount_.begin() + int64_t(t.begin + t.count));
-            t.begin = begin;
+        std::vector<uint32_t> byPlace(paths_.size());
+        std::iota(byPlace.begin(), byPlace.end(), 0u);
+        std::sort(byPlace.begin(), byPlace.end(), [&](uint32_t a, uint32_t b) { return paths_[a].begin < paths_[b].begin; });
+        uint64_t end = 0;
+        for (uint32_t i : byPlace) {
+            Tracked& t = paths_[i];
+            if (t.begin != end) {
+                const auto from = int64_t(t.begin), to = int64_t(end), count = int64_t(t.count);
+                std::copy(segments_.begin() + from, segments_.begin() + from + count, segments_.begin() + to);
+                std::copy(generation_.begin() + from, generation_.begin() + from + count, generation_.begin() + to);
+                std::copy(cellCount_.begin() + from, cellCount_.begin() + from + count, cellCount_.begin() + to);
+                t.begin = end;
+            }
             // Each path keeps its room (the store grows by retraces that outgrow it only).
-            segments.resize(begin + t.capacity);
-            generation.resize(begin + t.capacity, 0);
-            cellCount.resize(begin + t.capacity, 0);
+            end += t.capacity;
         }
-        segments_.swap(segments);
-        generation_.swap(generation);
-        cellCount_.swap(cellCount);
+        segments_.resize(end);
+        generation_.resize(end);
+        cellCount_.resize(end);
         garbage_ = 0;
+    }
+}
+
+void TrackedPaths::renumber() {
+    grid_.clear();
+    for (auto& list : byTriangle_) std::vector<SegmentRef>().swap(list);
+    gridEntries_ = liveGridEntries_ = 0;
+    std::fill(generation_.begin(), generation_.end(), uint16_t(0));
+    for (Tracked& t : paths_) {
+        t.generation = 0;
+        index(t);
     }
 }
 
@@ -431,8 +466,9 @@ void TrackedPaths::allSegments(std::vector<const Segment*>& out) const {
 size_t TrackedPaths::bytes() const {
     size_t listed = byTriangle_.capacity() * sizeof(byTriangle_[0]);
     for (const auto& list : byTriangle_) listed += list.capacity() * sizeof(SegmentRef);
-    return segments_.capacity() * (sizeof(Segment) + sizeof(uint32_t) + sizeof(uint16_t)) + paths_.capacity() * sizeof(Tracked) +
-           slot_.capacity() * sizeof(int32_t) + grid_.bytes() + listed;
+    return segments_.capacity() * sizeof(Segment) + generation_.capacity() * sizeof(uint16_t) +
+           cellCount_.capacity() * sizeof(uint16_t) + paths_.capacity() * sizeof(Tracked) +
+           slot_.capacity() * sizeof(int32_t) + retracedSinceSweep_.capacity() * sizeof(uint64_t) + grid_.bytes() + listed;
 }
 
 }  // namespace qsgi

@@ -31,9 +31,11 @@ class TrackedPaths {
 public:
     // extension: how far past its impact a segment is followed for the envelope test
     // (envelopeMargin's reasoning); gridBounds and cellSize: the segment grid's region (what
-    // queries ask about: the envelope's bounds) and cell edge.
+    // queries ask about: the envelope's bounds) and cell edge. generations: how many times a path
+    // can be retraced before every path is renumbered (SegmentRef's 16 bits; tests lower it).
     TrackedPaths(const RayCache& cache, const Envelope& envelope, float extension, const Bounds3f& gridBounds,
-                 float cellSize);
+                 float cellSize, uint32_t generations = kGenerations);
+    static constexpr uint32_t kGenerations = 1u << 16;
 
     // The paths the move from the previous pose to the current one affects. movedTriangles: the
     // scene triangles any of whose vertices moved (sorted), triangleMoved the same as flags;
@@ -63,6 +65,9 @@ public:
     void allSegments(std::vector<const Segment*>& out) const;
 
     size_t trackedPaths() const { return paths_.size(); }
+    // A tracked path's index among the trackedPaths() (fixed for this object's life), −1 if the
+    // path is not tracked: for per-path state kept beside this one.
+    int32_t slotOf(uint32_t path) const { return path < slot_.size() ? slot_[path] : -1; }
     size_t trackedSegments() const { return liveSegments_; }
     size_t bytes() const;
 
@@ -73,12 +78,16 @@ private:
     // spare, when it does not.
     struct Tracked {
         uint32_t path;
-        uint32_t generation = 0;  // of its newest segments: bumped by each retrace
-        uint32_t firstBounce;     // the first segment kept: the first that meets the envelope
+        uint16_t generation = 0;  // of its newest segments: bumped by each retrace
+        uint16_t firstBounce;     // the first segment kept: the first that meets the envelope
         uint64_t begin;           // into segments_
         uint32_t count;
         uint32_t capacity;
     };
+    // The reference to segment j of t as it is now.
+    SegmentRef refOf(const Tracked& t, uint32_t j) const {
+        return SegmentRef{t.path, generation_[t.begin + j], uint16_t(t.firstBounce + j)};
+    }
     const Segment* segmentOf(const SegmentRef& r) const;
     bool isLive(const SegmentRef& r) const;
     void index(const Tracked& t);
@@ -87,22 +96,28 @@ private:
     void listOnTriangle(const Tracked& t, uint32_t j);
     double reach(const Segment& s) const;  // how far along the ray the grid lists it
 
-    // Drops stale entries from the grid and the per-triangle lists once they outnumber the live
-    // ones, and compacts the store once moved paths left more garbage than it holds live.
+    // Drops stale entries from the grid and the per-triangle lists once they are a quarter of the
+    // live ones, and compacts the store once moved paths left a quarter of its live size as
+    // garbage: these stores are most of a long run's memory.
     void sweepIfStale();
+    // Every path's generation back to 0, and the grid and per-triangle lists rebuilt from the
+    // live segments: before a path's generation would wrap around.
+    void renumber();
 
     Envelope envelope_;
     float extension_;
+    uint32_t generations_;
     std::vector<Segment> segments_;  // tracked tails; paths that outgrew their room leave garbage
     // Per slot of segments_: the generation its segment was written in (a reference is live if
     // it names that generation), and how many grid cells list it.
-    std::vector<uint32_t> generation_;
+    std::vector<uint16_t> generation_;
     std::vector<uint16_t> cellCount_;
     size_t garbage_ = 0;             // slots of segments_ no path owns
     mutable size_t gridEntries_ = 0;  // listed in the grid, stale ones included
     size_t liveGridEntries_ = 0;
     std::vector<Tracked> paths_;     // increasing path id
     std::vector<int32_t> slot_;      // path id -> index in paths_, −1 if untracked
+    std::vector<uint64_t> retracedSinceSweep_;  // one bit per path id: its grid entries may be stale
     size_t liveSegments_ = 0;
     // Mutable: refsNear drops stale entries as it passes them, which changes no answer.
     mutable SegmentGrid grid_;
