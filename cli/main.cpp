@@ -16,6 +16,7 @@
 #include "output/ply_reader.h"
 #include "pipeline/render_job.h"
 #include "util/error.h"
+#include "run_display.h"
 #include "util/progress.h"
 
 namespace {
@@ -100,7 +101,6 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (o.noExr) s.writeExr = false;
     if (o.exrHalf) s.exrHalf = true;
     s.quiet = o.quiet;
-    s.progress = !o.quiet && qsgi::stderrIsTerminal();
     return s;
 }
 
@@ -237,14 +237,24 @@ int main(int argc, char** argv) {
         qsgi::RenderJob job(settingsFrom(o, scene), warnings);
         if (!o.quiet)
             for (const auto& w : warnings.messages) std::fprintf(stderr, "qsgi: warning: %s\n", w.c_str());
-        const qsgi::RunOutcome outcome = job.run([&](const qsgi::FrameReport& r) {
-            // Lights far from the geometry waste photons; say so once, with the number.
-            if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet)
-                std::fprintf(stderr, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate rests on the rest "
-                             "(move lights closer or add photons)\n", 100 * r.missedFraction);
-            if (o.verbose) std::fprintf(stderr, "qsgi: frame %d (%d/%d) %.3f s\n", r.frame, r.index + 1, r.count, r.seconds);
-        }, [] { return gStopSignal != 0; });
-        const std::string out = o.out.empty() ? std::string("the output folder") : o.out;
+        RunDisplay display(!o.quiet && qsgi::stderrIsTerminal());
+        const qsgi::RunOutcome outcome = job.run(
+            [&](const qsgi::FrameReport& r) {
+                // Lights far from the geometry waste photons; say so once, with the number.
+                if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet) {
+                    display.clearLine();
+                    std::fprintf(stderr, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate rests on the rest "
+                                 "(move lights closer or add photons)\n", 100 * r.missedFraction);
+                }
+                if (o.verbose) {
+                    display.clearLine();
+                    std::fprintf(stderr, "qsgi: frame %d (%d/%d) %.3f s\n", r.frame, r.index + 1, r.count, r.seconds);
+                }
+                display.frameDone(r);
+            },
+            [] { return gStopSignal != 0; }, [&](const qsgi::StageReport& r) { display.stage(r); });
+        display.clearLine();
+        const std::string& out = job.outputFolder();
         if (outcome.interrupted) {
             std::fprintf(stderr, "qsgi: stopped by %s after frame %d; every frame before %d is complete in %s (add --resume "
                          "to continue)\n", gStopSignal == SIGINT ? "SIGINT" : "SIGTERM", outcome.nextFrame - 1,
@@ -253,6 +263,8 @@ int main(int argc, char** argv) {
         }
         if (o.resume && !o.quiet && outcome.framesWritten == 0)
             std::fprintf(stderr, "qsgi: every frame is already complete in %s\n", out.c_str());
+        else if (!o.quiet)
+            std::fprintf(stderr, "qsgi: %s\n", display.summary(out).c_str());
         return 0;
     } catch (const qsgi::InputError& e) {
         std::fprintf(stderr, "qsgi: error: %s\n", e.what());

@@ -2,8 +2,14 @@
 // clear message, exit code 2 and nothing written (DESIGN §8).
 #include <gtest/gtest.h>
 
+#include <pty.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "output/image_compare.h"
 #include "test_support.h"
@@ -26,7 +32,68 @@ void expectBadInput(const std::string& args, const std::string& mention, const f
     EXPECT_FALSE(fs::exists(out)) << "bad input must write nothing: " << args;
 }
 
+// Runs qsgi with its output on a pseudo-terminal, as a user's terminal is: everything it wrote.
+CommandResult runQsgiOnTerminal(const std::vector<std::string>& arguments) {
+    std::vector<std::string> words{QSGI_CLI};
+    words.insert(words.end(), arguments.begin(), arguments.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    int terminal = -1;
+    const pid_t child = forkpty(&terminal, nullptr, nullptr, nullptr);
+    if (child < 0) return {-1, "forkpty failed"};
+    if (child == 0) {
+        execv(argv[0], argv.data());
+        _exit(127);
+    }
+    CommandResult r{-1, ""};
+    char buffer[4096];
+    for (;;) {
+        const ssize_t n = read(terminal, buffer, sizeof buffer);
+        if (n > 0) r.output.append(buffer, size_t(n));
+        else if (n < 0 && errno == EINTR) continue;
+        else break;  // EIO once the child has closed the terminal
+    }
+    close(terminal);
+    int status = 0;
+    waitpid(child, &status, 0);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
 }  // namespace
+
+// What the README promises: on a terminal a status line (frame i of N, the stage, a bar while
+// tracing) redrawn in place; a summary line at the end on a terminal or not; neither with --quiet,
+// and no status line when stderr is not a terminal.
+TEST(Cli, ProgressIsDrawnOnATerminalOnlyAndEveryRunEndsWithASummary) {
+    const fs::path dir = testScratchDir("progress");
+    const std::vector<std::string> args{"render", cornell(), "--animation", cornellAnimation(), "--frames", "0:2",
+                                        "--photons", "200000", "--no-exr"};
+    std::vector<std::string> onTerminal = args;
+    onTerminal.insert(onTerminal.end(), {"--out", (dir / "terminal").string()});
+    const CommandResult t = runQsgiOnTerminal(onTerminal);
+    ASSERT_EQ(t.exitCode, 0) << t.output;
+    for (const char* expected : {"qsgi: frame 1/3", "qsgi: frame 3/3", "tracing [", "retracing", "elapsed", "left", "\r",
+                                 "qsgi: wrote 3 frames to "})
+        EXPECT_NE(t.output.find(expected), std::string::npos) << "missing '" << expected << "' in:\n" << t.output;
+
+    std::string common;
+    for (const std::string& a : args) common += " " + a;
+    const CommandResult file = runQsgi(common + " --out " + (dir / "file").string());
+    ASSERT_EQ(file.exitCode, 0) << file.output;
+    EXPECT_EQ(file.output.find('\r'), std::string::npos) << file.output;
+    EXPECT_EQ(file.output.find("frame 1/3"), std::string::npos) << file.output;
+    EXPECT_NE(file.output.find("qsgi: wrote 3 frames to " + (dir / "file").string() + " in "), std::string::npos) << file.output;
+    EXPECT_EQ(std::count(file.output.begin(), file.output.end(), '\n'), 1) << file.output;
+
+    std::vector<std::string> quiet = onTerminal;
+    quiet.back() = (dir / "quiet").string();
+    quiet.push_back("--quiet");
+    const CommandResult q = runQsgiOnTerminal(quiet);
+    ASSERT_EQ(q.exitCode, 0) << q.output;
+    EXPECT_TRUE(q.output.empty()) << q.output;
+}
 
 TEST(Cli, OutputBytesAreIdenticalForOneAndTwoThreadsAndRepeatedRuns) {
     const fs::path dir = testScratchDir("determinism");

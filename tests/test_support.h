@@ -44,7 +44,7 @@ qsgi::RayCache traceScene(const qsgi::Scene& scene, uint64_t photons, uint64_t s
 qsgi::VertexRadiosity estimateWith(const qsgi::Scene& scene, const qsgi::RayCache& cache,
                                    const qsgi::EstimatorSettings& settings);
 
-// Scenes built in code, with one instance per mesh (see scene_builders.cpp).
+// Scenes built in code, with one instance per mesh (built in test_support.cpp).
 namespace testscenes {
 qsgi::Scene closedSphere(float radius, int subdivisions, qsgi::Vec3f albedo, bool inwardNormals = true);
 qsgi::Scene plane(float halfSize, int cells, qsgi::Vec3f albedo);

@@ -300,7 +300,8 @@ void DetpDiscs::crossingsIn(const Segment& s, std::initializer_list<std::pair<RT
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(bvh, &ctx.base, &rh);
     }
-    // Embree may report a primitive more than once along one ray (NOTES.md).
+    // Embree may report a primitive more than once along one ray (a filter function sees a
+    // primitive once per BVH leaf that holds it, and spatial splits put one in several leaves).
     std::sort(crossed.begin(), crossed.end());
     crossed.erase(std::unique(crossed.begin(), crossed.end(),
                               [](const CrossedDisc& a, const CrossedDisc& b) { return a.vertex == b.vertex; }),

@@ -157,6 +157,7 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     std::vector<uint32_t> touched = !firstTime && change.any ? touchedVertices(change) : std::vector<uint32_t>();
     // The estimators recompute the moved vertices and those whose disc now decides crossings
     // differently; the regions' conservative test touched more (most keep their disc).
+    stage("regions");
     std::vector<uint32_t> redecided = updateRegions(firstTime ? nullptr : &touched, stats);
     for (uint32_t v : touched)
         if (change.vertexMoved[v]) redecided.push_back(v);
@@ -206,7 +207,8 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
     tracked_.reset();
     lastCache_.reset();
     Stopwatch clock;
-    RayCache cache = tracer_.traceAll();
+    stage("tracing", 0, settings_.trace.photons);
+    RayCache cache = tracer_.traceAll([this](uint64_t done, uint64_t total) { stage("tracing", done, total); });
     stats.photonSimulationSeconds = clock.seconds();
     stats.segments = cache.segmentCount();
     stats.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
@@ -214,6 +216,7 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
     stats.segmentsAdded = cache.segmentCount();
 
     clock.restart();
+    stage("estimating");
     estimator_->solve(cache, result_, stats);
     stats.estimationSeconds = clock.seconds();
     if (!settings_.fullRecompute) lastCache_ = std::move(cache);
@@ -221,6 +224,7 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
 
 void FrameSolver::startTracking(FrameTiming& stats) {
     // Paths that meet the envelope are tracked, the rest stay folded into the estimator's state.
+    stage("tracking");
     Stopwatch clock;
     const RayCache& cache = *lastCache_;
     const float reach = estimator_->reach();
@@ -246,6 +250,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
 
 void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats) {
     Stopwatch clock;
+    stage("retracing");
     const std::vector<AffectedPath> affected =
         tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.gridForBlocking, stats);
     PathChanges changes;
@@ -255,6 +260,7 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
     clock.restart();
     const FrameChange frameChange{changes.removed,         changes.added, change.vertexMoved, change.triangleMoved,
                                   change.movedTriangles, touched,       *tracked_};
+    stage("updating");
     estimator_->update(frameChange, result_, stats);
     stats.estimationSeconds += clock.seconds();
 }

@@ -5,6 +5,7 @@
 // bits (fixed-point sums, identical hits). The solver knows no estimator: each owns its update.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -47,6 +48,13 @@ public:
     // The next solve starts from scratch, disc regions included.
     void reset();
 
+    // Told what a solve is doing, for a progress display: the stage ("regions", "tracing",
+    // "estimating", "tracking", "retracing", "updating") and, where known, how far it is (done of
+    // total; total 0 when unknown). Called from the solving thread, and for tracing from a
+    // reporter thread a few times a second.
+    using StageReporter = std::function<void(const char* stage, uint64_t done, uint64_t total)>;
+    void reportStagesTo(StageReporter reporter) { reportStage_ = std::move(reporter); }
+
     const SceneBvh& bvh() const { return bvh_; }
     // The share of the lights' power that emission sends toward the scene (LightSampler).
     double emittedFraction() const { return tracer_.lights().emittedFraction(); }
@@ -58,6 +66,9 @@ public:
     const PhotonTracer& tracer() const { return tracer_; }
 
 private:
+    void stage(const char* name, uint64_t done = 0, uint64_t total = 0) const {
+        if (reportStage_) reportStage_(name, done, total);
+    }
     struct PoseChange {
         std::vector<Bounds3f> bounds;      // old and new of each instance's moved triangles
         std::vector<Bounds3f> newBounds;
@@ -80,6 +91,7 @@ private:
 
     Scene& scene_;
     FrameSolverSettings settings_;
+    StageReporter reportStage_;
     SceneBvh bvh_;
     PhotonTracer tracer_;
     std::optional<DiscRegions> regions_;

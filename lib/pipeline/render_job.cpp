@@ -24,7 +24,6 @@
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
 #include "trace/photon_tracer.h"
-#include "util/progress.h"
 #include "util/stopwatch.h"
 
 namespace qsgi {
@@ -174,7 +173,8 @@ std::vector<FrameTiming> framesToKeep(const fs::path& outDir, const std::string&
 }  // namespace
 
 RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame,
-                          const std::function<bool()>& stopRequested) {
+                          const std::function<bool()>& stopRequested,
+                          const std::function<void(const StageReport&)>& onStage) {
     std::optional<tbb::global_control> threadLimit;
     if (settings_.threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(settings_.threads));
 
@@ -286,7 +286,13 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     }
 
     const int count = last_ - start + 1;
+    int current = start;  // the frame being solved, for the stage reports
+    auto stage = [&](const char* name, uint64_t done, uint64_t total) {
+        if (onStage) onStage(StageReport{current, current - start, count, name, done, total});
+    };
+    solver.reportStagesTo(stage);
     for (int frame = start; frame <= last_; ++frame) {
+        current = frame;
         Stopwatch frameClock;
         FrameTiming timing;
         const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), timing, frame < last_);
@@ -301,11 +307,13 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         std::optional<RgbImage> image;
         Stopwatch clock;
         if (settings_.writeExr || settings_.writePng) {
+            stage("image", 0, 0);
             image = renderRadiosityImage(scene_, solver.bvh(), result, cameraAt(frame), imageSettings);
             timing.renderSeconds = clock.seconds();
         }
 
         clock.restart();
+        stage("writing", 0, 0);
         writeVertexRadiosityPly(outDir / frameFileName(frame, "ply"), scene_, result, *tonemap);
         if (settings_.writeExr) writeExr(outDir / frameFileName(frame, "exr"), *image, imageMetadata(frame), settings_.exrHalf);
         if (settings_.writePng) writePngPreview(outDir / frameFileName(frame, "png"), *image, *exposure);

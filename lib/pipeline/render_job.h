@@ -20,6 +20,15 @@ struct FrameReport {
     double missedFraction;  // of the photons emitted this frame, those that hit no geometry
 };
 
+// What a frame is doing, for a progress display: the solver's stages (FrameSolver::StageReporter),
+// then "image" and "writing".
+struct StageReport {
+    int frame;
+    int index, count;  // position in the run
+    const char* stage;
+    uint64_t done, total;  // how far the stage is; total 0 when unknown
+};
+
 // How run() ended: every frame written, or stopped early on request with the frames before
 // `nextFrame` on disk.
 struct RunOutcome {
@@ -38,11 +47,14 @@ public:
     // Creates the output folder and renders every frame (with --resume, those an earlier run of
     // the same inputs has not written). onFrame runs after each frame; when stopRequested returns
     // true after a frame, run() returns with the folder consistent (every file complete, timing.json
-    // describing the frames on disk).
+    // describing the frames on disk). onStage is told each stage of a frame as it starts, and
+    // how far tracing is a few times a second (from another thread).
     RunOutcome run(const std::function<void(const FrameReport&)>& onFrame = {},
-                   const std::function<bool()>& stopRequested = {});
+                   const std::function<bool()>& stopRequested = {},
+                   const std::function<void(const StageReport&)>& onStage = {});
 
     const Scene& scene() const { return scene_; }
+    const std::string& outputFolder() const { return settings_.outDir; }
     int firstFrame() const { return first_; }
     int lastFrame() const { return last_; }
 

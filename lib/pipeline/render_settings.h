@@ -53,7 +53,6 @@ struct RenderSettings {
     std::optional<int> cameraIndex;       // a glTF camera by index
     struct LookAt { Vec3f position, target, up{0, 1, 0}; float yfov = 0.8f; };
     std::optional<LookAt> camera;         // world space, from the config
-    bool progress = false;
     bool quiet = false;
 };
 
