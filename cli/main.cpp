@@ -16,6 +16,7 @@
 #include "output/ply_reader.h"
 #include "pipeline/render_job.h"
 #include "util/error.h"
+#include "pipeline/scene_inspection.h"
 #include "run_display.h"
 #include "util/progress.h"
 
@@ -211,6 +212,17 @@ int main(int argc, char** argv) {
                         "the 'near an edge' distance, scene units (default 1.5 % of the scene diagonal, qsgi's default radius)");
     compare->add_flag("--json", compareJson, "print JSON instead of a table");
 
+    CliOptions io;
+    std::string inspectScene;
+    bool inspectJson = false;
+    CLI::App* inspect = app.add_subcommand(
+        "inspect", "what a render of this scene would see: meshes, materials, lights, cameras, what moves, the radius, warnings");
+    inspect->add_option("SCENE", inspectScene, "glTF 2.0 scene (.gltf or .glb); may come from --config instead");
+    inspect->add_option("--animation", io.animation, "as for render: a transform file, gltf or gltf:N");
+    inspect->add_option("--config", io.config, "as for render: its lights, radius, frames and camera are included");
+    inspect->add_option("--fps", io.fps, "as for render: frames per second of a glTF animation (default 24)");
+    inspect->add_flag("--json", inspectJson, "print JSON instead of text");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::Success& e) {  // --help, --version
@@ -227,6 +239,22 @@ int main(int argc, char** argv) {
         } catch (const qsgi::InputError& e) {
             std::fprintf(stderr, "qsgi: error: %s\n", e.what());
             return kExitBadInput;
+        }
+    }
+
+    if (inspect->parsed()) {
+        try {
+            qsgi::Warnings warnings;
+            const qsgi::RenderJob job(settingsFrom(io, inspectScene), warnings);
+            const nlohmann::json report = qsgi::inspectRender(job, warnings);
+            std::fputs(inspectJson ? (report.dump(2) + "\n").c_str() : qsgi::inspectionText(report).c_str(), stdout);
+            return 0;
+        } catch (const qsgi::InputError& e) {
+            std::fprintf(stderr, "qsgi: error: %s\n", e.what());
+            return kExitBadInput;
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "qsgi: internal error: %s\n", e.what());
+            return kExitInternal;
         }
     }
 

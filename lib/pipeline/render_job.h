@@ -55,6 +55,9 @@ public:
 
     const Scene& scene() const { return scene_; }
     const std::string& outputFolder() const { return settings_.outDir; }
+    const RenderSettings& settings() const { return settings_; }  // with the defaults the scene decides
+    const Animation& animation() const { return animation_; }
+    const Camera& camera() const { return camera_; }  // at frame 0
     int firstFrame() const { return first_; }
     int lastFrame() const { return last_; }
 

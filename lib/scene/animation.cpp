@@ -144,6 +144,12 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
     return a;
 }
 
+double Animation::lastFrameAt(double endSeconds, double fps) {
+    // Frame f shows time f / fps; the last frame is the first at or past the last key. Key times
+    // are float32, so a key meant for frame 41 may lie a few ulps past it: that is frame 41.
+    return std::max(0.0, std::ceil(endSeconds * fps * (1 - 1e-6)));
+}
+
 Animation Animation::fromGltf(const Scene& scene, int index, double fps, const std::string& source) {
     if (scene.animations.empty()) throw InputError(source, "", "the scene has no glTF animation");
     auto listing = [&] {
@@ -174,9 +180,7 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
             if (c.property != AnimatedProperty::Weights) animated.insert(c.node);
         }
     }
-    // Frame f shows time f / fps; the last frame is the first at or past the last key. Key times
-    // are float32, so a key meant for frame 41 may lie a few ulps past it: that is frame 41.
-    const double lastFrame = std::ceil(end * fps * (1 - 1e-6));
+    const double lastFrame = lastFrameAt(end, fps);
     if (!(lastFrame <= 10000000))
         throw InputError(source, "fps", "the animation's " + std::to_string(end) + " s at " + std::to_string(fps) +
                                             " frames per second exceed 10^7 frames");

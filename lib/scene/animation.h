@@ -32,6 +32,8 @@ public:
     // --animation gltf:1"). Throws InputError if there is no such animation, if animations played
     // together drive the same node property, or if a frame's transform is not invertible.
     static Animation fromGltf(const Scene& scene, int index, double fps, const std::string& source);
+    // The last frame of a glTF animation whose keys end at endSeconds, sampled at fps.
+    static double lastFrameAt(double endSeconds, double fps);
 
     int lastFrame() const { return lastFrame_; }
     double fps() const { return fps_; }

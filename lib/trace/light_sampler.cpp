@@ -147,6 +147,20 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
     aims_.push_back(std::move(a));
 }
 
+std::vector<Vec3f> LightSampler::lightPowers(size_t lightCount) const {
+    std::vector<Vec3f> powers(lightCount, Vec3f(0.0f));
+    for (const Emitter& e : emitters_)
+        if (e.kind != Emitter::Triangle && e.index < lightCount) powers[e.index] = e.power;
+    return powers;
+}
+
+Vec3f LightSampler::emissiveTrianglePower() const {
+    Vec3f sum(0.0f);
+    for (const Emitter& e : emitters_)
+        if (e.kind == Emitter::Triangle) sum += e.power;
+    return sum;
+}
+
 PhotonEmission LightSampler::sample(const PathNumbers& rng) const {
     using namespace rng_dim;
     const Emitter& e = emitters_[rng.dealt() ? rng.emitter() : chooseEmitter(rng.uniform(0, kLightChoice))];

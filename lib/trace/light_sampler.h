@@ -36,6 +36,10 @@ public:
                  std::optional<uint64_t> dealSeed = std::nullopt);
 
     bool empty() const { return emitters_.empty(); }
+    // What each emitter sends toward the scene (W, RGB): punctual lights by index (zero for one
+    // that sends nothing), and every emissive triangle together.
+    std::vector<Vec3f> lightPowers(size_t lightCount) const;
+    Vec3f emissiveTrianglePower() const;
     Vec3f totalPower() const { return totalPower_; }  // W, RGB, that the emitters send
     // The luminance of what the emitters send over what they would send unaimed: the share of
     // the lights' power that can reach the scene (1 unaimed).
