@@ -58,11 +58,7 @@ qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene)
     if (!o.config.empty()) qsgi::applyConfigFile(o.config, s);
     if (!scene.empty()) s.scenePath = scene;
     if (!o.animation.empty()) s.animationPath = o.animation;
-    if (o.fps) {
-        if (!(*o.fps > 0) || !(*o.fps <= 1e6))
-            throw qsgi::InputError("command line", "--fps", "must be a positive number of frames per second (at most 10^6)");
-        s.fps = *o.fps;
-    }
+    if (o.fps) s.fps = qsgi::checkedFps(*o.fps, "command line", "--fps");
     if (!o.estimator.empty()) s.estimator.kind = qsgi::parseEstimator(o.estimator, "command line");
     if (!o.detpIndex.empty()) s.estimator.detpIndex = qsgi::parseDetpIndex(o.detpIndex, "command line");
     if (!o.detpBoundary.empty()) s.estimator.boundary = qsgi::parseDetpBoundary(o.detpBoundary, "command line");
@@ -114,10 +110,10 @@ int runCompare(const std::string& a, const std::string& b, std::optional<double>
                                           std::to_string(reference.positions.size()) + ": not the same scene");
     if (radiusOption && (!(*radiusOption > 0) || !std::isfinite(*radiusOption)))
         throw qsgi::InputError("command line", "--radius", "must be a positive distance (scene units)");
-    // Default: qsgi's own default radius, 1.5 % of the bounding-box diagonal.
+    // Default: qsgi's own default radius, over the reference's vertices.
     qsgi::Bounds3f bounds;
     for (const qsgi::Vec3f& p : reference.positions) bounds.extend(p);
-    const float radius = radiusOption ? float(*radiusOption) : 0.015f * std::max(bounds.extent(), 1e-6f);
+    const float radius = radiusOption ? float(*radiusOption) : qsgi::defaultRadius(bounds);
     const qsgi::AccuracyReport r = qsgi::compareSolutions(reference.positions, reference.normals, reference.triangles,
                                                           solution.radiosity, reference.radiosity, radius);
     const std::pair<const char*, const qsgi::ErrorStats*> rows[] = {

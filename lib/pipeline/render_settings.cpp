@@ -75,7 +75,13 @@ std::optional<int> gltfAnimationSelector(const std::string& animation, const std
     return std::stoi(digits);
 }
 
-float defaultRadius(const Scene& scene) { return 0.015f * std::max(scene.animationBounds.extent(), 1e-6f); }
+float defaultRadius(const Bounds3f& animationBounds) { return kDefaultRadiusFraction * std::max(animationBounds.extent(), 1e-6f); }
+float defaultRadius(const Scene& scene) { return defaultRadius(scene.animationBounds); }
+
+double checkedFps(double fps, const std::string& file, const std::string& place) {
+    if (!(fps > 0) || !(fps <= 1e6)) throw InputError(file, place, "must be a positive number of frames per second (at most 10^6)");
+    return fps;
+}
 
 FrameRange parseFrameRange(const std::string& text, const std::string& source) {
     auto parseInt = [&](const std::string& s) {
@@ -183,9 +189,7 @@ void applyConfig(const std::string& path, const json& doc, RenderSettings& s) {
             s.animationPath = str();
             if (!gltfAnimationSelector(s.animationPath, path)) s.animationPath = resolve(s.animationPath);
         } else if (key == "fps") {
-            if (!v.is_number() || !(v.get<double>() > 0) || !(v.get<double>() <= 1e6))
-                throw InputError(path, key, "must be a positive number of frames per second (at most 10^6)");
-            s.fps = v.get<double>();
+            s.fps = checkedFps(v.is_number() ? v.get<double>() : 0.0, path, key);
         }
         else if (key == "out") s.outDir = str();
         else if (key == "estimator") s.estimator.kind = parseEstimator(str(), path);

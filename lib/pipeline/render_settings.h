@@ -93,8 +93,13 @@ DetpIndex parseDetpIndex(const std::string& name, const std::string& source);
 DetpBoundary parseDetpBoundary(const std::string& name, const std::string& source);
 SamplerKind parseSampler(const std::string& name, const std::string& source);
 
-// 1.5 % of the scene's bounding-box diagonal: a radius that means the same in any unit.
+// 1.5 % of the animation's bounding-box diagonal: a radius that means the same in any unit.
 float defaultRadius(const Scene& scene);
+// The same for bounds alone (qsgi compare, which has a PLY's vertices, not a scene).
+constexpr float kDefaultRadiusFraction = 0.015f;  // of the animation's bounding-box diagonal
+float defaultRadius(const Bounds3f& animationBounds);
+// A glTF animation's sampling rate, from a config or the command line: positive, at most 10^6.
+double checkedFps(double fps, const std::string& file, const std::string& place);
 
 // The sampling a run uses: the default K is capped at max_bounces (an explicit K above it is
 // refused by validateSettings); K means nothing under random and is 0 there.
