@@ -42,6 +42,20 @@ void installStopHandlers() {
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 1;
 
+// Runs a subcommand's work; bad input becomes one line and exit 2, anything else exit 1.
+template <typename Work>
+int exitCodeOf(Work&& work) {
+    try {
+        return work();
+    } catch (const qsgi::InputError& e) {
+        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
+        return kExitBadInput;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "qsgi: internal error: %s\n", e.what());
+        return kExitInternal;
+    }
+}
+
 struct CliOptions {
     std::string config, animation, estimator, detpIndex, detpBoundary, frames, out, sampler;
     // Unset options leave the config's (or the default) value alone.
@@ -229,32 +243,18 @@ int main(int argc, char** argv) {
         return kExitBadInput;
     }
 
-    if (compare->parsed()) {
-        try {
-            return runCompare(compareA, compareB, compareRadius, compareJson);
-        } catch (const qsgi::InputError& e) {
-            std::fprintf(stderr, "qsgi: error: %s\n", e.what());
-            return kExitBadInput;
-        }
-    }
+    if (compare->parsed()) return exitCodeOf([&] { return runCompare(compareA, compareB, compareRadius, compareJson); });
 
-    if (inspect->parsed()) {
-        try {
+    if (inspect->parsed())
+        return exitCodeOf([&] {
             qsgi::Warnings warnings;
             const qsgi::RenderJob job(settingsFrom(io, inspectScene), warnings);
             const nlohmann::json report = qsgi::inspectRender(job, warnings);
             std::fputs(inspectJson ? (report.dump(2) + "\n").c_str() : qsgi::inspectionText(report).c_str(), stdout);
             return 0;
-        } catch (const qsgi::InputError& e) {
-            std::fprintf(stderr, "qsgi: error: %s\n", e.what());
-            return kExitBadInput;
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "qsgi: internal error: %s\n", e.what());
-            return kExitInternal;
-        }
-    }
+        });
 
-    try {
+    return exitCodeOf([&] {
         // Before loading, so that a signal at any moment leaves through the same door.
         installStopHandlers();
         qsgi::Warnings warnings;
@@ -290,11 +290,5 @@ int main(int argc, char** argv) {
         else if (!o.quiet)
             std::fprintf(stderr, "qsgi: %s\n", display.summary(out).c_str());
         return 0;
-    } catch (const qsgi::InputError& e) {
-        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
-        return kExitBadInput;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "qsgi: internal error: %s\n", e.what());
-        return kExitInternal;
-    }
+    });
 }
