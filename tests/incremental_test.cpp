@@ -118,6 +118,11 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
     }
     // The scenes are built so the mover is in the light: the update did real work.
     EXPECT_GT(retraced, 0u);
+    // A lowered generation limit is there to make the renumbering run.
+    if (generations < TrackedPaths::kGenerations) {
+        ASSERT_NE(inc.trackedPaths(), nullptr);
+        EXPECT_GT(inc.trackedPaths()->renumberings(), 0u);
+    }
 }
 
 Vec3d slide(int f, double dx, double dz) { return Vec3d(dx * f, 0, dz * f); }

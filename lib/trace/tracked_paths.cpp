@@ -424,6 +424,7 @@ void TrackedPaths::sweepIfStale() {
 }
 
 void TrackedPaths::renumber() {
+    ++renumberings_;
     grid_.clear();
     for (auto& list : byTriangle_) std::vector<SegmentRef>().swap(list);
     gridEntries_ = liveGridEntries_ = 0;

@@ -65,6 +65,7 @@ public:
     void allSegments(std::vector<const Segment*>& out) const;
 
     size_t trackedPaths() const { return paths_.size(); }
+    uint64_t renumberings() const { return renumberings_; }  // times every path was renumbered
     // A tracked path's index among the trackedPaths() (fixed for this object's life), −1 if the
     // path is not tracked: for per-path state kept beside this one.
     int32_t slotOf(uint32_t path) const { return path < slot_.size() ? slot_[path] : -1; }
@@ -107,6 +108,7 @@ private:
     Envelope envelope_;
     float extension_;
     uint32_t generations_;
+    uint64_t renumberings_ = 0;
     std::vector<Segment> segments_;  // tracked tails; paths that outgrew their room leave garbage
     // Per slot of segments_: the generation its segment was written in (a reference is live if
     // it names that generation), and how many grid cells list it.
