@@ -15,6 +15,7 @@
 #include "estimate/accuracy.h"
 #include "output/ply_reader.h"
 #include "pipeline/render_job.h"
+#include "pipeline/render_options.h"
 #include "util/error.h"
 #include "pipeline/scene_inspection.h"
 #include "run_display.h"
@@ -56,62 +57,41 @@ int exitCodeOf(Work&& work) {
     }
 }
 
-struct CliOptions {
-    std::string config, animation, estimator, detpIndex, detpBoundary, frames, out, sampler;
-    // Unset options leave the config's (or the default) value alone.
-    std::optional<int64_t> photons, seed, threads, width, height, spp, camera;
-    std::optional<double> exposure, radius, fps;
-    std::optional<int64_t> k, qmcBounces;
-    bool noRayCache = false, noSortQueries = false, fullRecompute = false, alwaysUpdate = false, noEnvelope = false, noAim = false, resume = false;
-    bool quiet = false, verbose = false, png = false, noExr = false, exrHalf = false, gltfOut = false;
-};
+// A render's options on the command line, made from the one table (lib/pipeline/render_options.cpp):
+// each is kept as the text given and applied after --config by the rules a config's value meets.
+using BoundOptions = std::vector<std::pair<const qsgi::RenderOption*, CLI::Option*>>;
 
-// Later sources override earlier ones: defaults, then --config, then explicit options.
-qsgi::RenderSettings settingsFrom(const CliOptions& o, const std::string& scene) {
+std::string commandLineHelp(const qsgi::RenderOption& o) {
+    std::string help = o.help;
+    if (*o.defaultText && o.type != qsgi::OptionType::Boolean) help += " (default: " + std::string(o.defaultText) + ")";
+    return help;
+}
+
+// Adds the options with a flag (all of them, or those named in `only`) to `command`.
+BoundOptions addRenderOptions(CLI::App* command, const std::vector<std::string>& only = {}) {
+    BoundOptions bound;
+    for (const qsgi::RenderOption& o : qsgi::renderOptions()) {
+        if (!o.flag || (!only.empty() && std::find(only.begin(), only.end(), o.flag) == only.end())) continue;
+        CLI::Option* option = o.type == qsgi::OptionType::Boolean ? command->add_flag(std::string(o.flag))
+                                                                  : command->add_option(std::string(o.flag));
+        option->description(commandLineHelp(o));
+        option->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);  // as most tools: the last one given wins
+        std::string metavar = o.metavar;
+        for (const std::string& choice : o.choices) metavar += (metavar.empty() ? "" : "|") + choice;
+        if (!metavar.empty()) option->type_name(metavar);
+        bound.emplace_back(&o, option);
+    }
+    return bound;
+}
+
+// Later sources override earlier ones: the defaults, then --config, then the other options.
+qsgi::RenderSettings settingsFrom(const BoundOptions& bound) {
     qsgi::RenderSettings s;
-    if (!o.config.empty()) qsgi::applyConfigFile(o.config, s);
-    if (!scene.empty()) s.scenePath = scene;
-    if (!o.animation.empty()) s.animationPath = o.animation;
-    if (o.fps) s.fps = qsgi::checkedFps(*o.fps, "command line", "--fps");
-    if (!o.estimator.empty()) s.estimator.kind = qsgi::parseEstimator(o.estimator, "command line");
-    if (!o.detpIndex.empty()) s.estimator.detpIndex = qsgi::parseDetpIndex(o.detpIndex, "command line");
-    if (!o.detpBoundary.empty()) s.estimator.boundary = qsgi::parseDetpBoundary(o.detpBoundary, "command line");
-    if (o.radius) {
-        s.estimator.radius = float(*o.radius);
-        s.radiusGiven = true;
-    }
-    const std::string cli = "command line";
-    if (o.k) s.estimator.k = int(qsgi::checkedInteger(*o.k, 1, qsgi::kMaxK, cli, "--k"));
-    if (o.noRayCache) s.estimator.useIndex = false;
-    if (o.noSortQueries) s.estimator.sortQueries = false;
-    if (o.fullRecompute) s.fullRecompute = true;
-    if (o.alwaysUpdate) s.alwaysUpdate = true;
-    if (o.noEnvelope) s.useEnvelope = false;
-    if (o.noAim) s.aimEmission = false;
-    if (!o.sampler.empty()) s.sampling.kind = qsgi::parseSampler(o.sampler, cli);
-    if (o.qmcBounces) {
-        s.sampling.qmcBounces = qsgi::checkedQmcBounces(*o.qmcBounces, cli, "--qmc-bounces");
-        s.qmcBouncesGiven = true;
-    }
-    if (o.resume) s.resume = true;
-    if (!o.frames.empty()) {
-        s.frames = qsgi::parseFrameRange(o.frames, cli);
-        s.framesSource = cli;
-    }
-    if (!o.out.empty()) s.outDir = o.out;
-    if (o.photons) s.photons = qsgi::checkedPhotons(*o.photons, cli, "--photons");
-    if (o.seed) s.seed = uint64_t(qsgi::checkedInteger(*o.seed, 0, qsgi::kMaxSeed, cli, "--seed"));
-    if (o.threads) s.threads = int(qsgi::checkedInteger(*o.threads, 0, qsgi::kMaxThreads, cli, "--threads", " (0: all cores)"));
-    if (o.width) s.width = int(qsgi::checkedInteger(*o.width, 1, qsgi::kMaxImageSide, cli, "--width"));
-    if (o.height) s.height = int(qsgi::checkedInteger(*o.height, 1, qsgi::kMaxImageSide, cli, "--height"));
-    if (o.spp) s.samplesPerPixel = int(qsgi::checkedInteger(*o.spp, 1, qsgi::kMaxSamplesPerPixel, cli, "--spp"));
-    if (o.camera) s.cameraIndex = int(qsgi::checkedInteger(*o.camera, 0, INT32_MAX, cli, "--camera"));
-    if (o.exposure) s.exposure = float(*o.exposure);
-    if (o.png) s.writePng = true;
-    if (o.gltfOut) s.writeGltf = true;
-    if (o.noExr) s.writeExr = false;
-    if (o.exrHalf) s.exrHalf = true;
-    s.quiet = o.quiet;
+    for (const auto& [o, option] : bound)
+        if (std::string(o->flag) == "--config" && option->count()) qsgi::applyConfigFile(option->as<std::string>(), s);
+    for (const auto& [o, option] : bound)
+        if (o->set && option->count())
+            qsgi::applyCommandLineOption(*o, o->type == qsgi::OptionType::Boolean ? "" : option->as<std::string>(), s);
     return s;
 }
 
@@ -155,62 +135,8 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", std::string("qsgi ") + QSGI_VERSION);
     app.require_subcommand(1);
 
-    CliOptions o;
-    std::string scene;
     CLI::App* render = app.add_subcommand("render", "render every frame of a scene's animation to vertex-radiosity PLYs");
-    render->add_option("SCENE", scene, "glTF 2.0 scene (.gltf or .glb); may come from --config instead");
-    render->add_option("--config", o.config, "JSON config with the same keys (configs/default.json); options override it");
-    render->add_option("--animation", o.animation,
-                       "qsgi-animation transform file (JSON), or gltf (every animation in the scene file at once) or "
-                       "gltf:N (its animation N)");
-    render->add_option("--fps", o.fps, "frames per second at which a glTF animation is sampled (default 24)");
-    render->add_option("--estimator", o.estimator, "density estimator: detp, photon-map or impact-count (default)");
-    render->add_option("--radius", o.radius, "DETP disc / photon-map search radius, scene units (default 1.5 % of the scene diagonal)");
-    render->add_option("--k", o.k, "photon map: nearest impacts per vertex (default 50)");
-    render->add_option("--detp-index", o.detpIndex, "DETP index: embree (exact, default) or flann (approximate candidates)");
-    render->add_option("--detp-boundary", o.detpBoundary,
-                       "where discs meet other geometry: clip (default: reachable cells only, no leaks), linear (clip "
-                       "plus a first-order fit at edges) or paper (the published rule; the textbook photon map)");
-    render->add_flag("--no-ray-cache", o.noRayCache, "density estimation without any spatial index (brute force)");
-    render->add_flag("--no-sort-queries", o.noSortQueries, "queries in input order instead of Morton order");
-    render->add_flag("--full-recompute", o.fullRecompute,
-                     "compute every frame from scratch instead of updating the previous one (same bytes, slower)");
-    render->add_flag("--always-update", o.alwaysUpdate,
-                     "update every frame after the first incrementally, even one whose change would cost more to update "
-                     "than to recompute (same bytes; for measuring the update)");
-    render->add_flag("--no-envelope", o.noEnvelope,
-                     "track every light path instead of only those that meet the moving geometry's envelope (same "
-                     "bytes, more memory and work per frame)");
-    render->add_flag("--no-aim", o.noAim,
-                     "emit photons in every direction a light shines, not only toward the scene (projection maps "
-                     "off; the same estimate in expectation, more photons wasted)");
-    render->add_option("--photons", o.photons, "photons traced per frame (default 1000000)");
-    render->add_option("--sampler", o.sampler,
-                       "where photons' numbers come from: sobol (scrambled Sobol points, stratified; default) or random "
-                       "(hashed, independent: the paper's)");
-    render->add_option("--qmc-bounces", o.qmcBounces,
-                       "sobol: scatterings whose survival and direction are Sobol coordinates too, 0..max_bounces "
-                       "(default 2; later ones are hashed)");
-    render->add_option("--seed", o.seed, "random seed (default 1); same seed, same bytes");
-    render->add_option("--threads", o.threads, "worker threads, 0 = all cores (default 0)");
-    render->add_option("--frames", o.frames, "frames A:B, inclusive at both ends (default: all)");
-    render->add_option("--out", o.out, "output folder (default out)");
-    render->add_flag("--resume", o.resume,
-                     "continue the output folder after its last complete frame (same inputs and settings only; "
-                     "threads and --full-recompute may differ)");
-    render->add_option("--width", o.width, "image width in pixels (default 640)");
-    render->add_option("--height", o.height, "image height in pixels (default 480)");
-    render->add_option("--spp", o.spp, "jittered primary rays per pixel (default 1: the pixel centre)");
-    render->add_option("--camera", o.camera, "use the glTF camera with this index (default: the first camera node)");
-    render->add_flag("--no-exr", o.noExr, "do not write frame_NNNN.exr");
-    render->add_flag("--exr-half", o.exrHalf, "write EXRs as half floats instead of float");
-    render->add_flag("--png", o.png, "also write an 8-bit sRGB preview frame_NNNN.png");
-    render->add_flag("--gltf-out", o.gltfOut,
-                     "also write frame_NNNN.glb: the posed geometry with COLOR_0 = radiosity/pi on an unlit material "
-                     "(irradiance in _IRRADIANCE), for glTF viewers");
-    render->add_option("--exposure", o.exposure, "PNG exposure multiplier (default: automatic, fixed at the first frame)");
-    render->add_flag("--quiet", o.quiet, "print nothing but errors");
-    render->add_flag("--verbose", o.verbose, "print per-frame timings");
+    const BoundOptions renderOptions = addRenderOptions(render);
 
     std::string compareA, compareB;
     std::optional<double> compareRadius;
@@ -222,16 +148,15 @@ int main(int argc, char** argv) {
                         "the 'near an edge' distance, scene units (default 1.5 % of the scene diagonal, qsgi's default radius)");
     compare->add_flag("--json", compareJson, "print JSON instead of a table");
 
-    CliOptions io;
-    std::string inspectScene;
-    bool inspectJson = false;
     CLI::App* inspect = app.add_subcommand(
         "inspect", "what a render of this scene would see: meshes, materials, lights, cameras, what moves, the radius, warnings");
-    inspect->add_option("SCENE", inspectScene, "glTF 2.0 scene (.gltf or .glb); may come from --config instead");
-    inspect->add_option("--animation", io.animation, "as for render: a transform file, gltf or gltf:N");
-    inspect->add_option("--config", io.config, "as for render: its lights, radius, frames and camera are included");
-    inspect->add_option("--fps", io.fps, "as for render: frames per second of a glTF animation (default 24)");
+    const BoundOptions inspectOptions = addRenderOptions(inspect, {"SCENE", "--animation", "--config", "--fps"});
+    bool inspectJson = false;
     inspect->add_flag("--json", inspectJson, "print JSON instead of text");
+
+    CLI::App* options = app.add_subcommand("options", "every render option: its flag, config key, default and meaning");
+    bool optionsMarkdown = false;
+    options->add_flag("--markdown", optionsMarkdown, "print the table of docs/command-line.md instead of JSON");
 
     try {
         app.parse(argc, argv);
@@ -245,10 +170,16 @@ int main(int argc, char** argv) {
 
     if (compare->parsed()) return exitCodeOf([&] { return runCompare(compareA, compareB, compareRadius, compareJson); });
 
+    if (options->parsed()) {
+        if (optionsMarkdown) std::fputs(qsgi::optionsMarkdownTable().c_str(), stdout);
+        else std::printf("%s\n", qsgi::optionsDescription().dump(2).c_str());
+        return 0;
+    }
+
     if (inspect->parsed())
         return exitCodeOf([&] {
             qsgi::Warnings warnings;
-            const qsgi::RenderJob job(settingsFrom(io, inspectScene), warnings);
+            const qsgi::RenderJob job(settingsFrom(inspectOptions), warnings);
             const nlohmann::json report = qsgi::inspectRender(job, warnings);
             std::fputs(inspectJson ? (report.dump(2) + "\n").c_str() : qsgi::inspectionText(report).c_str(), stdout);
             return 0;
@@ -258,7 +189,8 @@ int main(int argc, char** argv) {
         // Before loading, so that a signal at any moment leaves through the same door.
         installStopHandlers();
         qsgi::Warnings warnings;
-        qsgi::RenderJob job(settingsFrom(o, scene), warnings);
+        qsgi::RenderJob job(settingsFrom(renderOptions), warnings);
+        const qsgi::RenderSettings& o = job.settings();
         if (!o.quiet)
             for (const auto& w : warnings.messages) std::fprintf(stderr, "qsgi: warning: %s\n", w.c_str());
         RunDisplay display(!o.quiet && qsgi::stderrIsTerminal());

@@ -7,5 +7,5 @@ scripts/setup.sh
 # Only the renderer: the tests and benchmarks (and what they need) are the test command's.
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DQSGI_BUILD_TESTS=OFF -DQSGI_BUILD_BENCHMARKS=OFF > /dev/null
 cmake --build build --target qsgi
+# qsgi's last line says how many frames it wrote and where (out/cornell unless --out says otherwise).
 ./build/cli/qsgi render --config configs/default.json "$@"
-echo "run: wrote $(ls out/cornell/frame_*.ply | wc -l) PLY frames and out/cornell/timing.json"

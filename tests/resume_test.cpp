@@ -142,7 +142,7 @@ TEST(Resume, SigintAndSigtermStopAfterTheCurrentFrameWithAConsistentFolder) {
 TEST(Resume, FolderFromOtherInputsIsRefusedAndLeftUntouched) {
     const fs::path dir = testScratchDir("resume-refuse");
     const fs::path out = dir / "out";
-    const std::string few = " --frames 0:2 --photons 20000 --width 40 --height 30 --quiet";
+    const std::string few = " --frames 0:2 --photons 20000 --width 40 --height 30 --estimator detp --quiet";
     const fs::path cornell = sourceDir() / "data" / "cornell";
     const std::string scene = (cornell / "cornell.gltf").string() + " --animation " + (cornell / "animation.json").string();
     ASSERT_EQ(runQsgi("render " + scene + few + " --out " + out.string()).exitCode, 0);
@@ -156,10 +156,14 @@ TEST(Resume, FolderFromOtherInputsIsRefusedAndLeftUntouched) {
         EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
         EXPECT_EQ(readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json"), before);
     }
-    // The same inputs with another update strategy: nothing left to do, nothing rewritten.
-    const CommandResult same = runQsgi("render " + scene + few + " --full-recompute --resume --out " + out.string());
-    EXPECT_EQ(same.exitCode, 0) << same.output;
-    EXPECT_EQ(readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json"), before);
+    // The same inputs with another update strategy, or a setting DETP does not read (the photon
+    // map's k): nothing left to do, nothing rewritten.
+    for (const char* change : {" --full-recompute", " --k 7"}) {
+        SCOPED_TRACE(change);
+        const CommandResult same = runQsgi("render " + scene + few + change + " --resume --out " + out.string());
+        EXPECT_EQ(same.exitCode, 0) << same.output;
+        EXPECT_EQ(readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json"), before);
+    }
     // Frame files without a log are not ours to continue.
     fs::remove(out / "timing.json");
     const CommandResult orphan = runQsgi("render " + scene + few + " --resume --out " + out.string());

@@ -11,6 +11,22 @@
 #include "trace/photon_numbers.h"
 #include "trace/ray_cache.h"
 
+// Whether this build runs under AddressSanitizer (scripts/test-sanitizers.sh), where every
+// instruction costs several times more. There the question is memory safety, not statistics: a
+// test whose property holds at any size (indexed == brute force, incremental == full) may check
+// it on fewer cases or a smaller instance, and says so where it does.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+#else
+inline constexpr bool kSanitized = false;
+#endif
+
 std::filesystem::path sourceDir();  // the repository root
 std::filesystem::path sharedDir();  // ../shared beside the repository (may be absent)
 std::string testScratchDir(const std::string& name);

@@ -13,15 +13,6 @@
 
 namespace qsgi {
 
-const char* detpBoundaryName(DetpBoundary rule) {
-    switch (rule) {
-        case DetpBoundary::Clip: return "clip";
-        case DetpBoundary::Linear: return "linear";
-        case DetpBoundary::Paper: return "paper";
-    }
-    return "?";
-}
-
 namespace {
 // The disc of a vertex when no regions were computed (the paper rule needs none).
 const VertexDisc kPaperDisc = [] {

@@ -29,11 +29,14 @@
 #include "scene/scene.h"
 #include "trace/embree_device.h"
 #include "trace/ray_cache.h"
+#include "util/enum_names.h"
 
 namespace qsgi {
 
 enum class DetpBoundary { Clip, Linear, Paper };
-const char* detpBoundaryName(DetpBoundary rule);
+inline constexpr NamedValue<DetpBoundary> kDetpBoundaryNames[] = {
+    {DetpBoundary::Clip, "clip"}, {DetpBoundary::Linear, "linear"}, {DetpBoundary::Paper, "paper"}};
+inline const char* detpBoundaryName(DetpBoundary rule) { return nameOf(kDetpBoundaryNames, rule); }
 
 // Where a segment crosses a disc: (x, y) in units of r in the disc's frame, and the cell there.
 struct DiscCrossing {

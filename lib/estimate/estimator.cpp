@@ -4,15 +4,6 @@
 
 namespace qsgi {
 
-const char* estimatorName(EstimatorKind kind) {
-    switch (kind) {
-        case EstimatorKind::ImpactCount: return "impact-count";
-        case EstimatorKind::PhotonMap: return "photon-map";
-        case EstimatorKind::Detp: return "detp";
-    }
-    return "?";
-}
-
 bool needsDiscRegions(const EstimatorSettings& s) {
     return s.kind != EstimatorKind::ImpactCount && s.boundary != DetpBoundary::Paper;
 }

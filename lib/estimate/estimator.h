@@ -17,12 +17,16 @@
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
 #include "trace/tracked_paths.h"
+#include "util/enum_names.h"
 #include "util/frame_timing.h"
 
 namespace qsgi {
 
 enum class EstimatorKind { ImpactCount, PhotonMap, Detp };
 enum class DetpIndex { Embree, Flann };
+inline constexpr NamedValue<EstimatorKind> kEstimatorNames[] = {
+    {EstimatorKind::ImpactCount, "impact-count"}, {EstimatorKind::PhotonMap, "photon-map"}, {EstimatorKind::Detp, "detp"}};
+inline constexpr NamedValue<DetpIndex> kDetpIndexNames[] = {{DetpIndex::Embree, "embree"}, {DetpIndex::Flann, "flann"}};
 
 struct EstimatorSettings {
     EstimatorKind kind = EstimatorKind::ImpactCount;
@@ -39,7 +43,7 @@ struct EstimatorSettings {
 // Whether the estimator needs disc regions, and whether with the photon map's coverage.
 bool needsDiscRegions(const EstimatorSettings& settings);
 DiscRegions makeDiscRegions(const EstimatorSettings& settings);
-const char* estimatorName(EstimatorKind kind);
+inline const char* estimatorName(EstimatorKind kind) { return nameOf(kEstimatorNames, kind); }
 
 // What one frame changed, as an update reads it (DESIGN §6 steps 2–4). The scene, its BVH and
 // the disc regions already hold the new pose.

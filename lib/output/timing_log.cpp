@@ -26,15 +26,8 @@ void TimingLog::write(const std::filesystem::path& path) const {
     using nlohmann::json;
     json j;
     j["version"] = QSGI_VERSION;
-    const bool hasRadius = estimator != "impact-count";
-    j["config"] = {{"estimator", estimator}, {"photons", photons},
-                   {"radius", hasRadius ? nlohmann::json(radius) : nlohmann::json(nullptr)},
-                   {"k", estimator == "photon-map" ? nlohmann::json(k) : nlohmann::json(nullptr)},
-                   {"detp_index", estimator == "detp" ? nlohmann::json(detpIndex) : nlohmann::json(nullptr)},
-                   {"detp_boundary", hasRadius ? nlohmann::json(boundary) : nlohmann::json(nullptr)},
-                   {"ray_cache", rayCache}, {"sort_queries", sortQueries}, {"full_recompute", fullRecompute}, {"envelope", envelope},
-                   {"aim_emission", aimEmission}, {"sampler", sampler},
-                   {"qmc_bounces", sampler == "sobol" ? json(qmcBounces) : json(nullptr)}, {"seed", seed}, {"threads", threads}, {"inputs_fingerprint", inputsFingerprint}};
+    j["config"] = config;
+    j["config"]["inputs_fingerprint"] = inputsFingerprint;
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
                   {"degenerate_triangles", degenerateTriangles}, {"animation_diagonal", animationDiagonal}};

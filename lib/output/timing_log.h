@@ -2,6 +2,8 @@
 // summaries that mirror the paper's table (initial frame vs. per-frame update).
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -12,20 +14,10 @@
 namespace qsgi {
 
 struct TimingLog {
-    // config
-    std::string estimator;
-    float radius = 0;
-    int k = 0;
-    bool rayCache = true, sortQueries = true;
-    std::string detpIndex;
-    std::string boundary;  // DETP / photon-map boundary rule
-    uint64_t photons = 0, seed = 0;
-    int threads = 0;
-    bool fullRecompute = false;
-    bool envelope = true;
-    bool aimEmission = true;
-    std::string sampler;
-    uint32_t qmcBounces = 0;  // written only under sobol
+    // "config": the options the option table marks for the log (optionValues), by config key;
+    // null where an option means nothing for the run. "threads" is the count the run used.
+    nlohmann::json config = nlohmann::json::object();
+    uint64_t photons = 0;              // traced per frame
     uint64_t photonsMissingScene = 0;  // at the run's first frame
     double emittedFraction = 1;        // LightSampler::emittedFraction
     bool emissionMeasured = false;     // the two above are set (after this run's first frame)

@@ -20,6 +20,7 @@
 #include "output/radiosity_image.h"
 #include "output/timing_log.h"
 #include "output/atomic_file.h"
+#include "pipeline/render_options.h"
 #include "pipeline/frame_solver.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
@@ -116,15 +117,19 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     }
     std::string animationBytes;
     if (gltfAnimation) {
-        // What the run shows of it: every moving node's transform and every morphing node's
-        // weights at every frame.
-        for (int frame = 0; frame <= animation_.lastFrame(); ++frame) {
-            const Pose pose = animation_.poseAt(frame);
-            for (int node : animation_.movedNodes())
-                animationBytes.append(reinterpret_cast<const char*>(pose.locals[size_t(node)].m.data()), sizeof(double) * 16);
-            for (int node : animation_.morphedNodes()) {
-                const std::vector<double>& w = pose.morphWeights[size_t(node)];
-                animationBytes.append(reinterpret_cast<const char*>(w.data()), sizeof(double) * w.size());
+        // The keyframes the run samples (the fps is among the fingerprinted options): their size
+        // is the file's, not the frame count's, so a long animation costs no memory per frame.
+        auto append = [&](const void* data, size_t bytes) { animationBytes.append(static_cast<const char*>(data), bytes); };
+        append(&*gltfAnimation, sizeof(int));
+        for (size_t a = 0; a < scene_.animations.size(); ++a) {
+            if (*gltfAnimation >= 0 && size_t(*gltfAnimation) != a) continue;
+            for (const AnimationChannel& channel : scene_.animations[a].channels) {
+                const int64_t header[6] = {channel.node, int64_t(channel.property), int64_t(channel.track.interpolation),
+                                           channel.track.components, int64_t(channel.track.times.size()),
+                                           int64_t(channel.track.values.size())};
+                append(header, sizeof header);
+                append(channel.track.times.data(), sizeof(double) * channel.track.times.size());
+                append(channel.track.values.data(), sizeof(double) * channel.track.values.size());
             }
         }
     } else if (!settings_.animationPath.empty()) {
@@ -211,23 +216,11 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     RunOutcome outcome;
 
     TimingLog log;
-    log.estimator = estimatorName(settings_.estimator.kind);
-    log.radius = settings_.estimator.radius;
-    log.k = settings_.estimator.k;
-    log.rayCache = settings_.estimator.useIndex;
-    log.fullRecompute = settings_.fullRecompute;
-    log.envelope = settings_.useEnvelope;
-    log.aimEmission = settings_.aimEmission;
-    log.sampler = samplerName(settings_.sampling.kind);
-    log.qmcBounces = effectiveSampling(settings_).qmcBounces;
-    log.sortQueries = settings_.estimator.sortQueries;
-    log.detpIndex = settings_.estimator.detpIndex == DetpIndex::Flann ? "flann" : "embree";
-    log.boundary = detpBoundaryName(settings_.estimator.boundary);
+    log.config = optionValues(settings_, OptionSelection::Logged);
     log.degenerateTriangles = ImpactCount(scene_).degenerateTriangles();
     log.photons = settings_.photons;
-    log.seed = settings_.seed;
-    log.threads = settings_.threads > 0 ? settings_.threads
-                                        : int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    log.config["threads"] = settings_.threads > 0 ? settings_.threads
+                                                  : int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     log.scene = settings_.scenePath;
     log.vertices = scene_.vertexCount();
     log.triangles = scene_.triangleCount();

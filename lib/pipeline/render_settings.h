@@ -1,5 +1,6 @@
 // Everything a render run needs to know, from a JSON config (configs/*.json) overridden by the
-// command line (DESIGN §8). Parsing lives here; the CLI only maps options onto the fields.
+// command line (DESIGN §8). Each option is declared once, in render_options.cpp: its key, flag,
+// range, default and help; the config reader here and the CLI both apply values through it.
 #pragma once
 
 #include <nlohmann/json_fwd.hpp>
@@ -54,6 +55,7 @@ struct RenderSettings {
     struct LookAt { Vec3f position, target, up{0, 1, 0}; float yfov = 0.8f; };
     std::optional<LookAt> camera;         // world space, from the config
     bool quiet = false;
+    bool verbose = false;  // each frame's time on stderr
 };
 
 // Limits of qsgi's own formats and of sane runs. Values beyond them are refused with a message,
@@ -72,8 +74,6 @@ int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string&
 // A photon count: within 1..kMaxPhotons and within the machine's memory (each photon stores at
 // least one segment and its path's start).
 uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place);
-// A number of quasi-random scatterings: within 0..kMaxQmcBounces (the Sobol table's reach).
-uint32_t checkedQmcBounces(int64_t value, const std::string& source, const std::string& place);
 
 // Reads a config file into `settings` (only the keys present change). Relative scene and
 // animation paths are resolved against the config's folder. Throws InputError.
@@ -88,24 +88,19 @@ constexpr double kDefaultGltfFps = 24;
 
 // Parses "A:B" (inclusive, as in Blender) or "A". Throws InputError naming `source`.
 FrameRange parseFrameRange(const std::string& text, const std::string& source);
-EstimatorKind parseEstimator(const std::string& name, const std::string& source);
-DetpIndex parseDetpIndex(const std::string& name, const std::string& source);
-DetpBoundary parseDetpBoundary(const std::string& name, const std::string& source);
-SamplerKind parseSampler(const std::string& name, const std::string& source);
 
 // 1.5 % of the animation's bounding-box diagonal: a radius that means the same in any unit.
 float defaultRadius(const Scene& scene);
 // The same for bounds alone (qsgi compare, which has a PLY's vertices, not a scene).
 constexpr float kDefaultRadiusFraction = 0.015f;  // of the animation's bounding-box diagonal
 float defaultRadius(const Bounds3f& animationBounds);
-// A glTF animation's sampling rate, from a config or the command line: positive, at most 10^6.
-double checkedFps(double fps, const std::string& file, const std::string& place);
 
 // The sampling a run uses: the default K is capped at max_bounces (an explicit K above it is
 // refused by validateSettings); K means nothing under random and is 0 there.
 PhotonSampling effectiveSampling(const RenderSettings& settings);
 
-// Checks values that no parser can (photons > 0, …). Throws InputError naming the option.
+// Checks every option's value by the rules its declaration gives (for settings filled by a
+// program), and what no single option can: a scene is given, K is at most max_bounces.
 void validateSettings(const RenderSettings& settings);
 
 }  // namespace qsgi

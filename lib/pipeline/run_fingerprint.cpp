@@ -2,6 +2,8 @@
 
 #include <OpenImageIO/hash.h>
 
+#include "pipeline/render_options.h"
+
 #include <cstdio>
 #include <type_traits>
 #include <vector>
@@ -56,18 +58,9 @@ std::string runFingerprint(const RenderSettings& s, const Scene& scene, const st
         f.addValue(l.cosOuterCone);
     }
     f.add(animationBytes);
-    f.add(s.scenePath);  // EXR metadata names it
-    // Settings that reach the frame files.
-    const EstimatorSettings& e = s.estimator;
-    f.add(std::vector<int64_t>{int64_t(e.kind), int64_t(e.k), int64_t(e.useIndex), int64_t(e.sortQueries),
-                               int64_t(e.detpIndex), int64_t(e.boundary), int64_t(s.photons), int64_t(s.seed),
-                               int64_t(s.maxBounces), s.width, s.height, s.samplesPerPixel, int64_t(s.writeExr),
-                               int64_t(s.exrHalf), int64_t(s.writePng), int64_t(s.exposure.has_value()),
-                               int64_t(s.writeGltf), int64_t(s.aimEmission), int64_t(s.sampling.kind),
-                               // The K that shapes the bytes: none under random, capped at max_bounces.
-                               int64_t(effectiveSampling(s).qmcBounces)});
-    f.addValue(e.radius);
-    f.addValue(s.exposure.value_or(0.0f));
+    // Every option that reaches the frame files, as the option table declares them (the scene's
+    // path among them: EXR metadata names it).
+    f.add(optionValues(s, OptionSelection::Fingerprinted).dump());
     f.addValue(camera.position);
     f.addValue(camera.forward);
     f.addValue(camera.up);

@@ -19,6 +19,7 @@
 
 #include "trace/counter_rng.h"
 #include "trace/sobol.h"
+#include "util/enum_names.h"
 
 namespace qsgi {
 
@@ -29,7 +30,8 @@ constexpr uint32_t kSobolDimensionsPerBounce = 3;
 // The scatterings the shipped table can cover.
 constexpr uint32_t kMaxQmcBounces = (SobolSequence::kDimensions - kSobolEmissionDimensions) / kSobolDimensionsPerBounce;
 
-inline const char* samplerName(SamplerKind kind) { return kind == SamplerKind::Sobol ? "sobol" : "random"; }
+inline constexpr NamedValue<SamplerKind> kSamplerNames[] = {{SamplerKind::Sobol, "sobol"}, {SamplerKind::Random, "random"}};
+inline const char* samplerName(SamplerKind kind) { return nameOf(kSamplerNames, kind); }
 
 struct PhotonSampling {
     SamplerKind kind = SamplerKind::Sobol;

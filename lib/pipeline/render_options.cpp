@@ -1,0 +1,474 @@
+#include "pipeline/render_options.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "util/error.h"
+#include "util/json_file.h"
+#include "util/nearest_name.h"
+
+namespace qsgi {
+
+using nlohmann::json;
+
+namespace {
+
+// Relative paths in a config are relative to its folder; on the command line, to the working directory.
+std::string resolved(const std::string& path, const OptionSource& source) {
+    return source.base.empty() || std::filesystem::path(path).is_absolute() ? path : (source.base / path).string();
+}
+
+json orNull(bool meaningful, json value) { return meaningful ? std::move(value) : json(nullptr); }
+
+template <class E, size_t N>
+E choiceValue(const NamedValue<E> (&names)[N], const json& value) {
+    return *valueNamed(names, value.get<std::string>());  // applyOption has checked the name
+}
+
+Vec3f vec3(const json& j, const std::string& file, const std::string& place) {
+    if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
+        throw InputError(file, place, "must be an array of 3 numbers");
+    const double x = j[0].get<double>(), y = j[1].get<double>(), z = j[2].get<double>();
+    const double largest = std::numeric_limits<float>::max();
+    if (!(std::fabs(x) <= largest && std::fabs(y) <= largest && std::fabs(z) <= largest))
+        throw InputError(file, place, "holds a number beyond single precision");
+    return Vec3f(float(x), float(y), float(z));
+}
+json toJson(const Vec3f& v) { return json::array({v.x, v.y, v.z}); }
+
+PunctualLight parseLight(const json& j, const std::string& file, const std::string& place) {
+    if (!j.is_object() || !j.contains("type") || !j["type"].is_string())
+        throw InputError(file, place, "must be an object with a \"type\" (point or directional)");
+    refuseUnknownKeys(j, {"type", "position", "intensity", "direction", "irradiance", "name"}, file, place);
+    PunctualLight l;
+    const std::string type = j["type"];
+    l.name = place;
+    auto nonNegative = [&](const Vec3f& v, const std::string& field) {
+        if (v.x < 0 || v.y < 0 || v.z < 0) throw InputError(file, place + "." + field, "must be non-negative");
+        return v;
+    };
+    if (type == "point") {
+        l.type = LightType::Point;
+        if (!j.contains("position") || !j.contains("intensity"))
+            throw InputError(file, place, "a point light needs \"position\" and \"intensity\" (W/sr)");
+        l.position = vec3(j["position"], file, place + ".position");
+        l.intensity = nonNegative(vec3(j["intensity"], file, place + ".intensity"), "intensity");
+    } else if (type == "directional") {
+        l.type = LightType::Directional;
+        if (!j.contains("direction") || !j.contains("irradiance"))
+            throw InputError(file, place, "a directional light needs \"direction\" and \"irradiance\" (W/m^2)");
+        l.direction = normalize(vec3(j["direction"], file, place + ".direction"));
+        if (dot(l.direction, l.direction) == 0) throw InputError(file, place + ".direction", "must not be zero");
+        l.intensity = nonNegative(vec3(j["irradiance"], file, place + ".irradiance"), "irradiance");
+    } else {
+        throw InputError(file, place + ".type", "unknown light type '" + type + "' (point or directional)");
+    }
+    return l;
+}
+
+json lightJson(const PunctualLight& l) {
+    if (l.type == LightType::Directional)
+        return {{"type", "directional"}, {"direction", toJson(l.direction)}, {"irradiance", toJson(l.intensity)}};
+    return {{"type", "point"}, {"position", toJson(l.position)}, {"intensity", toJson(l.intensity)}};
+}
+
+void setCamera(RenderSettings& s, const json& v, const OptionSource& src) {
+    if (v.is_number()) {
+        const int64_t index = v.is_number_integer() ? v.get<int64_t>() : -1;
+        if (v.is_number_float() && std::floor(v.get<double>()) == v.get<double>() && std::fabs(v.get<double>()) < 1e10)
+            return setCamera(s, json(int64_t(v.get<double>())), src);
+        s.cameraIndex = int(checkedInteger(index, 0, INT32_MAX, src.file, src.place, " (a glTF camera index)"));
+        s.camera.reset();
+        return;
+    }
+    const char* shape = "must be a glTF camera index or {position, target, up, yfov}";
+    if (!v.is_object()) throw InputError(src.file, src.place, shape);
+    refuseUnknownKeys(v, {"position", "target", "up", "yfov"}, src.file, src.place);
+    if (!v.contains("position") || !v.contains("target")) throw InputError(src.file, src.place, shape);
+    RenderSettings::LookAt c;
+    c.position = vec3(v["position"], src.file, src.place + ".position");
+    c.target = vec3(v["target"], src.file, src.place + ".target");
+    if (v.contains("up")) c.up = vec3(v["up"], src.file, src.place + ".up");
+    if (v.contains("yfov")) {
+        if (!v["yfov"].is_number() || !std::isfinite(v["yfov"].get<double>()))
+            throw InputError(src.file, src.place + ".yfov", "must be a number (radians)");
+        c.yfov = v["yfov"].get<float>();
+    }
+    s.camera = c;
+    s.cameraIndex.reset();
+}
+
+json getCamera(const RenderSettings& s) {
+    if (s.camera)
+        return {{"position", toJson(s.camera->position)}, {"target", toJson(s.camera->target)},
+                {"up", toJson(s.camera->up)}, {"yfov", s.camera->yfov}};
+    return s.cameraIndex ? json(*s.cameraIndex) : json(nullptr);
+}
+
+constexpr int64_t kInt32Max = std::numeric_limits<int32_t>::max();
+
+std::vector<RenderOption> declareOptions() {
+    using T = OptionType;
+    std::vector<RenderOption> o;
+    // Inputs
+    o.push_back({"scene", "SCENE", T::Text, 0, 0, "", {}, true, "", "from --config",
+                 "glTF 2.0 scene, .gltf (external or embedded buffers) or .glb", true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) { s.scenePath = resolved(v, src); },
+                 [](const RenderSettings& s) { return s.scenePath.empty() ? json(nullptr) : json(s.scenePath); }});
+    o.push_back({"animation", "--animation", T::Text, 0, 0, "", {}, true, "FILE|gltf|gltf:N", "none: one frame, 0",
+                 "a qsgi-animation transform file (docs/inputs.md); gltf plays every animation in the scene file at "
+                 "once, gltf:N its animation N (the file's content, not its path, enters the fingerprint)",
+                 false, false,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     const std::string a = v;
+                     s.animationPath = gltfAnimationSelector(a, src.file) ? a : resolved(a, src);
+                 },
+                 [](const RenderSettings& s) { return s.animationPath.empty() ? json(nullptr) : json(s.animationPath); }});
+    o.push_back({"fps", "--fps", T::Number, 0, 1e6, "", {}, true, "F", "24",
+                 "frames per second at which a glTF animation is sampled (glTF has no frame rate)", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.fps = v.get<double>(); },
+                 [](const RenderSettings& s) { return json(s.fps.value_or(kDefaultGltfFps)); }});
+    o.push_back({nullptr, "--config", T::Text, 0, 0, "", {}, true, "FILE", "",
+                 "a JSON config with these keys (configs/default.json); options on the command line override it", false,
+                 false, nullptr, nullptr});
+    // Estimation
+    o.push_back({"estimator", "--estimator", T::Choice, 0, 0, "", namesOf(kEstimatorNames), true, "", "impact-count",
+                 "the density estimator: impact-count (the paper's impact count), photon-map or detp (density estimation on the tangent plane; docs/method.md)", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.kind = choiceValue(kEstimatorNames, v); },
+                 [](const RenderSettings& s) { return json(estimatorName(s.estimator.kind)); }});
+    o.push_back({"radius", "--radius", T::Number, 0, 1e30, " (scene units)", {}, true, "R",
+                 "1.5 % of the animation's bounding-box diagonal",
+                 "DETP disc radius and photon-map search radius, scene units", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) {
+                     s.estimator.radius = v.get<float>();
+                     s.radiusGiven = true;
+                 },
+                 [](const RenderSettings& s) {
+                     return orNull(s.estimator.kind != EstimatorKind::ImpactCount, json(s.estimator.radius));
+                 }});
+    o.push_back({"k", "--k", T::Integer, 1, double(kMaxK), "", {}, true, "K", "50",
+                 "photon map: the nearest impacts per vertex", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.k = v.get<int>(); },
+                 [](const RenderSettings& s) { return orNull(s.estimator.kind == EstimatorKind::PhotonMap, json(s.estimator.k)); }});
+    o.push_back({"detp_boundary", "--detp-boundary", T::Choice, 0, 0, "", namesOf(kDetpBoundaryNames), true, "", "clip",
+                 "where a disc meets other geometry: clip (only the parts of the disc light can reach from the vertex's "
+                 "side count: no leaks through thin occluders), linear (clip plus a linear fit that removes the "
+                 "first-order bias at edges) or paper (the published rule, and the textbook photon map: for ablations)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) {
+                     s.estimator.boundary = choiceValue(kDetpBoundaryNames, v);
+                 },
+                 [](const RenderSettings& s) {
+                     return orNull(s.estimator.kind != EstimatorKind::ImpactCount, json(detpBoundaryName(s.estimator.boundary)));
+                 }});
+    o.push_back({"detp_index", "--detp-index", T::Choice, 0, 0, "", namesOf(kDetpIndexNames), true, "", "embree",
+                 "DETP's index: embree (exact) or flann (approximate candidates: it misses segments that cross a disc "
+                 "but land far away)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.detpIndex = choiceValue(kDetpIndexNames, v); },
+                 [](const RenderSettings& s) {
+                     return orNull(s.estimator.kind == EstimatorKind::Detp, json(nameOf(kDetpIndexNames, s.estimator.detpIndex)));
+                 }});
+    o.push_back({"ray_cache", "--no-ray-cache", T::Boolean, 0, 0, "", {}, false, "", "true",
+                 "no spatial index, every vertex against every segment or impact (the paper's \"No Ray Caché\"; "
+                 "slow, the reference)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.useIndex = v; },
+                 [](const RenderSettings& s) { return json(s.estimator.useIndex); }});
+    o.push_back({"sort_queries", "--no-sort-queries", T::Boolean, 0, 0, "", {}, false, "", "true",
+                 "queries in input order instead of Morton order", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.sortQueries = v; },
+                 [](const RenderSettings& s) { return json(s.estimator.sortQueries); }});
+    // Frames after the first
+    o.push_back({"full_recompute", "--full-recompute", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "compute every frame from scratch instead of updating the previous one (the same bytes; the "
+                 "baseline of the update's speed)",
+                 false, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.fullRecompute = v; },
+                 [](const RenderSettings& s) { return json(s.fullRecompute); }});
+    o.push_back({"always_update", "--always-update", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "update every frame after the first, even one whose change would cost more to update than to "
+                 "recompute (the same bytes; for measuring the update)",
+                 false, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.alwaysUpdate = v; },
+                 [](const RenderSettings& s) { return json(s.alwaysUpdate); }});
+    o.push_back({"envelope", "--no-envelope", T::Boolean, 0, 0, "", {}, false, "", "true",
+                 "track every light path instead of only those meeting the moving geometry's envelope (the same "
+                 "bytes; more memory and work per frame)",
+                 false, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.useEnvelope = v; },
+                 [](const RenderSettings& s) { return json(s.useEnvelope); }});
+    o.push_back({"blocking_grid", nullptr, T::Boolean, 0, 0, "", {}, true, "", "true",
+                 "test every tracked segment against the moved geometry instead of those the grid finds (the "
+                 "same bytes; for measuring the grid)",
+                 false, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.blockingGrid = v; },
+                 [](const RenderSettings& s) { return json(s.blockingGrid); }});
+    // Photons
+    o.push_back({"photons", "--photons", T::Integer, 1, double(kMaxPhotons), " (2^32: the path index is 32 bits)", {},
+                 true, "N", "1000000", "photons traced per frame", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     s.photons = checkedPhotons(v.get<int64_t>(), src.file, src.place);
+                 },
+                 [](const RenderSettings& s) { return json(s.photons); }});
+    o.push_back({"seed", "--seed", T::Integer, 0, double(kMaxSeed), "", {}, true, "S", "1",
+                 "the random seed: the same inputs and seed give the same bytes for any thread count", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.seed = v.get<uint64_t>(); },
+                 [](const RenderSettings& s) { return json(s.seed); }});
+    o.push_back({"max_bounces", "--max-bounces", T::Integer, 1, double(kMaxBounces),
+                 " (the bounce field of a segment is 16 bits)", {}, true, "B", "32",
+                 "the most scatterings a photon's path may have (Russian roulette ends most paths long before)", true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.maxBounces = v.get<uint32_t>(); },
+                 [](const RenderSettings& s) { return json(s.maxBounces); }});
+    o.push_back({"sampler", "--sampler", T::Choice, 0, 0, "", namesOf(kSamplerNames), true, "", "sobol",
+                 "where each photon's numbers come from: sobol (an Owen-scrambled Sobol point per photon, each light its "
+                 "own sequence; docs/photons-and-radius.md) or random (hashed, independent: the paper's kind)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.sampling.kind = choiceValue(kSamplerNames, v); },
+                 [](const RenderSettings& s) { return json(samplerName(s.sampling.kind)); }});
+    o.push_back({"qmc_bounces", "--qmc-bounces", T::Integer, 0, double(kMaxQmcBounces),
+                 " (the Sobol table covers that many scatterings)", {}, true, "K", "2",
+                 "sobol only: the first K scatterings take their survival and direction from the Sobol point too (at "
+                 "most max_bounces); later ones are hashed",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) {
+                     s.sampling.qmcBounces = v.get<uint32_t>();
+                     s.qmcBouncesGiven = true;
+                 },
+                 // The K that shapes the bytes: none under random, capped at max_bounces.
+                 [](const RenderSettings& s) {
+                     return orNull(s.sampling.kind == SamplerKind::Sobol, json(effectiveSampling(s).qmcBounces));
+                 }});
+    // Running
+    o.push_back({"threads", "--threads", T::Integer, 0, double(kMaxThreads), " (0: all cores)", {}, true, "T", "0",
+                 "worker threads, 0 = all cores (any count gives the same bytes)", false, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.threads = v.get<int>(); },
+                 [](const RenderSettings& s) { return json(s.threads); }});
+    o.push_back({"frames", "--frames", T::Text, 0, 0, "", {}, true, "A:B", "all",
+                 "frames A to B, inclusive at both ends (0:0 is frame 0 alone)", false, false,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     s.frames = parseFrameRange(v, src.file);
+                     s.framesSource = src.file;
+                 },
+                 [](const RenderSettings& s) {
+                     return s.frames ? json(std::to_string(s.frames->first) + ":" + std::to_string(s.frames->last)) : json(nullptr);
+                 }});
+    o.push_back({"out", "--out", T::Text, 0, 0, "", {}, true, "DIR", "out",
+                 "the output folder, created (relative to the working directory, also in a config)", false, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.outDir = v; },
+                 [](const RenderSettings& s) { return json(s.outDir); }});
+    o.push_back({nullptr, "--resume", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "continue the output folder after its last complete frame (the same inputs and fingerprinted settings "
+                 "only)",
+                 false, false, [](RenderSettings& s, const json& v, const OptionSource&) { s.resume = v; },
+                 [](const RenderSettings& s) { return json(s.resume); }});
+    // Lights added to the scene
+    o.push_back({"lights", nullptr, T::Object, 0, 0, "", {}, true, "", "none",
+                 "lights added to any scene: [{\"type\": \"point\", \"position\": [x,y,z], \"intensity\": [r,g,b] (W/sr)} "
+                 "or {\"type\": \"directional\", \"direction\": [x,y,z], \"irradiance\": [r,g,b] (W/m^2)}], world space",
+                 true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     if (!v.is_array()) throw InputError(src.file, src.place, "must be an array of lights");
+                     for (size_t i = 0; i < v.size(); ++i)
+                         s.extraLights.push_back(parseLight(v[i], src.file, src.place + "[" + std::to_string(i) + "]"));
+                 },
+                 [](const RenderSettings& s) {
+                     if (s.extraLights.empty()) return json(nullptr);
+                     json list = json::array();
+                     for (const PunctualLight& l : s.extraLights) list.push_back(lightJson(l));
+                     return list;
+                 }});
+    // Images
+    o.push_back({"width", "--width", T::Integer, 1, double(kMaxImageSide), "", {}, true, "W", "640",
+                 "image width in pixels", true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.width = v.get<int>(); },
+                 [](const RenderSettings& s) { return json(s.width); }});
+    o.push_back({"height", "--height", T::Integer, 1, double(kMaxImageSide), "", {}, true, "H", "480",
+                 "image height in pixels", true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.height = v.get<int>(); },
+                 [](const RenderSettings& s) { return json(s.height); }});
+    o.push_back({"spp", "--spp", T::Integer, 1, double(kMaxSamplesPerPixel), "", {}, true, "N", "1",
+                 "primary rays per pixel (1: the pixel centre; more: jittered, the same every run)", true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.samplesPerPixel = v.get<int>(); },
+                 [](const RenderSettings& s) { return json(s.samplesPerPixel); }});
+    o.push_back({"camera", "--camera", T::Object, 0, 0, "", {}, true, "I", "the first camera node",
+                 "a glTF camera index; in a config also {\"position\": [x,y,z], \"target\": [x,y,z], \"up\": [0,1,0], "
+                 "\"yfov\": 0.8} in world space, radians",
+                 true, false, setCamera, getCamera});
+    o.push_back({"exr", "--no-exr", T::Boolean, 0, 0, "", {}, false, "", "true", "write no frame_NNNN.exr", true,
+                 false, [](RenderSettings& s, const json& v, const OptionSource&) { s.writeExr = v; },
+                 [](const RenderSettings& s) { return json(s.writeExr); }});
+    o.push_back({"exr_half", "--exr-half", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "EXR pixels as half floats instead of float", true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.exrHalf = v; },
+                 [](const RenderSettings& s) { return json(s.exrHalf); }});
+    o.push_back({"png", "--png", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "also write an 8-bit sRGB preview frame_NNNN.png (on in configs/default.json)", true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.writePng = v; },
+                 [](const RenderSettings& s) { return json(s.writePng); }});
+    o.push_back({"gltf_out", "--gltf-out", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "also write frame_NNNN.glb: the posed geometry with COLOR_0 = radiosity/pi on an unlit material "
+                 "(irradiance in _IRRADIANCE), for glTF viewers",
+                 true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.writeGltf = v; },
+                 [](const RenderSettings& s) { return json(s.writeGltf); }});
+    o.push_back({"exposure", "--exposure", T::Number, 0, 1e30, "", {}, true, "X",
+                 "automatic: the 99th-percentile luminance of the first frame becomes 0.8",
+                 "the PNG preview's exposure multiplier", true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.exposure = v.get<float>(); },
+                 [](const RenderSettings& s) { return s.exposure ? json(*s.exposure) : json(nullptr); }});
+    // Messages
+    o.push_back({nullptr, "--quiet", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "print nothing but errors (no progress line, no summary, no warnings)", false, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.quiet = v; },
+                 [](const RenderSettings& s) { return json(s.quiet); }});
+    o.push_back({nullptr, "--verbose", T::Boolean, 0, 0, "", {}, true, "", "false", "print each frame's time", false,
+                 false, [](RenderSettings& s, const json& v, const OptionSource&) { s.verbose = v; },
+                 [](const RenderSettings& s) { return json(s.verbose); }});
+    return o;
+}
+
+std::string numberText(double value) {
+    char text[40];
+    if (std::fabs(value) < 1e15 && std::floor(value) == value) std::snprintf(text, sizeof text, "%.0f", value);
+    else std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
+// An integer in [lo, hi], also when written as 1e6 (a float with no fraction); never wrapped.
+int64_t checkedOptionInteger(const RenderOption& o, const json& v, const OptionSource& src) {
+    const int64_t lo = int64_t(o.min), hi = o.max >= 9.2e18 ? INT64_MAX : int64_t(o.max);
+    const std::string range = " is outside " + numberText(o.min) + ".." + (hi == INT64_MAX ? std::to_string(hi) : numberText(o.max)) + o.rangeNote;
+    if (v.is_number_unsigned()) {
+        const uint64_t u = v.get<uint64_t>();
+        if (u > uint64_t(hi)) throw InputError(src.file, src.place, std::to_string(u) + range);
+        return checkedInteger(int64_t(u), lo, hi, src.file, src.place, o.rangeNote);
+    }
+    if (v.is_number_integer()) return checkedInteger(v.get<int64_t>(), lo, hi, src.file, src.place, o.rangeNote);
+    if (v.is_number_float()) {
+        const double d = v.get<double>();
+        if (std::isfinite(d) && std::floor(d) == d) {
+            if (d < o.min || d > o.max) throw InputError(src.file, src.place, numberText(d) + range);
+            return checkedInteger(int64_t(d), lo, hi, src.file, src.place, o.rangeNote);
+        }
+    }
+    throw InputError(src.file, src.place, "must be an integer");
+}
+
+}  // namespace
+
+const std::vector<RenderOption>& renderOptions() {
+    static const std::vector<RenderOption> options = declareOptions();
+    return options;
+}
+
+const RenderOption* optionWithKey(const std::string& key) {
+    for (const RenderOption& o : renderOptions())
+        if (o.key && key == o.key) return &o;
+    return nullptr;
+}
+
+void applyOption(const RenderOption& o, const json& v, const OptionSource& src, RenderSettings& s) {
+    switch (o.type) {
+        case OptionType::Integer: o.set(s, json(checkedOptionInteger(o, v, src)), src); return;
+        case OptionType::Number: {
+            const std::string wanted = "must be a positive number, at most " + numberText(o.max) + o.rangeNote;
+            if (!v.is_number()) throw InputError(src.file, src.place, wanted);
+            const double d = v.get<double>();
+            if (!(d > o.min && d <= o.max)) throw InputError(src.file, src.place, numberText(d) + ": " + wanted);
+            o.set(s, json(d), src);
+            return;
+        }
+        case OptionType::Boolean:
+            if (!v.is_boolean()) throw InputError(src.file, src.place, "must be true or false");
+            o.set(s, v, src);
+            return;
+        case OptionType::Choice: {
+            const std::string name = v.is_string() ? v.get<std::string>() : v.dump();
+            std::string list;
+            for (const std::string& c : o.choices) list += (list.empty() ? "" : ", ") + c;
+            if (!v.is_string() || std::find(o.choices.begin(), o.choices.end(), name) == o.choices.end())
+                throw InputError(src.file, src.place, "unknown " + std::string(o.key) + " '" + name + "'" +
+                                                          didYouMean(name, o.choices) + " (available: " + list + ")");
+            o.set(s, v, src);
+            return;
+        }
+        case OptionType::Text:
+            if (!v.is_string()) throw InputError(src.file, src.place, "must be a string");
+            o.set(s, v, src);
+            return;
+        case OptionType::Object: o.set(s, v, src); return;
+    }
+}
+
+void applyCommandLineOption(const RenderOption& o, const std::string& text, RenderSettings& s) {
+    const OptionSource src{"command line", o.flag, {}};
+    json value = text;
+    if (o.type == OptionType::Integer || o.type == OptionType::Number || o.type == OptionType::Object) {
+        // A number as JSON writes it ("1e6" too); anything else is refused by the same check as a config's.
+        value = json::parse(text, nullptr, false);
+        if (value.is_discarded() || !value.is_number()) value = text;
+    }
+    if (o.type == OptionType::Boolean) value = o.flagSets;
+    applyOption(o, value, src, s);
+}
+
+json optionValues(const RenderSettings& s, OptionSelection selection) {
+    json values = json::object();
+    for (const RenderOption& o : renderOptions()) {
+        if (!o.key || !o.get) continue;
+        if (selection == OptionSelection::Fingerprinted && !o.fingerprinted) continue;
+        if (selection == OptionSelection::Logged && !o.logged) continue;
+        values[o.key] = o.get(s);
+    }
+    return values;
+}
+
+json optionsDescription() {
+    static const char* typeNames[] = {"integer", "number", "boolean", "choice", "text", "object"};
+    json list = json::array();
+    for (const RenderOption& o : renderOptions()) {
+        json entry = {{"key", o.key ? json(o.key) : json(nullptr)}, {"flag", o.flag ? json(o.flag) : json(nullptr)},
+                      {"type", typeNames[int(o.type)]}, {"default", o.defaultText}, {"help", o.help},
+                      {"fingerprint", o.fingerprinted}, {"timing_log", o.logged}};
+        if (o.type == OptionType::Integer || o.type == OptionType::Number) entry["range"] = {o.min, o.max};
+        if (o.type == OptionType::Choice) entry["choices"] = o.choices;
+        if (o.type == OptionType::Boolean && o.flag) entry["flag_sets"] = o.flagSets;
+        list.push_back(entry);
+    }
+    return list;
+}
+
+std::string optionsMarkdownTable() {
+    auto escaped = [](std::string text) {
+        for (size_t i = 0; (i = text.find('|', i)) != std::string::npos; i += 2) text.replace(i, 1, "\\|");
+        return text;
+    };
+    std::string table = "| command line | config key | meaning | default | fingerprint | timing.json |\n"
+                        "|---|---|---|---|---|---|\n";
+    for (const RenderOption& o : renderOptions()) {
+        std::string flag = o.flag ? std::string(o.flag) : "";
+        if (o.flag && *o.metavar) flag += " " + std::string(o.metavar);
+        if (o.type == OptionType::Choice && o.flag) {
+            std::string list;
+            for (const std::string& c : o.choices) list += (list.empty() ? "" : "|") + c;
+            flag += " " + list;
+        }
+        std::string meaning = o.help;
+        if (o.type == OptionType::Boolean && o.key && o.flag && !o.flagSets)
+            meaning = "false (the flag): " + meaning;
+        else if (o.type == OptionType::Boolean && o.key && !o.flag)
+            meaning = "false: " + meaning;
+        if (o.type == OptionType::Integer && o.max > o.min)
+            meaning += " (" + numberText(o.min) + "…" + (o.max >= 9.2e18 ? std::string("2^63-1") : numberText(o.max)) + ")";
+        table += "| " + (flag.empty() ? "—" : "`" + escaped(flag) + "`") + " | " +
+                 (o.key ? "`" + std::string(o.key) + "`" : "—") + " | " + escaped(meaning) + " | " +
+                 (*o.defaultText ? escaped(o.defaultText) : "—") + " | " + (o.fingerprinted ? "yes" : "") + " | " +
+                 (o.logged ? "yes" : "") + " |\n";
+    }
+    return table;
+}
+
+}  // namespace qsgi
