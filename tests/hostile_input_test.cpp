@@ -113,3 +113,28 @@ TEST(HostileInput, ValidEdgeCasesLoadWithTheGeometryTheyHold) {
         }
     }
 }
+
+// Issue 23: what a file cannot say. A folder given as a transform file, and a request beyond
+// what this process may use although the machine has it (ulimit -v; a container's or a Slurm
+// job's control group is read the same way, usableMemory in lib/util/memory.cpp).
+TEST(HostileInput, AFolderAsATransformFileIsRefusedByName) {
+    const std::string base = (dataDir() / "good" / "base.gltf").string();
+    const CommandResult r = runQsgi("render " + base + " --animation " + dataDir().string() + " --photons 1000 --out " +
+                                    (fs::path(testScratchDir("hostile-folder")) / "out").string());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("is a directory"), std::string::npos) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+}
+
+TEST(HostileInput, MemoryBeyondTheProcesssLimitIsRefusedNamingTheLimit) {
+    if (kSanitized) GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space, so ulimit -v cannot apply";
+    const std::string base = (dataDir() / "good" / "base.gltf").string();
+    // 400 million photons need at least 4.8 GB of ray cache: within this machine's memory, not
+    // within a 3 GiB address space.
+    const CommandResult r = runCommand("ulimit -v 3145728 && " + std::string(QSGI_CLI) + " render " + base +
+                                       " --photons 400000000 --out " +
+                                       (fs::path(testScratchDir("hostile-ulimit")) / "out").string());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("ulimit -v"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--photons"), std::string::npos) << r.output;
+}

@@ -99,6 +99,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     scene_.setRestPose(animation_.poseAt(0));
     scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
+    checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
     if (!settings_.animationPath.empty())
         checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");
 

@@ -377,7 +377,9 @@ void applyOption(const RenderOption& o, const json& v, const OptionSource& src, 
             const std::string wanted = "must be a positive number, at most " + numberText(o.max) + o.rangeNote;
             if (!v.is_number()) throw InputError(src.file, src.place, wanted);
             const double d = v.get<double>();
-            if (!(d > o.min && d <= o.max)) throw InputError(src.file, src.place, numberText(d) + ": " + wanted);
+            if (!(d > o.min && d <= o.max))
+                throw InputError(src.file, src.place,
+                                 numberText(d) + " is not a positive number at most " + numberText(o.max) + o.rangeNote);
             o.set(s, json(d), src);
             return;
         }

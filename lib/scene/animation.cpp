@@ -78,8 +78,7 @@ Transform parseNodeTransform(const json& j, const std::string& file, const std::
         }
         t = Transform::fromTRS(tr, rot, sc);
     }
-    const double det = t.determinant3x3();
-    if (!(std::fabs(det) > 1e-12) || !t.isFinite()) throw InputError(file, place, "transform is not invertible");
+    if (!t.isInvertible()) throw InputError(file, place, "transform is not invertible");
     return t;
 }
 
@@ -203,7 +202,7 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
         const Pose p = a.poseAt(frame);
         for (int node : a.sampled_->animated) {
             const Transform& t = p.locals[size_t(node)];
-            if (!t.isFinite() || !(std::fabs(t.determinant3x3()) > 1e-12))
+            if (!t.isInvertible())
                 throw InputError(source, "frame " + std::to_string(frame) + " (" + std::to_string(frame / fps) +
                                              " s), node '" + scene.nodes[node].name + "'",
                                  "the animated transform is not invertible (a zero scale?), which qsgi cannot light");

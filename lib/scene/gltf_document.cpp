@@ -8,6 +8,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "util/json_file.h"
+
 namespace qsgi {
 namespace {
 
@@ -157,6 +159,8 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     GlbLayout glb;
     if (binary) glb = readGlbLayout(path, bytes);
     const std::string& jsonText = binary ? glb.jsonText : bytes;
+    // Before any parser: tinygltf copies extras recursively and would overflow the stack.
+    refuseDeepNesting(jsonText, path, binary ? 20 : 0);
 
     json doc;
     try {

@@ -2,6 +2,7 @@
 
 #include "util/error.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <functional>
 #include <limits>
@@ -38,6 +39,51 @@ void checkSceneExtent(const std::vector<Vec3f>& positions, const Bounds3f& bound
         throw InputError(file, place, std::string("the scene spans ") + spans + " units; qsgi supports up to 1e15 "
                                       "(beyond that float areas overflow)");
     }
+}
+
+void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, const std::string& configFile) {
+    constexpr double kPi = 3.14159265358979323846;
+    auto text = [](double value) {
+        char out[32];
+        std::snprintf(out, sizeof out, "%.3g", value);
+        return std::string(out);
+    };
+    std::string file = sceneFile;
+    auto refuse = [&](const std::string& place, double watts) {
+        throw InputError(file, place, "carries " + text(watts) + " W, beyond the " + text(kMaxLightPower) +
+                                          " W qsgi carries in float photon powers (scale the light's units down)");
+    };
+    const Bounds3f& bounds = scene.animationBounds;
+    const double sceneRadius = 0.5 * length(Vec3d(bounds.diagonal()));
+    double total = 0;
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        const PunctualLight& l = scene.lights[i];
+        const std::string place = l.name.empty() ? "lights[" + std::to_string(i) + "]" : l.name;
+        file = l.node < 0 && !configFile.empty() ? configFile : sceneFile;
+        const double strongest = std::max({double(l.intensity.x), double(l.intensity.y), double(l.intensity.z)});
+        // Point and spot: 4 pi I at most; directional: the irradiance over the scene's cross-section.
+        const double watts = l.type == LightType::Directional ? strongest * kPi * sceneRadius * sceneRadius : 4 * kPi * strongest;
+        if (!(watts <= kMaxLightPower)) refuse(place, watts);
+        total += watts;
+        if (l.type != LightType::Directional) {
+            const Vec3d p(l.position), lo(bounds.lower), hi(bounds.upper);
+            const Vec3d outside(std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+                                std::max({lo.z - p.z, 0.0, p.z - hi.z}));
+            const double distance = length(outside);
+            if (!(distance <= kMaxSceneExtent))
+                throw InputError(file, place, "lies " + text(distance) + " units from the scene; qsgi supports scenes "
+                                              "(their lights included) spanning up to 1e15 units");
+        }
+    }
+    file = sceneFile;
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
+        const Material& m = scene.materials[scene.triangleMaterial[t]];
+        if (!m.isEmissive()) continue;
+        const double watts = kPi * double(maxComponent(m.emission)) * double(scene.triangleArea(t));
+        if (!(watts <= kMaxLightPower)) refuse("materials: " + m.name, watts);
+        total += watts;
+    }
+    if (!(total <= kMaxLightPower)) refuse("its lights together", total);
 }
 
 Vec3f Scene::geometricNormal(uint32_t tri) const {

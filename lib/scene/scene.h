@@ -200,4 +200,12 @@ struct Scene {
                        const std::vector<double>& weights);
 };
 
+// The most power qsgi carries, in watts: photon powers are floats, and a light's power times the
+// scene's emitters and scatterings must stay far below float's 3.4e38.
+constexpr double kMaxLightPower = 1e30;
+// Throws InputError when a light or emitter carries more than kMaxLightPower (the total too), or a
+// point or spot light lies farther from the animation's bounds than kMaxSceneExtent. Messages name
+// sceneFile, or configFile for a light the config added (node -1). Needs animationBounds.
+void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, const std::string& configFile);
+
 }  // namespace qsgi

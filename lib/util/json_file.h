@@ -9,7 +9,17 @@
 
 namespace qsgi {
 
+// A JSON file of qsgi's own (a config, a transform file). Besides syntax it refuses a key given
+// twice in one object (JSON readers silently keep one of them) and nesting deeper than
+// kMaxJsonDepth; a directory or an unreadable file is refused by name.
 nlohmann::json readJsonFile(const std::string& path);
+
+// Nesting deeper than this is refused before any parser sees it: recursive readers (tinygltf's
+// copy of extras) overflow the stack around 10^4–10^5 levels, and no scene needs more than a few.
+constexpr size_t kMaxJsonDepth = 256;
+// Throws InputError(path, "byte N", …) at the first bracket nested deeper than kMaxJsonDepth;
+// `byteOffset` is added to N (the JSON chunk's place in a GLB).
+void refuseDeepNesting(const std::string& text, const std::string& path, size_t byteOffset = 0);
 
 // Throws InputError(file, place.key, "unknown key (did you mean …?)") for a key of the object `j`
 // that is not in `known`. Keys starting with "_", and "comment", are notes for people.

@@ -11,11 +11,20 @@ namespace qsgi {
 // Physical memory of the machine, in bytes (sysconf); a large fallback if it cannot be read.
 uint64_t physicalMemoryBytes();
 
+// The memory this process may use: the least of the machine's memory, the address-space and data
+// limits (ulimit -v, ulimit -d) and the memory limit of its control group (a container's, a Slurm
+// job's), with the name of the one that binds ("this machine has", "ulimit -v allows", …).
+struct MemoryLimit {
+    uint64_t bytes;
+    std::string source;
+};
+MemoryLimit usableMemory();
+
 // "48.0 GiB", "512 MiB", "12 KiB", "100 B".
 std::string formatBytes(uint64_t bytes);
 
-// Throws InputError(file, place, "<what> would need X, more than the Y of memory this machine
-// has") when bytes exceeds the machine's physical memory.
+// Throws InputError(file, place, "<what> would need X, more than the Y of memory <source>") when
+// bytes exceeds usableMemory().
 void refuseBeyondMemory(uint64_t bytes, const std::string& file, const std::string& place, const std::string& what);
 
 // a*b, saturating at UINT64_MAX instead of wrapping.

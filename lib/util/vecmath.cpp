@@ -78,6 +78,13 @@ double Transform::determinant3x3() const {
            at(0, 2) * (at(1, 0) * at(2, 1) - at(1, 1) * at(2, 0));
 }
 
+bool Transform::isInvertible() const {
+    if (!isFinite()) return false;
+    double columns = 1;
+    for (int c = 0; c < 3; ++c) columns *= std::sqrt(at(0, c) * at(0, c) + at(1, c) * at(1, c) + at(2, c) * at(2, c));
+    return columns > 0 && std::fabs(determinant3x3()) > 1e-9 * columns;
+}
+
 Transform Transform::normalMatrix() const {
     // inverse-transpose of the 3x3 = cofactor matrix / det
     const double det = determinant3x3();

@@ -129,6 +129,10 @@ struct Transform {
     Vec3d applyPoint(const Vec3d& p) const;
     Vec3d applyVector(const Vec3d& v) const;
     double determinant3x3() const;
+    // Finite, and its 3x3 not degenerate relative to its own scale: |det| against the product of
+    // its column lengths (1 for any rotation times any scale, 0 for a flattened one), so a scale
+    // of 1e-5 is as invertible as a scale of 1.
+    bool isInvertible() const;
     // The inverse-transpose of the upper 3x3, for normals. Requires an invertible transform.
     Transform normalMatrix() const;
     bool isFinite() const;

@@ -344,6 +344,8 @@ bad("animation", "translation_overflows_float.json",
 bad("animation", "scene_spans_too_far.json",
     anim([{"frame": 0}, {"frame": 1, "nodes": {"Floor": {"translation": [1e20, 0, 0]}}}]), "supports up to 1e15")
 bad("animation", "not_json.json", "frames: [0, 1, 2]", "not valid JSON")
+bad("animation", "key_twice.json", '{"format": "qsgi-animation", "version": 1, "frames": [{"frame": 0}], '
+    '"frames": [{"frame": 1}]}', "given twice", "frames")
 bad("animation", "top_level_array.json", [anim([{"frame": 0}])], "JSON object")
 bad("animation", "number_overflow.json", '{"format":"qsgi-animation","version":1,"frames":[{"frame":0,'
     '"nodes":{"Floor":{"translation":[0,1e999,0]}}}]}', "JSON")
@@ -383,6 +385,18 @@ config("spp_huge.json", {"spp": 10**6}, "spp")
 config("scene_missing.json", {"scene": "no-such-scene.gltf"}, "no such file", "no-such-scene.gltf")
 config("not_an_object.json", [1, 2, 3], "JSON object")
 config("boolean_as_string.json", {"png": "yes"}, "true or false")
+# Issue 23: found by a hostile set of files.
+config("key_twice.json", '{"scene": "../../good/base.gltf", "photons": 1000, "photons": 2000}', "given twice", "photons")
+config("nested_too_deep.json", '{"scene": "../../good/base.gltf", "_note": ' + "[" * 100000 + "]" * 100000 + "}",
+       "nested deeper than 256")
+config("radius_beyond_float.json", {"radius": 1e300}, "1e+300 is not a positive number")
+config("photons_beyond_int64.json", {"photons": 1e20}, "1e+20 is outside 1..4294967296")
+config("light_far_away.json", {"lights": [{"type": "point", "position": [1e20, 0, 0], "intensity": [1, 1, 1]}]},
+       "units from the scene", "lights[0]")
+config("light_overflowing_power.json",
+       {"lights": [{"type": "point", "position": [0, 2, 0], "intensity": [3e38, 3e38, 3e38]}]}, "W qsgi carries", "lights[0]")
+bad("gltf", "extras_nested_too_deep.gltf",
+    json.dumps(scene())[:-1] + ', "extras": ' + "[" * 100000 + "]" * 100000 + "}", "nested deeper than 256")
 
 with open(os.path.join(HERE, "bad", "generated.tsv"), "w") as f:
     f.write("# kind\tfile (relative to tests/data)\twords the error message must contain\tfile it names\n")
