@@ -3,11 +3,14 @@
 // and nothing written; every valid edge case in tests/data/good/ loads with the geometry it holds.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 
+#include "scene/animation.h"
 #include "scene/gltf_loader.h"
 #include "test_support.h"
 
@@ -137,4 +140,50 @@ TEST(HostileInput, MemoryBeyondTheProcesssLimitIsRefusedNamingTheLimit) {
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("ulimit -v"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("--photons"), std::string::npos) << r.output;
+}
+
+// Hierarchies and transform files of any length load in linear time and without recursion
+// (issue 23: a chain of 150,000 nodes ran past a minute, growing with the square of its depth,
+// and so did a transform file of 150,000 frames). A deep chain would overflow the stack if any
+// step recursed; the times are the benchmark's business (the note reports them), this checks
+// that the scene and the animation are what the files say.
+TEST(HostileInput, ADeepChainOfNodesAndALongTransformFileLoadAsTheySay) {
+    const int depth = kSanitized ? 20000 : 100000;  // a recursive step would need megabytes of stack
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(dataDir() / "good" / "base.gltf"));
+    nlohmann::json& nodes = doc["nodes"];
+    const nlohmann::json floor = nodes[0];
+    // nodes[0] becomes the root of the chain; each link moves 1e-6 up; the floor hangs from the last.
+    nodes[0] = {{"name", "Link0"}, {"translation", {0, 1e-6, 0}}, {"children", {2}}};
+    for (int i = 1; i < depth; ++i)
+        nodes.push_back({{"name", "Link" + std::to_string(i)}, {"translation", {0, 1e-6, 0}}, {"children", {i + 2}}});
+    nodes.push_back(floor);
+    const fs::path dir = testScratchDir("hostile-chain");
+    const fs::path scenePath = dir / "chain.gltf";
+    std::ofstream(scenePath) << doc.dump();
+    // Copy the buffers the file names beside it.
+    for (const auto& buffer : doc["buffers"])
+        if (buffer.contains("uri") && buffer["uri"].get<std::string>().rfind("data:", 0) != 0)
+            fs::copy_file(dataDir() / "good" / buffer["uri"].get<std::string>(), dir / buffer["uri"].get<std::string>(),
+                          fs::copy_options::overwrite_existing);
+    Warnings warnings;
+    const Scene scene = loadGltfScene(scenePath.string(), warnings);
+    ASSERT_EQ(scene.nodes.size(), size_t(depth) + 2);
+    ASSERT_EQ(scene.positions.size(), 4u);
+    // Every link lifted the floor by 1e-6: the world transform composed all of them.
+    const Vec3d corner = Vec3d(scene.positions[0]) + scene.worldOrigin;
+    EXPECT_NEAR(corner.y, depth * 1e-6, 1e-9 * depth);
+
+    // A transform file keying the floor at every frame, by its name; every frame holds its own key.
+    const int frames = kSanitized ? 10000 : 50000;
+    nlohmann::json animation = {{"format", "qsgi-animation"}, {"version", 1}, {"frames", nlohmann::json::array()}};
+    for (int f = 0; f < frames; ++f)
+        animation["frames"].push_back({{"frame", f}, {"nodes", {{"Floor", {{"translation", {0, 1e-3 * (f % 7), 0}}}}}}});
+    const fs::path animationPath = dir / "long.json";
+    std::ofstream(animationPath) << animation.dump();
+    const Scene base = loadGltfScene((dataDir() / "good" / "base.gltf").string(), warnings);
+    const Animation a = Animation::fromTransformFile(animationPath.string(), base);
+    ASSERT_EQ(a.lastFrame(), frames - 1);
+    ASSERT_EQ(a.movedNodes(), std::vector<int>{0});
+    for (int f : {0, 1, 6, 7, frames / 2, frames - 1})
+        EXPECT_DOUBLE_EQ(a.localsAt(f)[0].at(1, 3), 1e-3 * (f % 7)) << "frame " << f;
 }

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <unordered_map>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -24,7 +25,9 @@ Animation Animation::still(const Scene& scene) {
 
 namespace {
 
-int findNode(const Scene& scene, const std::string& name) {
+// A node by "#index" or by name (the first node of that name), through a map built once: a file
+// naming many nodes of a large scene costs a lookup each, not a scan of every node.
+int findNode(const Scene& scene, const std::unordered_map<std::string, int>& byName, const std::string& name) {
     if (!name.empty() && name[0] == '#') {
         const std::string digits = name.substr(1);
         if (!digits.empty() && digits.find_first_not_of("0123456789") == std::string::npos && digits.size() < 10) {
@@ -33,9 +36,8 @@ int findNode(const Scene& scene, const std::string& name) {
         }
         return -1;
     }
-    for (size_t i = 0; i < scene.nodes.size(); ++i)
-        if (scene.nodes[i].name == name) return int(i);
-    return -1;
+    const auto it = byName.find(name);
+    return it == byName.end() ? -1 : it->second;
 }
 
 std::vector<double> numbers(const json& j, size_t count, const std::string& file, const std::string& place) {
@@ -108,7 +110,10 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
     if (!doc.contains("frames") || !doc["frames"].is_array() || doc["frames"].empty())
         throw InputError(path, "frames", "must be a non-empty array");
 
+    std::unordered_map<std::string, int> byName;
+    for (size_t i = scene.nodes.size(); i-- > 0;) byName[scene.nodes[i].name] = int(i);  // the first of a name wins
     int previousFrame = -1;
+    std::vector<Key> keys;
     for (size_t i = 0; i < doc["frames"].size(); ++i) {
         const json& f = doc["frames"][i];
         std::string place = "frames[" + std::to_string(i) + "]";
@@ -126,7 +131,7 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
         if (f.contains("nodes")) {
             if (!f["nodes"].is_object()) throw InputError(path, place + ".nodes", "must be an object keyed by node name");
             for (auto it = f["nodes"].begin(); it != f["nodes"].end(); ++it) {
-                const int node = findNode(scene, it.key());
+                const int node = findNode(scene, byName, it.key());
                 if (node < 0) {
                     std::vector<std::string> names;
                     for (const SceneNode& n : scene.nodes) names.push_back(n.name);
@@ -136,10 +141,18 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
                 key.nodes.emplace_back(node, parseNodeTransform(it.value(), path, place + ", node '" + it.key() + "'"));
             }
         }
-        a.keys_.push_back(std::move(key));
+        // A node named twice in one frame (by its name and by #index) would have two transforms.
+        std::vector<int> named;
+        for (const auto& [node, transform] : key.nodes) named.push_back(node);
+        std::sort(named.begin(), named.end());
+        const auto twice = std::adjacent_find(named.begin(), named.end());
+        if (twice != named.end())
+            throw InputError(path, place, "names node " + std::to_string(*twice) + " ('" + scene.nodes[size_t(*twice)].name +
+                                              "') twice (by its name and by #index?)");
+        keys.push_back(std::move(key));
     }
     a.lastFrame_ = previousFrame;
-    a.findMovedNodes();
+    a.indexKeys(keys);
     return a;
 }
 
@@ -216,14 +229,25 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
     return a;
 }
 
-void Animation::findMovedNodes() {
-    // Transform files: between keys nothing changes, so a node moves iff some key gives it
-    // another transform than it has at frame 0.
+void Animation::indexKeys(const std::vector<Key>& keys) {
+    std::vector<int> trackOf(rest_.size(), -1);
+    for (const Key& k : keys)
+        for (const auto& [node, t] : k.nodes) {
+            if (trackOf[size_t(node)] < 0) {
+                trackOf[size_t(node)] = int(tracks_.size());
+                tracks_.push_back({node, {}, {}});
+            }
+            NodeTrack& track = tracks_[size_t(trackOf[size_t(node)])];
+            track.frames.push_back(k.frame);
+            track.transforms.push_back(t);
+        }
+    // Between keys nothing changes, so a node moves iff some key gives it another transform than
+    // it has at frame 0.
     const std::vector<Transform> first = localsAt(0);
     std::set<int> moved;
-    for (const Key& k : keys_)
-        for (const auto& [node, t] : k.nodes)
-            if (!(t == first[node])) moved.insert(node);
+    for (const NodeTrack& track : tracks_)
+        for (const Transform& t : track.transforms)
+            if (!(t == first[size_t(track.node)])) moved.insert(track.node);
     moved_.assign(moved.begin(), moved.end());
 }
 
@@ -251,9 +275,9 @@ std::vector<Transform> Animation::localsAt(int frame) const {
         for (int node : sampled_->animated) locals[size_t(node)] = trs[size_t(node)].matrix();
         return locals;
     }
-    for (const Key& k : keys_) {
-        if (k.frame > frame) break;
-        for (const auto& [node, t] : k.nodes) locals[node] = t;
+    for (const NodeTrack& track : tracks_) {
+        const auto after = std::upper_bound(track.frames.begin(), track.frames.end(), frame);
+        if (after != track.frames.begin()) locals[size_t(track.node)] = track.transforms[size_t(after - track.frames.begin() - 1)];
     }
     return locals;
 }

@@ -57,10 +57,17 @@ private:
         std::vector<NodeTrs> restTrs;  // per node: what channels do not drive
         std::vector<int> animated;     // nodes with a translation, rotation or scale channel
     };
-    void findMovedNodes();  // transform files (fromGltf finds them in its own scan of every frame)
+    // A transform file's keys of one node, frames increasing: localsAt finds the one in force by
+    // binary search, so a file of many frames is read in n log n, not n^2.
+    struct NodeTrack {
+        int node;
+        std::vector<int> frames;
+        std::vector<Transform> transforms;
+    };
+    void indexKeys(const std::vector<Key>& keys);  // a transform file's keys into tracks_, and the moved nodes
 
     std::vector<Transform> rest_;
-    std::vector<Key> keys_;  // increasing frame (transform files)
+    std::vector<NodeTrack> tracks_;  // a transform file's keys, by node
     std::shared_ptr<const SampledAnimations> sampled_;  // or glTF animations
     std::vector<int> moved_, morphed_;
     int lastFrame_ = 0;

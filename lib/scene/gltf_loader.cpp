@@ -172,15 +172,22 @@ std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::s
             nodes[i].children.push_back(c);
         }
     }
-    // A cycle without a root: following parents from any node must end.
+    // A cycle without a root: following parents from any node must end. Each walk stops at a node
+    // an earlier walk has shown to reach a root, so every node is walked once (a chain of any
+    // depth costs its length, not its square).
+    enum : uint8_t { kUnknown, kOnThisWalk, kReachesARoot };
+    std::vector<uint8_t> state(nodes.size(), kUnknown);
+    std::vector<int> walk;
     for (size_t i = 0; i < nodes.size(); ++i) {
-        int p = nodes[i].parent;
-        size_t steps = 0;
-        while (p >= 0) {
-            if (++steps > nodes.size())
-                throw InputError(file, gltfPlace("nodes", int(i)), "is its own descendant (the hierarchy has a cycle)");
-            p = nodes[p].parent;
+        int p = int(i);
+        for (; p >= 0 && state[size_t(p)] == kUnknown; p = nodes[size_t(p)].parent) {
+            state[size_t(p)] = kOnThisWalk;
+            walk.push_back(p);
         }
+        if (p >= 0 && state[size_t(p)] == kOnThisWalk)
+            throw InputError(file, gltfPlace("nodes", p), "is its own descendant (the hierarchy has a cycle)");
+        for (int w : walk) state[size_t(w)] = kReachesARoot;
+        walk.clear();
     }
     return nodes;
 }
@@ -272,7 +279,7 @@ private:
                     throw InputError(file_, (!node.weights.empty() ? gltfPlace("nodes", n) : gltfPlace("meshes", node.mesh)) + ".weights",
                                      "has " + std::to_string(weights.size()) + " weights for " +
                                          std::to_string(mesh.primitives[p].targets.size()) + " morph targets");
-                addPrimitive(scene, n, mesh.primitives[p], place, skin, weights);
+                addPrimitive(scene, n, world, mesh.primitives[p], place, skin, weights);
             }
         }
         if (node.camera >= 0) addCamera(scene, n, world);
@@ -280,8 +287,8 @@ private:
         if (light != node.extensions.end() && light->second.Has("light")) addLight(scene, n, world, light->second.Get("light"));
     }
 
-    void addPrimitive(Scene& scene, int nodeIndex, const tinygltf::Primitive& prim, const std::string& place, int skin,
-                      const std::vector<double>& morphWeights) {
+    void addPrimitive(Scene& scene, int nodeIndex, const Transform& world, const tinygltf::Primitive& prim,
+                      const std::string& place, int skin, const std::vector<double>& morphWeights) {
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
             warnings_.add(file_ + ": point and line primitives are skipped");
@@ -350,7 +357,7 @@ private:
             for (size_t i = 0; i < vertexCount; ++i)
                 objectNormals[i] = Vec3f(float((*normals)(i, 0)), float((*normals)(i, 1)), float((*normals)(i, 2)));
         }
-        scene.addInstance(nodeIndex, std::move(objectPositions), std::move(objectNormals), tri, material);
+        scene.addInstance(nodeIndex, std::move(objectPositions), std::move(objectNormals), tri, material, &world);
         MeshInstance& instance = scene.instances.back();
         if (skin >= 0) addInfluences(scene, instance, prim, place, skin);
         addMorphTargets(instance, prim, place, morphWeights, normals.has_value());

@@ -105,17 +105,21 @@ std::vector<Transform> Scene::restLocals() const {
 }
 
 std::vector<Transform> Scene::worldTransforms(const std::vector<Transform>& locals) const {
-    // The loader guarantees the hierarchy is a forest (no cycles), so recursion terminates.
+    // The loader guarantees the hierarchy is a forest (no cycles). Each node's unresolved
+    // ancestors are collected, then resolved from the top down: linear in the nodes, and no
+    // recursion, so a chain of any depth cannot overflow the stack.
     std::vector<Transform> world(nodes.size());
     std::vector<uint8_t> done(nodes.size(), 0);
-    std::function<const Transform&(int)> resolve = [&](int i) -> const Transform& {
-        if (!done[i]) {
-            world[i] = nodes[i].parent < 0 ? locals[i] : resolve(nodes[i].parent) * locals[i];
-            done[i] = 1;
+    std::vector<int> chain;
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        for (int n = int(i); n >= 0 && !done[size_t(n)]; n = nodes[size_t(n)].parent) chain.push_back(n);
+        for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+            const int parent = nodes[size_t(*it)].parent;
+            world[size_t(*it)] = parent < 0 ? locals[size_t(*it)] : world[size_t(parent)] * locals[size_t(*it)];
+            done[size_t(*it)] = 1;
         }
-        return world[i];
-    };
-    for (size_t i = 0; i < nodes.size(); ++i) resolve(int(i));
+        chain.clear();
+    }
     return world;
 }
 
@@ -289,9 +293,14 @@ int Scene::addNode(std::string name, const Transform& local, int parent) {
 }
 
 void Scene::addInstance(int node, std::vector<Vec3f> objectPositions, std::vector<Vec3f> objectNormals,
-                        const std::vector<uint32_t>& indices, uint32_t material) {
-    Transform world = nodes[node].local;  // rest pose, composed up the (acyclic) hierarchy
-    for (int p = nodes[node].parent; p >= 0; p = nodes[p].parent) world = nodes[p].local * world;
+                        const std::vector<uint32_t>& indices, uint32_t material, const Transform* restWorld) {
+    Transform world;  // rest pose, composed up the (acyclic) hierarchy unless the caller has it
+    if (restWorld) {
+        world = *restWorld;
+    } else {
+        world = nodes[node].local;
+        for (int p = nodes[node].parent; p >= 0; p = nodes[p].parent) world = nodes[p].local * world;
+    }
     MeshInstance inst;
     inst.node = node;
     inst.firstVertex = uint32_t(positions.size());

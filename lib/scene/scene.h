@@ -185,8 +185,10 @@ struct Scene {
     int addNode(std::string name, const Transform& local, int parent = -1);
     // Appends one mesh placed by `node`. indices: CCW triangles in object space; objectNormals
     // may be empty (area-weighted normals are used). World positions are set by finalize().
+    // restWorld: the node's rest-pose world transform if the caller has it (a loader walking the
+    // hierarchy does), else it is composed up the parents.
     void addInstance(int node, std::vector<Vec3f> objectPositions, std::vector<Vec3f> objectNormals,
-                     const std::vector<uint32_t>& indices, uint32_t material);
+                     const std::vector<uint32_t>& indices, uint32_t material, const Transform* restWorld = nullptr);
     // Chooses worldOrigin, places every instance in the rest pose, re-centres lights and camera
     // given in world space, and marks everything static.
     void finalize();

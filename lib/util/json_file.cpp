@@ -31,6 +31,46 @@ void refuseDeepNesting(const std::string& text, const std::string& path, size_t 
     }
 }
 
+namespace {
+
+// A SAX pass that only looks at keys: one set per object being read, a second key of the same
+// name is refused. (nlohmann's DOM callback could do it, but its end_object scans the enclosing
+// array for discarded values, which makes a file of many frames quadratic.)
+class DuplicateKeyFinder : public nlohmann::json_sax<nlohmann::json> {
+public:
+    explicit DuplicateKeyFinder(const std::string& path) : path_(path) {}
+    bool null() override { return true; }
+    bool boolean(bool) override { return true; }
+    bool number_integer(number_integer_t) override { return true; }
+    bool number_unsigned(number_unsigned_t) override { return true; }
+    bool number_float(number_float_t, const string_t&) override { return true; }
+    bool string(string_t&) override { return true; }
+    bool binary(binary_t&) override { return true; }
+    bool start_object(std::size_t) override {
+        keys_.emplace_back();
+        return true;
+    }
+    bool key(string_t& name) override {
+        if (!keys_.empty() && !keys_.back().insert(name).second)
+            throw InputError(path_, name, "this key is given twice in one object (JSON keeps only one of them: remove the other)");
+        return true;
+    }
+    bool end_object() override {
+        if (!keys_.empty()) keys_.pop_back();
+        return true;
+    }
+    bool start_array(std::size_t) override { return true; }
+    bool end_array() override { return true; }
+    // Syntax errors are the DOM parse's to report, with the byte.
+    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override { return false; }
+
+private:
+    const std::string& path_;
+    std::vector<std::set<std::string>> keys_;
+};
+
+}  // namespace
+
 nlohmann::json readJsonFile(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a JSON file");
@@ -39,19 +79,10 @@ nlohmann::json readJsonFile(const std::string& path) {
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) throw InputError(path, "", "cannot be read");
     refuseDeepNesting(text, path);
-    // One set of keys per object being read; a second of the same name is refused.
-    std::vector<std::set<std::string>> keys;
-    auto refuseDuplicates = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
-        using Event = nlohmann::json::parse_event_t;
-        if (event == Event::object_start) keys.emplace_back();
-        else if (event == Event::object_end && !keys.empty()) keys.pop_back();
-        else if (event == Event::key && !keys.empty() && !keys.back().insert(parsed.get<std::string>()).second)
-            throw InputError(path, parsed.get<std::string>(),
-                             "this key is given twice in one object (JSON keeps only one of them: remove the other)");
-        return true;
-    };
     try {
-        return nlohmann::json::parse(text, refuseDuplicates);
+        DuplicateKeyFinder duplicates(path);
+        nlohmann::json::sax_parse(text, &duplicates);
+        return nlohmann::json::parse(text);
     } catch (const nlohmann::json::parse_error& e) {
         throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
     } catch (const nlohmann::json::exception& e) {
