@@ -34,6 +34,10 @@ seed transform_file data/**/animation*.json tests/data/bad/animation/*.json
 seed config configs/*.json tests/data/bad/config/*.json
 seed gltf data/**/*.gltf data/**/*.glb tests/data/good/* tests/data/bad/gltf/* $shared/**/*.gltf $shared/**/*.glb
 
+# Every check AddressSanitizer has, use of a returned function's stack frame included (the test
+# suite under the sanitizers leaves that one to the fuzzers: scripts/test-sanitizers.sh).
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 status=0
 mkdir -p build-fuzz/artifacts
 for h in "${harnesses[@]}"; do

@@ -15,10 +15,13 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh --test
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release -DQSGI_SANITIZE=ON -DQSGI_BUILD_BENCHMARKS=OFF
 cmake --build build-asan
-export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
+# Use of a stack frame after its function returned is looked for by the fuzzers (scripts/fuzz.sh),
+# which feed the readers hostile bytes; here it would double the suite's time (ImpactCount's
+# closed sphere: 10.3 s with it, 5.9 s without), for code that takes no input of its own.
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cd build-asan
-statistical='DetpBoundary\.(InsideCorner|OpenEdgeOfAFloor|OutsideOfASphere|FloorBesideABox)'
+statistical='DetpBoundary\.(InsideCorner|OpenEdgeOfAFloor|OutsideOfASphere|FloorBesideABox|CeilingAboveALightPanel)'
 statistical+='|Estimators\.(PaperRuleMatches|PlaneUnderPointLight|ClosedSphereGives|DetpAndPhotonMapAreIndependentOfTessellation)'
 statistical+='|Incremental\.(NoDriftOverTenThousandFrames|RememberedCrossingsLeaveNoTraceAfterAThousandFrames)|Sweep\.TinyGrid|ReferenceAccuracy'
 statistical+='|Sobol\.AgreesWith'

@@ -4,7 +4,7 @@
 #   2. tests the Slurm job arrays on a single-node cluster it starts (scripts/test-slurm.sh);
 #   3. builds with AddressSanitizer + UndefinedBehaviorSanitizer and runs the suite again
 #      (scripts/test-sanitizers.sh);
-#   4. fuzzes the transform-file, config and glTF readers for QSGI_FUZZ_SECONDS each (default 60;
+#   4. fuzzes the transform-file, config and glTF readers for QSGI_FUZZ_SECONDS each (default 30;
 #      scripts/fuzz.sh).
 # QSGI_SKIP_SLURM=1 / QSGI_SKIP_SANITIZERS=1 / QSGI_SKIP_FUZZ=1 leave out 2 / 3 / 4 for a quick
 # local run. Extra arguments
@@ -17,4 +17,4 @@ cmake --build build
 (cd build && ctest --output-on-failure -j 2 "$@")
 if [ "${QSGI_SKIP_SLURM:-0}" != 1 ]; then scripts/test-slurm.sh; fi
 if [ "${QSGI_SKIP_SANITIZERS:-0}" != 1 ]; then scripts/test-sanitizers.sh; fi
-if [ "${QSGI_SKIP_FUZZ:-0}" != 1 ]; then scripts/fuzz.sh "${QSGI_FUZZ_SECONDS:-60}"; fi
+if [ "${QSGI_SKIP_FUZZ:-0}" != 1 ]; then scripts/fuzz.sh "${QSGI_FUZZ_SECONDS:-30}"; fi

@@ -82,3 +82,28 @@ TEST(Inspect, BadInputGetsTheRendersMessageAndExitCode) {
     }
     EXPECT_FALSE(fs::exists(dir / "out"));
 }
+
+// data/walker (scripts/make_walker.py): a skinned figure animated in the glTF file itself — 4 s
+// of "Walk", the figure sliding and its legs swinging, constant channels on the hips (which
+// therefore do not move), a 60 W/sr lamp and a camera node.
+TEST(Inspect, WalkerShowsItsSkinnedAnimationAtTheChosenRate) {
+    const std::string walker = (sourceDir() / "data/walker/walker.gltf").string();
+    const json r = inspectJson(walker + " --animation gltf");
+    EXPECT_EQ(r["animation"]["source"], "gltf");
+    EXPECT_EQ(r["animation"]["frames"].get<int>(), 4 * 24 + 1);
+    ASSERT_EQ(r["animation"]["gltf_animations"].size(), 1u);
+    EXPECT_EQ(r["animation"]["gltf_animations"][0]["name"], "Walk");
+    EXPECT_DOUBLE_EQ(r["animation"]["gltf_animations"][0]["seconds"].get<double>(), 4.0);
+    EXPECT_EQ(r["animation"]["moved_nodes"], json::array({"Walker", "LeftLeg", "RightLeg"}));
+    // The figure moves, the room and its furniture do not.
+    const double dynamic = r["animation"]["dynamic_triangles"].get<double>();
+    EXPECT_GT(dynamic, 0);
+    EXPECT_LT(dynamic, r["scene"]["triangles"].get<double>());
+    ASSERT_EQ(r["lights"].size(), 1u);
+    EXPECT_EQ(r["lights"][0]["name"], "Lamp");
+    EXPECT_NEAR(r["lights"][0]["power_w"].get<double>(), 4 * M_PI * 60, 1e-3);
+    EXPECT_EQ(r["cameras"]["render"]["from"], "node 'Camera'");
+    EXPECT_TRUE(r["warnings"].empty()) << r["warnings"].dump();
+    // Sampled at 10 frames a second: 41 frames over the same 4 s.
+    EXPECT_EQ(inspectJson(walker + " --animation gltf --fps 10")["animation"]["frames"].get<int>(), 41);
+}
