@@ -24,7 +24,8 @@ namespace {
 // x = 5, which a skinned mesh ignores. The animation turns Tip by 90° about +z over 1 s (LINEAR).
 // A second mesh, "Blob" (a quad at y = 1), has one morph target lifting vertex 2 by (0, 0, 1),
 // its weight 0.25 at rest (mesh.weights) and animated from 0 to 1 over 1 s.
-fs::path writeDeformingScene(const std::string& name, bool withFloorAndLamp) {
+// unweightedJoint: the joint vertex 0 names in its third influence, whose weight is 0.
+fs::path writeDeformingScene(const std::string& name, bool withFloorAndLamp, uint8_t unweightedJoint = 0) {
     testscenes::GltfWriter w;
     const int stripPositions = w.accessor({0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 0.2f, 0, 1, 0.2f, 0, 2, 0.2f, 0}, "VEC3");
     const int stripNormals = w.accessor({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
@@ -32,7 +33,7 @@ fs::path writeDeformingScene(const std::string& name, bool withFloorAndLamp) {
     // JOINTS_0 as unsigned bytes (VEC4): written through a float accessor's bytes would be wrong,
     // so they go in by hand below.
     const int weights = w.accessor({1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 0, 1, 0, 0}, "VEC4");
-    std::vector<uint8_t> jointBytes = {0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0};
+    std::vector<uint8_t> jointBytes = {0, 1, unweightedJoint, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0};
     while (w.bin.size() % 4) w.bin.push_back('\0');
     w.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", w.bin.size()}, {"byteLength", jointBytes.size()}});
     w.bin.append(reinterpret_cast<const char*>(jointBytes.data()), jointBytes.size());
@@ -235,5 +236,19 @@ TEST(Deformation, AMeshDeformingInOneRegionRetracesAndRecomputesOnlyNearIt) {
         EXPECT_GT(f["paths_retraced"].get<int64_t>(), 0);
         EXPECT_LT(f["paths_retraced"].get<int64_t>(), 40000 / 20);
         EXPECT_LT(f["vertices_recomputed"].get<int64_t>(), 2601 / 10);
+    }
+}
+
+// A joint index names a joint of the skin even where its weight is 0 (glTF 2.0; issue 23): the
+// strip's skin has 2 joints, and vertex 0 names joint 7 with weight 0.
+TEST(Deformation, AJointIndexBeyondTheSkinIsRefusedEvenWithWeightZero) {
+    Warnings warnings;
+    EXPECT_NO_THROW(loadGltfScene(writeDeformingScene("joints-valid", false, 1).string(), warnings));
+    try {
+        loadGltfScene(writeDeformingScene("joints-beyond", false, 7).string(), warnings);
+        ADD_FAILURE() << "a joint index beyond the skin was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("JOINTS_0"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("names joint 7 of a skin with 2"), std::string::npos) << e.what();
     }
 }

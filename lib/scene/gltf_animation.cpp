@@ -59,6 +59,8 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
         const std::string animationPlace = gltfPlace("animations", int(a));
         KeyframeAnimation animation;
         animation.name = source.name.empty() ? "animation " + std::to_string(a) : source.name;
+        if (source.channels.empty())  // kept, so that gltf:N still names the file's animation N
+            warnings.add(file + ": " + animationPlace + " has no channels (glTF requires at least one): it moves nothing");
         std::set<std::pair<int, AnimatedProperty>> targets;
         bool first = true;
         for (size_t c = 0; c < source.channels.size(); ++c) {

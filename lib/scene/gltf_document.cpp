@@ -2,7 +2,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -44,6 +46,17 @@ GlbLayout readGlbLayout(const std::string& path, const std::string& bytes) {
     if (jsonType != kGlbJsonChunk) throw InputError(path, "GLB chunk 0", "is not the JSON chunk");
     if (uint64_t(jsonLength) + 20 > bytes.size())
         throw InputError(path, "GLB chunk 0", "its length " + std::to_string(jsonLength) + " runs past the end of the file");
+    // glTF 2.0 (§4.4.3): every chunk is padded to a multiple of 4 bytes, so the next one is aligned.
+    if (jsonLength % 4 != 0)
+        throw InputError(path, "GLB chunk 0", "its length " + std::to_string(jsonLength) +
+                                                  " is not a multiple of 4 (GLB pads chunks with spaces or zeros)");
+    for (uint64_t at = 20 + uint64_t(jsonLength); at + 8 <= bytes.size();) {
+        const uint32_t chunkLength = readU32(bytes, size_t(at));
+        if (chunkLength % 4 != 0)
+            throw InputError(path, "GLB chunk at byte " + std::to_string(at),
+                             "its length " + std::to_string(chunkLength) + " is not a multiple of 4 (GLB pads chunks)");
+        at += 8 + uint64_t(chunkLength);
+    }
     return {bytes.substr(20, jsonLength), 20 + size_t(jsonLength)};
 }
 
@@ -85,6 +98,99 @@ void checkAsset(const std::string& path, const json& doc) {
             throw InputError(path, "asset.minVersion", "is " + asset["minVersion"].get<std::string>() +
                                                            ": the file needs features newer than glTF 2.0, which qsgi implements");
     }
+}
+
+// The glTF 2.0 schema's integer fields that index or measure bytes and elements: each must be an
+// integer >= 0 (its "minimum": 0; componentType, mode and target have enumerated values, checked
+// where they are read). tinygltf takes a negative byteOffset as 0 in one place and reads before
+// the view in another, so every one of them is checked here, before it reads any.
+void refuseNegativeIndices(const std::string& path, const json& doc) {
+    static const std::pair<const char*, std::vector<const char*>> kFields[] = {
+        {"accessors", {"bufferView", "byteOffset", "count", "sparse.count", "sparse.indices.bufferView",
+                       "sparse.indices.byteOffset", "sparse.values.bufferView", "sparse.values.byteOffset"}},
+        {"bufferViews", {"buffer", "byteOffset", "byteLength", "byteStride"}},
+        {"buffers", {"byteLength"}},
+        {"images", {"bufferView"}},
+        {"materials", {"pbrMetallicRoughness.baseColorTexture.index", "pbrMetallicRoughness.baseColorTexture.texCoord",
+                       "emissiveTexture.index", "emissiveTexture.texCoord"}},
+        {"nodes", {"camera", "mesh", "skin"}},
+        {"skins", {"inverseBindMatrices", "skeleton"}},
+        {"textures", {"source", "sampler"}},
+    };
+    auto check = [&](const json& value, const std::string& place) {
+        const bool ok = value.is_number_unsigned() ||
+                        (value.is_number_float() && value.get<double>() >= 0 && value.get<double>() < 9.0e15 &&
+                         std::floor(value.get<double>()) == value.get<double>());
+        if (!ok) throw InputError(path, place, value.dump().substr(0, 40) + " is not a non-negative integer below 2^53 (glTF 2.0 requires one)");
+    };
+    for (const auto& [array, fields] : kFields) {
+        if (!doc.contains(array) || !doc[array].is_array()) continue;
+        const json& items = doc[array];
+        for (size_t i = 0; i < items.size(); ++i) {
+            const std::string item = std::string(array) + "[" + std::to_string(i) + "]";
+            for (const char* field : fields) {
+                const json* at = &items[i];
+                std::string dotted = field;
+                for (size_t start = 0; at && start <= dotted.size();) {
+                    const size_t dot = std::min(dotted.find('.', start), dotted.size());
+                    const std::string key = dotted.substr(start, dot - start);
+                    at = at->is_object() && at->contains(key) ? &(*at)[key] : nullptr;
+                    start = dot + 1;
+                }
+                if (at) check(*at, item + "." + field);
+            }
+        }
+    }
+    // Lists of indices: a node's children, a scene's nodes, a skin's joints; a primitive's indices
+    // and material, and its attributes' and targets' accessors; an animation's samplers and targets.
+    auto checkList = [&](const json& list, const std::string& place) {
+        if (!list.is_array()) return;
+        for (size_t k = 0; k < list.size(); ++k) check(list[k], place + "[" + std::to_string(k) + "]");
+    };
+    auto each = [&](const char* array, const auto& visit) {
+        if (!doc.contains(array) || !doc[array].is_array()) return;
+        for (size_t i = 0; i < doc[array].size(); ++i)
+            if (doc[array][i].is_object()) visit(doc[array][i], std::string(array) + "[" + std::to_string(i) + "]");
+    };
+    each("nodes", [&](const json& n, const std::string& at) { if (n.contains("children")) checkList(n["children"], at + ".children"); });
+    each("scenes", [&](const json& s, const std::string& at) { if (s.contains("nodes")) checkList(s["nodes"], at + ".nodes"); });
+    each("skins", [&](const json& s, const std::string& at) { if (s.contains("joints")) checkList(s["joints"], at + ".joints"); });
+    each("meshes", [&](const json& m, const std::string& at) {
+        if (!m.contains("primitives") || !m["primitives"].is_array()) return;
+        for (size_t p = 0; p < m["primitives"].size(); ++p) {
+            const json& prim = m["primitives"][p];
+            const std::string place = at + ".primitives[" + std::to_string(p) + "]";
+            if (!prim.is_object()) continue;
+            for (const char* key : {"indices", "material"})
+                if (prim.contains(key)) check(prim[key], place + "." + key);
+            if (prim.contains("attributes") && prim["attributes"].is_object())
+                for (auto it = prim["attributes"].begin(); it != prim["attributes"].end(); ++it)
+                    check(it.value(), place + ".attributes." + it.key());
+            if (prim.contains("targets") && prim["targets"].is_array())
+                for (size_t t = 0; t < prim["targets"].size(); ++t)
+                    if (prim["targets"][t].is_object())
+                        for (auto it = prim["targets"][t].begin(); it != prim["targets"][t].end(); ++it)
+                            check(it.value(), place + ".targets[" + std::to_string(t) + "]." + it.key());
+        }
+    });
+    each("animations", [&](const json& a, const std::string& at) {
+        if (a.contains("channels") && a["channels"].is_array())
+            for (size_t c = 0; c < a["channels"].size(); ++c) {
+                const json& ch = a["channels"][c];
+                const std::string place = at + ".channels[" + std::to_string(c) + "]";
+                if (!ch.is_object()) continue;
+                if (ch.contains("sampler")) check(ch["sampler"], place + ".sampler");
+                if (ch.contains("target") && ch["target"].is_object() && ch["target"].contains("node"))
+                    check(ch["target"]["node"], place + ".target.node");
+            }
+        if (a.contains("samplers") && a["samplers"].is_array())
+            for (size_t s = 0; s < a["samplers"].size(); ++s) {
+                const json& sm = a["samplers"][s];
+                if (!sm.is_object()) continue;
+                for (const char* key : {"input", "output"})
+                    if (sm.contains(key)) check(sm[key], at + ".samplers[" + std::to_string(s) + "]." + key);
+            }
+    });
 }
 
 void refuseRemoteUris(const std::string& path, const json& doc, const char* array) {
@@ -172,6 +278,7 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     }
     if (!doc.is_object()) throw InputError(path, "", "the glTF JSON must be an object");
     checkAsset(path, doc);
+    refuseNegativeIndices(path, doc);
     refuseRemoteUris(path, doc, "buffers");
     refuseRemoteUris(path, doc, "images");
 

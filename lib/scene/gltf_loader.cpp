@@ -100,16 +100,15 @@ Material convertMaterial(const tinygltf::Model& model, const AccessorReader& rea
     out.name = m.name;
     const auto& pbr = m.pbrMetallicRoughness;
     out.albedo = vec3FromFactor(pbr.baseColorFactor, Vec3f(1.0f));
+    // glTF 2.0: each factor lies in [0, 1] (a surface that reflects more than it receives would
+    // make energy); refused, not clamped, so that the render is of the file as written.
+    if (!isFinite(out.albedo) || out.albedo.x < 0 || out.albedo.y < 0 || out.albedo.z < 0 || maxComponent(out.albedo) > 1)
+        throw InputError(file, place + ".pbrMetallicRoughness.baseColorFactor", "must lie in [0, 1] (glTF 2.0)");
     if (pbr.baseColorTexture.index >= 0) {
         const std::string texturePlace = place + ".pbrMetallicRoughness.baseColorTexture";
         const TextureColour base = textureColour(model, reader, pbr.baseColorTexture.index, texturePlace);
         if (base.mean) out.albedo = out.albedo * *base.mean;
         else warnings.add(file + ": " + texturePlace + ": " + base.problem + "; using baseColorFactor alone");
-    }
-    if (!isFinite(out.albedo) || out.albedo.x < 0 || out.albedo.y < 0 || out.albedo.z < 0 || maxComponent(out.albedo) > 1) {
-        warnings.add(file + ": " + place + ": albedo outside [0,1] clamped (energy must not grow)");
-        out.albedo = min(max(out.albedo, Vec3f(0.0f)), Vec3f(1.0f));
-        if (!isFinite(out.albedo)) out.albedo = Vec3f(0.0f);
     }
     if (pbr.metallicRoughnessTexture.index >= 0 || m.normalTexture.index >= 0 || m.occlusionTexture.index >= 0)
         warnings.add(file + ": metallic/roughness, normal and occlusion maps are ignored (surfaces are Lambertian)");
@@ -146,10 +145,33 @@ std::optional<NodeTrs> nodeTrs(const tinygltf::Node& n) {
     return trs;
 }
 
+// glTF 2.0 (§5.25, node): a node gives a matrix or TRS properties, not both; a matrix must
+// decompose to TRS (animation targets and skins assume it): its last row 0 0 0 1 and no shear;
+// a rotation is a unit quaternion (a zero one has no direction at all).
 Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTrs>& trs, const std::string& file,
                              int index) {
+    const std::string place = gltfPlace("nodes", index);
+    if (n.matrix.size() == 16 && (!n.translation.empty() || !n.rotation.empty() || !n.scale.empty()))
+        throw InputError(file, place, "has both a matrix and translation, rotation or scale (glTF allows one or the other)");
+    if (n.rotation.size() == 4 &&
+        !(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
+              n.rotation[3] * n.rotation[3] > 1e-12))
+        throw InputError(file, place + ".rotation", "is a zero quaternion (a rotation must be a unit quaternion)");
     const Transform t = trs ? trs->matrix() : Transform::fromColumnMajor(n.matrix.data());
-    if (!t.isFinite()) throw InputError(file, gltfPlace("nodes", index), "transform holds a non-finite number");
+    if (!t.isFinite()) throw InputError(file, place, "transform holds a non-finite number");
+    if (!trs) {
+        if (t.at(3, 0) != 0 || t.at(3, 1) != 0 || t.at(3, 2) != 0 || t.at(3, 3) != 1)
+            throw InputError(file, place + ".matrix", "has a last row other than 0 0 0 1, so it is no translation, rotation "
+                                                      "and scale (glTF requires that it decompose to them)");
+        for (int a = 0; a < 3; ++a)
+            for (int b = a + 1; b < 3; ++b) {
+                const Vec3d ca(t.at(0, a), t.at(1, a), t.at(2, a)), cb(t.at(0, b), t.at(1, b), t.at(2, b));
+                if (std::fabs(dot(ca, cb)) > 1e-4 * length(ca) * length(cb))
+                    throw InputError(file, place + ".matrix", "shears (its columns " + std::to_string(a) + " and " +
+                                                                  std::to_string(b) + " are not perpendicular), so it does "
+                                                                  "not decompose to translation, rotation and scale");
+            }
+    }
     return t;
 }
 
@@ -266,6 +288,9 @@ private:
             if (node.mesh >= int(model_.meshes.size()))
                 throw InputError(file_, gltfPlace("nodes", n) + ".mesh", "refers to mesh " + std::to_string(node.mesh) + ", which does not exist");
             const tinygltf::Mesh& mesh = model_.meshes[node.mesh];
+            if (mesh.primitives.empty())
+                throw InputError(file_, gltfPlace("meshes", node.mesh) + ".primitives",
+                                 "is empty (glTF requires at least one primitive), and node " + std::to_string(n) + " uses the mesh");
             const int skin = node.skin >= 0 ? addSkin(scene, node.skin, gltfPlace("nodes", n) + ".skin") : -1;
             // Morph target weights: the node's, else the mesh's, else zeros (glTF 2.0 §3.7.2.2).
             const std::vector<double>& weights = !node.weights.empty() ? node.weights : mesh.weights;
@@ -297,6 +322,11 @@ private:
         auto pos = prim.attributes.find("POSITION");
         if (pos == prim.attributes.end()) throw InputError(file_, place, "has no POSITION attribute");
         const AccessorData positions = reader_.read(pos->second, place + ".attributes.POSITION", kPositionFormat);
+        // glTF 2.0 (§5.1.3): a POSITION accessor states its bounds (min and max), which viewers use.
+        if (pos->second >= 0 && size_t(pos->second) < model_.accessors.size() &&
+            (model_.accessors[size_t(pos->second)].minValues.size() != 3 || model_.accessors[size_t(pos->second)].maxValues.size() != 3))
+            throw InputError(file_, gltfPlace("accessors", pos->second),
+                             "is a POSITION accessor without min and max (glTF requires both, 3 numbers each)");
                 const size_t vertexCount = positions.count;
 
         std::optional<AccessorData> normals;
@@ -317,6 +347,13 @@ private:
 
         std::vector<uint32_t> indices;
         if (prim.indices >= 0) {
+            // glTF 2.0 (§3.6.2.4): indices are tightly packed; their bufferView has no byteStride.
+            if (prim.indices < int(model_.accessors.size())) {
+                const int view = model_.accessors[size_t(prim.indices)].bufferView;
+                if (view >= 0 && view < int(model_.bufferViews.size()) && model_.bufferViews[size_t(view)].byteStride != 0)
+                    throw InputError(file_, gltfPlace("bufferViews", view) + ".byteStride",
+                                     "is set on a view that holds indices (" + place + ".indices), which glTF forbids");
+            }
             const AccessorData idx = reader_.read(prim.indices, place + ".indices", kIndexFormat);
             indices.resize(idx.count);
             // The largest value of the index type means "primitive restart", which glTF forbids.
@@ -337,6 +374,11 @@ private:
             indices.resize(vertexCount);
             for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
         }
+        // glTF 2.0 (§5.24.4): TRIANGLES takes three vertices a triangle; a remainder is no triangle
+        // the file meant, so it is refused rather than dropped.
+        if (prim.mode == TINYGLTF_MODE_TRIANGLES && indices.size() % 3 != 0)
+            throw InputError(file_, place + (prim.indices >= 0 ? ".indices" : ".attributes.POSITION"),
+                             "has " + std::to_string(indices.size()) + " vertices, not a multiple of 3 (TRIANGLES)");
         std::vector<uint32_t> tri = triangleIndices(prim.mode, indices);
         if (scene.positions.size() + vertexCount > (size_t(1) << 31))
             throw InputError(file_, place, "the scene exceeds 2^31 vertices");
@@ -422,7 +464,8 @@ private:
                     const double joint = jointSets[s](v, k), weight = weightSets[s](v, k);
                     if (weight < 0)
                         throw InputError(file_, place + ".attributes.WEIGHTS_" + std::to_string(s), "holds a negative weight");
-                    if (weight > 0 && joint >= double(joints))
+                    // Every joint index names a joint of the skin, also where its weight is 0 (glTF 2.0).
+                    if (joint >= double(joints))
                         throw InputError(file_, place + ".attributes.JOINTS_" + std::to_string(s),
                                          "vertex " + std::to_string(v) + " names joint " + std::to_string(size_t(joint)) +
                                              " of a skin with " + std::to_string(joints));
@@ -505,6 +548,11 @@ private:
         }
         if (!(lens.znear >= 0) || !std::isfinite(lens.znear))
             throw InputError(file_, gltfPlace("cameras", node.camera), "znear must be non-negative and finite");
+        // zfar: beyond znear (a perspective camera may omit it: infinite).
+        const double zfar = cam.type == "perspective" ? cam.perspective.zfar : cam.orthographic.zfar;
+        if ((cam.type == "orthographic" || zfar != 0) && !(zfar > lens.znear))
+            throw InputError(file_, gltfPlace("cameras", node.camera) + "." + cam.type + ".zfar",
+                             "must lie beyond znear (" + std::to_string(lens.znear) + ")");
         // World space here: Scene::finalize re-centres it with the lights.
         const Camera c = placeCamera(lens, world, Vec3d(0.0));
         if (!isFinite(c.position) || !isFinite(c.forward) || !isFinite(c.up))
@@ -524,6 +572,9 @@ private:
         out.name = l.name.empty() ? "light " + std::to_string(index) : l.name;
         out.node = n;
         const Vec3f colour = vec3FromFactor(l.color, Vec3f(1.0f));
+        if (!isFinite(colour) || colour.x < 0 || colour.y < 0 || colour.z < 0 || maxComponent(colour) > 1)
+            throw InputError(file_, gltfPlace("KHR_lights_punctual.lights", index) + ".color",
+                             "must lie in [0, 1] (KHR_lights_punctual: the strength is in intensity)");
         out.intensity = colour * float(l.intensity);
         placeLight(out, world, Vec3d(0.0));  // world space; Scene::finalize re-centres it
         if (l.type == "point") out.type = LightType::Point;
@@ -532,6 +583,10 @@ private:
             const double outer = l.spot.outerConeAngle;
             if (!(outer > 0 && outer <= M_PI / 2 + 1e-9))
                 throw InputError(file_, gltfPlace("KHR_lights_punctual.lights", index) + ".spot.outerConeAngle", "must lie in (0, pi/2]");
+            const double inner = l.spot.innerConeAngle;
+            if (!(inner >= 0 && inner < outer))
+                throw InputError(file_, gltfPlace("KHR_lights_punctual.lights", index) + ".spot.innerConeAngle",
+                                 "must lie in [0, outerConeAngle)");
             out.cosOuterCone = float(std::cos(outer));
         } else if (l.type == "directional") out.type = LightType::Directional;
         else throw InputError(file_, gltfPlace("KHR_lights_punctual.lights", index) + ".type", "unknown light type '" + l.type + "'");
@@ -555,9 +610,13 @@ namespace {
 
 Scene buildScene(const GltfDocument& document, const std::string& path, Warnings& warnings) {
     const tinygltf::Model& model = document.model;
-    for (const auto& ext : model.extensionsRequired)
+    for (const auto& ext : model.extensionsRequired) {
+        // glTF 2.0 (§3.12): every required extension is also listed as used.
+        if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), ext) == model.extensionsUsed.end())
+            throw InputError(path, "extensionsRequired", ext + " is required but not listed in extensionsUsed");
         if (!kSupportedExtensions.count(ext))
             throw InputError(path, "extensionsRequired", "requires extension " + ext + ", which qsgi does not implement");
+    }
     for (const auto& ext : model.extensionsUsed)
         if (!kSupportedExtensions.count(ext)) warnings.add(path + ": extension " + ext + " is ignored");
 

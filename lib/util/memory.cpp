@@ -66,9 +66,7 @@ uint64_t controlGroupLimit() {
     return limit;
 }
 
-}  // namespace
-
-MemoryLimit usableMemory() {
+MemoryLimit readUsableMemory() {
     MemoryLimit limit{physicalMemoryBytes(), "this machine has"};
     auto consider = [&](uint64_t bytes, const char* source) {
         if (bytes < limit.bytes) limit = {bytes, source};
@@ -77,6 +75,16 @@ MemoryLimit usableMemory() {
     if (getrlimit(RLIMIT_AS, &r) == 0 && r.rlim_cur != RLIM_INFINITY) consider(uint64_t(r.rlim_cur), "ulimit -v allows this process");
     if (getrlimit(RLIMIT_DATA, &r) == 0 && r.rlim_cur != RLIM_INFINITY) consider(uint64_t(r.rlim_cur), "ulimit -d allows this process");
     consider(controlGroupLimit(), "its control group (a container's or a job's limit) allows this process");
+    return limit;
+}
+
+}  // namespace
+
+MemoryLimit usableMemory() {
+    // Read once: the limits do not change under a running process, and every accessor and photon
+    // count is checked against them (reading /proc and /sys each time made the fuzzers' loads
+    // ten times slower).
+    static const MemoryLimit limit = readUsableMemory();
     return limit;
 }
 

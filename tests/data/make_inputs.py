@@ -248,6 +248,22 @@ def sparse(edit):
     return f
 bad("gltf", "sparse_index_beyond_count.gltf", edited(sparse([0, 9, 0, 0])), "beyond the accessor")
 bad("gltf", "sparse_indices_not_increasing.gltf", edited(sparse([2, 1, 0, 0])), "strictly increase")
+# Issue 23: negative offsets, which tinygltf took as 0 in one place and read before the view in another.
+bad("gltf", "accessor_negative_offset.gltf", edited(accessor(0, byteOffset=-12)), "accessors[0].byteOffset")
+bad("gltf", "sparse_values_negative_offset.gltf",
+    edited(lambda m: (sparse([0, 1, 0, 0])(m), m["accessors"][0]["sparse"]["values"].update(byteOffset=-24))),
+    "accessors[0].sparse.values.byteOffset")
+bad("gltf", "view_negative_offset.gltf", edited(lambda m: m["bufferViews"][1].update(byteOffset=-4)), "bufferViews[1].byteOffset")
+bad("gltf", "child_negative.gltf", edited(lambda m: m["nodes"][0].update(children=[-1])), "nodes[0].children[0]")
+IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+bad("gltf", "node_matrix_and_translation.gltf",
+    edited(lambda m: m["nodes"][0].update(matrix=IDENTITY, translation=[0, 1, 0])), "both a matrix and")
+bad("gltf", "triangles_remainder.gltf", scene(indices=struct.pack("<8H", 0, 1, 2, 0, 2, 3, 0, 1)), "not a multiple of 3")
+bad("gltf", "node_rotation_zero.gltf", edited(lambda m: m["nodes"][0].update(rotation=[0, 0, 0, 0])), "zero quaternion")
+bad("gltf", "node_matrix_sheared.gltf",
+    edited(lambda m: m["nodes"][0].update(matrix=[1, 0, 0, 0, 0.5, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])), "shears")
+bad("gltf", "node_matrix_projective.gltf",
+    edited(lambda m: m["nodes"][0].update(matrix=[1, 0, 0, 0.1, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])), "last row")
 bad("gltf", "attribute_lengths_differ.gltf", edited(accessor(2, count=3), scene(normals=NRM)), "equal lengths")
 bad("gltf", "node_two_parents.gltf",
     edited(lambda m: m["nodes"].extend([{"children": [0]}, {"children": [0]}]) or m["scenes"][0].update(nodes=[1, 2, 3])),
@@ -287,6 +303,23 @@ bad("gltf", "light_missing.gltf",
 bad("gltf", "spot_cone_too_wide.gltf",
     edited(lambda m: m["extensions"]["KHR_lights_punctual"]["lights"][0].update(
         type="spot", spot={"innerConeAngle": 0.1, "outerConeAngle": 2.0})), "outerConeAngle")
+bad("gltf", "light_colour_above_one.gltf",
+    edited(lambda m: m["extensions"]["KHR_lights_punctual"]["lights"][0].update(color=[2, 1, 1])), "color")
+bad("gltf", "base_colour_above_one.gltf",
+    edited(lambda m: m.update(materials=[{"pbrMetallicRoughness": {"baseColorFactor": [1.5, 0.5, 0.5, 1]}}])
+           or m["meshes"][0]["primitives"][0].update(material=0)), "baseColorFactor")
+bad("gltf", "index_view_with_stride.gltf", edited(lambda m: m["bufferViews"][1].update(byteStride=4)), "byteStride")
+bad("gltf", "mesh_without_primitives.gltf", edited(lambda m: m["meshes"].append({"primitives": []})
+                                                   or m["nodes"][0].update(mesh=1)), "at least one primitive")
+bad("gltf", "position_without_bounds.gltf", edited(lambda m: m["accessors"][0].pop("min")), "without min and max")
+bad("gltf", "required_extension_not_used.gltf",
+    edited(lambda m: m.update(extensionsRequired=["KHR_materials_emissive_strength"])), "not listed in extensionsUsed")
+bad("gltf", "spot_inner_not_below_outer.gltf",
+    edited(lambda m: m["extensions"]["KHR_lights_punctual"]["lights"][0].update(
+        type="spot", spot={"innerConeAngle": 0.8, "outerConeAngle": 0.8})), "innerConeAngle")
+bad("gltf", "camera_zfar_before_znear.gltf",
+    edited(lambda m: m.update(cameras=[{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.5, "zfar": 0.1}}])
+           or m["nodes"].append({"camera": 0}) or m["scenes"][0]["nodes"].append(2)), "zfar")
 bad("gltf", "camera_zero_yfov.gltf",
     edited(lambda m: m.update(cameras=[{"type": "perspective", "perspective": {"yfov": 0, "znear": 0.1}}])
            or m["nodes"].append({"camera": 0}) or m["scenes"][0]["nodes"].append(2)), "yfov")
@@ -306,6 +339,15 @@ bad("gltf", "glb_json_chunk_overrun.glb", good_glb[:12] + struct.pack("<I", 1 <<
 glb_doc = scene()
 glb_doc["buffers"] = [{"byteLength": 4096}]
 bad("gltf", "glb_buffer_longer_than_bin.glb", glb(glb_doc, POS + IDX), "byteLength")
+def glb_unaligned_bin():
+    doc = scene()
+    doc["buffers"] = [{"byteLength": len(POS + IDX) - 2}]
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    binary = (POS + IDX)[:-2]  # 58 bytes: not padded to a multiple of 4
+    chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
+    return b"glTF" + struct.pack("<II", 2, 12 + len(chunks)) + chunks
+bad("gltf", "glb_chunk_not_aligned.glb", glb_unaligned_bin(), "not a multiple of 4")
 
 # ---- transform files (bad/animation), rendered with good/base.gltf ----
 def anim(frames, **top):
@@ -344,6 +386,8 @@ bad("animation", "translation_overflows_float.json",
 bad("animation", "scene_spans_too_far.json",
     anim([{"frame": 0}, {"frame": 1, "nodes": {"Floor": {"translation": [1e20, 0, 0]}}}]), "supports up to 1e15")
 bad("animation", "not_json.json", "frames: [0, 1, 2]", "not valid JSON")
+bad("animation", "node_named_twice.json",
+    anim([{"frame": 0, "nodes": {"Floor": {"translation": [0, 1, 0]}, "#0": {"translation": [0, 2, 0]}}}]), "twice")
 bad("animation", "key_twice.json", '{"format": "qsgi-animation", "version": 1, "frames": [{"frame": 0}], '
     '"frames": [{"frame": 1}]}', "given twice", "frames")
 bad("animation", "top_level_array.json", [anim([{"frame": 0}])], "JSON object")
