@@ -100,7 +100,8 @@ void checkAsset(const std::string& path, const json& doc) {
     }
 }
 
-// The glTF 2.0 schema's integer fields that index or measure bytes and elements: each must be an
+// Structural rules tinygltf does not enforce, checked on the JSON before it reads anything. The
+// glTF 2.0 schema's integer fields that index or measure bytes and elements: each must be an
 // integer >= 0 (its "minimum": 0; componentType, mode and target have enumerated values, checked
 // where they are read). tinygltf takes a negative byteOffset as 0 in one place and reads before
 // the view in another, so every one of them is checked here, before it reads any.
@@ -152,7 +153,12 @@ void refuseNegativeIndices(const std::string& path, const json& doc) {
         for (size_t i = 0; i < doc[array].size(); ++i)
             if (doc[array][i].is_object()) visit(doc[array][i], std::string(array) + "[" + std::to_string(i) + "]");
     };
-    each("nodes", [&](const json& n, const std::string& at) { if (n.contains("children")) checkList(n["children"], at + ".children"); });
+    each("nodes", [&](const json& n, const std::string& at) {
+        if (n.contains("children")) checkList(n["children"], at + ".children");
+        // glTF 2.0 (§5.25): a matrix or TRS properties, not both (tinygltf keeps one silently).
+        if (n.contains("matrix") && (n.contains("translation") || n.contains("rotation") || n.contains("scale")))
+            throw InputError(path, at, "has both a matrix and translation, rotation or scale (glTF allows one or the other)");
+    });
     each("scenes", [&](const json& s, const std::string& at) { if (s.contains("nodes")) checkList(s["nodes"], at + ".nodes"); });
     each("skins", [&](const json& s, const std::string& at) { if (s.contains("joints")) checkList(s["joints"], at + ".joints"); });
     each("meshes", [&](const json& m, const std::string& at) {

@@ -145,14 +145,11 @@ std::optional<NodeTrs> nodeTrs(const tinygltf::Node& n) {
     return trs;
 }
 
-// glTF 2.0 (§5.25, node): a node gives a matrix or TRS properties, not both; a matrix must
-// decompose to TRS (animation targets and skins assume it): its last row 0 0 0 1 and no shear;
+// glTF 2.0 (§5.25, node): a matrix must decompose to TRS (animation targets and skins assume it): its last row 0 0 0 1 and no shear;
 // a rotation is a unit quaternion (a zero one has no direction at all).
 Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTrs>& trs, const std::string& file,
                              int index) {
     const std::string place = gltfPlace("nodes", index);
-    if (n.matrix.size() == 16 && (!n.translation.empty() || !n.rotation.empty() || !n.scale.empty()))
-        throw InputError(file, place, "has both a matrix and translation, rotation or scale (glTF allows one or the other)");
     if (n.rotation.size() == 4 &&
         !(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
               n.rotation[3] * n.rotation[3] > 1e-12))
