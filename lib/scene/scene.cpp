@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <functional>
 #include <limits>
 
 namespace qsgi {
@@ -250,12 +249,16 @@ void Scene::setRestPose(const Pose& pose) {
 
 std::vector<uint8_t> Scene::dynamicInstances(const std::vector<int>& movedNodes, const std::vector<int>& morphedNodes) const {
     std::vector<uint8_t> nodeDynamic(nodes.size(), 0);
-    std::function<void(int)> mark = [&](int n) {
-        if (nodeDynamic[n]) return;
-        nodeDynamic[n] = 1;
-        for (int c : nodes[n].children) mark(c);
-    };
-    for (int n : movedNodes) mark(n);
+    // A moved node's whole subtree moves; marked with an explicit stack, so a chain of any depth
+    // cannot overflow the call stack (as worldTransforms).
+    std::vector<int> pending(movedNodes.begin(), movedNodes.end());
+    while (!pending.empty()) {
+        const int n = pending.back();
+        pending.pop_back();
+        if (nodeDynamic[size_t(n)]) continue;
+        nodeDynamic[size_t(n)] = 1;
+        for (int c : nodes[size_t(n)].children) pending.push_back(c);
+    }
     std::vector<uint8_t> morphed(nodes.size(), 0);
     for (int n : morphedNodes) morphed[size_t(n)] = 1;
     std::vector<uint8_t> out(instances.size(), 0);
