@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "output/ply_reader.h"
+#include "pipeline/render_job.h"
 #include "scene/animation.h"
 #include "scene/gltf_loader.h"
 #include "test_support.h"
@@ -127,6 +129,41 @@ TEST(HostileInput, AFolderAsATransformFileIsRefusedByName) {
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("is a directory"), std::string::npos) << r.output;
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+}
+
+// A zero scale in a transform file hides the node for that frame (glTF's visibility, DESIGN
+// §3; issue 23: it was refused as "not invertible"), on every axis or on one; the frame after it
+// shows the floor lit again, exactly as frame 0 (the same pose, the same photons).
+TEST(HostileInput, AZeroScaleInATransformFileHidesTheNode) {
+    const std::string base = (dataDir() / "good" / "base.gltf").string();
+    const fs::path dir = testScratchDir("hostile-zero-scale");
+    const fs::path animation = dir / "hide.json";
+    {
+        std::ofstream f(animation);
+        f << R"({"format":"qsgi-animation","version":1,"frames":[{"frame":0},)"
+          << R"({"frame":1,"nodes":{"Floor":{"scale":[0,0,0]}}},{"frame":2,"nodes":{"Floor":{"scale":[1,0,1]}}},)"
+          << R"({"frame":3,"nodes":{"Floor":{"scale":[1,1,1]}}}]})";
+    }
+    const CommandResult r = runQsgi("render " + base + " --animation " + animation.string() +
+                                    " --photons 20000 --quiet --out " + (dir / "out").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::vector<VertexRadiosityPly> frames;
+    for (int f = 0; f < 4; ++f) frames.push_back(readVertexRadiosityPly((dir / "out" / frameFileName(f, "ply")).string()));
+    for (int f = 0; f < 4; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        const bool hidden = f == 1 || f == 2;
+        for (size_t v = 0; v < frames[size_t(f)].radiosity.size(); ++v) {
+            const Vec3f b = frames[size_t(f)].radiosity[v];
+            ASSERT_TRUE(isFinite(b) && isFinite(frames[size_t(f)].normals[v]));
+            if (hidden) {
+                EXPECT_EQ(maxComponent(b), 0.0f) << v;
+                EXPECT_EQ(frames[size_t(f)].normals[v].y, 1.0f) << "the last finite normal is kept";
+            } else {
+                EXPECT_GT(b.y, 0.0f) << v;
+                EXPECT_EQ(b.y, frames[0].radiosity[v].y) << v;
+            }
+        }
+    }
 }
 
 TEST(HostileInput, MemoryBeyondTheProcesssLimitIsRefusedNamingTheLimit) {

@@ -80,7 +80,8 @@ Transform parseNodeTransform(const json& j, const std::string& file, const std::
         }
         t = Transform::fromTRS(tr, rot, sc);
     }
-    if (!t.isInvertible()) throw InputError(file, place, "transform is not invertible");
+    // A singular transform (a zero scale) hides the node for the frame (DESIGN §3).
+    if (!t.isFinite()) throw InputError(file, place, "transform is not finite");
     return t;
 }
 
@@ -215,10 +216,11 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
         const Pose p = a.poseAt(frame);
         for (int node : a.sampled_->animated) {
             const Transform& t = p.locals[size_t(node)];
-            if (!t.isInvertible())
+            // A singular one (a zero scale) hides the node for the frame (DESIGN §3).
+            if (!t.isFinite())
                 throw InputError(source, "frame " + std::to_string(frame) + " (" + std::to_string(frame / fps) +
                                              " s), node '" + scene.nodes[node].name + "'",
-                                 "the animated transform is not invertible (a zero scale?), which qsgi cannot light");
+                                 "the animated transform is not finite");
             if (!(t == first.locals[size_t(node)])) moved.insert(node);
         }
         for (size_t node = 0; node < p.morphWeights.size(); ++node)

@@ -153,14 +153,25 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world, const st
         return total > 0 ? blend : world;  // a vertex no joint holds stays with its node
     };
     const bool transformNormals = !objectNormal.empty();
-    const Transform rigidNormals = transformNormals && !skinned ? world.normalMatrix() : Transform();
+    const bool rigidHidden = !skinned && !world.isInvertible();
+    const Transform rigidNormals = transformNormals && !skinned && !rigidHidden ? world.normalMatrix() : Transform();
     for (uint32_t i = 0; i < inst.vertexCount; ++i) {
+        const uint32_t v = inst.firstVertex + i;
         const Transform m = skinned ? vertexTransform(i) : world;
-        positions[inst.firstVertex + i] = Vec3f(m.applyPoint(objectPosition[i]) - worldOrigin);
+        const bool hidden = skinned ? !m.isInvertible() : rigidHidden;
+        vertexHidden[v] = hidden;
+        // A hidden rigid instance shrinks to a point: a zero on one axis alone would leave
+        // triangles with area that still block.
+        positions[v] = Vec3f((rigidHidden ? m.applyPoint(Vec3d(0.0)) : m.applyPoint(objectPosition[i])) - worldOrigin);
+        if (hidden) {
+            // The last finite normal stays; one never placed visible takes its object-space normal.
+            if (!(dot(normals[v], normals[v]) > 0)) normals[v] = objectNormal.empty() ? Vec3f(0, 1, 0) : Vec3f(normalize(objectNormal[i]));
+            continue;
+        }
         if (transformNormals) {
             Vec3d n = normalize((skinned ? m.normalMatrix() : rigidNormals).applyVector(objectNormal[i]));
             if (!(dot(n, n) > 0) || !isFinite(Vec3f(n))) n = Vec3d(0, 1, 0);  // a degenerate blend: any unit normal
-            normals[inst.firstVertex + i] = Vec3f(n);
+            normals[v] = Vec3f(n);
         }
     }
     if (!transformNormals) {
@@ -173,6 +184,7 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world, const st
             for (uint32_t k = 0; k < 3; ++k) sum[tri.v[k] - inst.firstVertex] += n;
         }
         for (uint32_t i = 0; i < inst.vertexCount; ++i) {
+            if (vertexHidden[inst.firstVertex + i]) continue;
             Vec3d n = normalize(sum[i]);
             // A vertex of degenerate triangles only: any unit normal keeps estimators finite.
             if (dot(n, n) == 0) n = Vec3d(0, 1, 0);
@@ -314,7 +326,8 @@ void Scene::addInstance(int node, std::vector<Vec3f> objectPositions, std::vecto
     inst.objectPositions = std::move(objectPositions);
     inst.objectNormals = std::move(objectNormals);
     positions.resize(positions.size() + inst.vertexCount);
-    normals.resize(normals.size() + inst.vertexCount);
+    normals.resize(normals.size() + inst.vertexCount, Vec3f(0.0f));
+    vertexHidden.resize(vertexHidden.size() + inst.vertexCount, 0);
     vertexMaterial.resize(vertexMaterial.size() + inst.vertexCount, material);
     for (size_t t = 0; t + 2 < indices.size(); t += 3) {
         // A mirroring transform reverses the winding; swapping keeps the front side CCW in world space.

@@ -130,6 +130,12 @@ struct Scene {
     std::vector<uint32_t> vertexMaterial;
     std::vector<Triangle> triangles;
     std::vector<uint32_t> triangleMaterial;
+    // A vertex is hidden while its transform is singular — a zero scale, on any axis, is how glTF
+    // animates visibility (DESIGN §3). A hidden rigid instance is collapsed to its node's origin,
+    // so its zero-area triangles block and receive nothing; a skinned vertex goes where its
+    // singular blend puts it. Hidden vertices keep their last finite normal and carry radiosity 0
+    // (computeRadiosity).
+    std::vector<uint8_t> vertexHidden;
 
     // Dynamic = under a node the animation moves (DESIGN §2). Filled by markDynamic.
     std::vector<uint8_t> vertexDynamic;
