@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
 
     CLI::App* inspect = app.add_subcommand(
         "inspect", "what a render of this scene would see: meshes, materials, lights, cameras, what moves, the radius, warnings");
-    const BoundOptions inspectOptions = addRenderOptions(inspect, {"SCENE", "--animation", "--config", "--fps"});
+    const BoundOptions inspectOptions = addRenderOptions(inspect, {"SCENE", "--animation", "--config", "--fps", "--strict"});
     bool inspectJson = false;
     inspect->add_flag("--json", inspectJson, "print JSON instead of text");
 

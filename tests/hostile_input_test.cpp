@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -164,6 +166,59 @@ TEST(HostileInput, AZeroScaleInATransformFileHidesTheNode) {
             }
         }
     }
+}
+
+// The contract of issue 23: an error in an object the render reads is exit 2 naming it; the
+// same error in an object nothing reads is a warning naming it; --strict refuses those too.
+TEST(HostileInput, ErrorsInUnusedObjectsWarnAndStrictRefusesThem) {
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(dataDir() / "good" / "base.gltf"));
+    doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 1.0}, {"zfar", 0.5}}}}};
+    doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {2, 1, 1, 1}}}}}};
+    nlohmann::json beyond = doc["accessors"][0];
+    beyond["byteOffset"] = 4000;  // past the end of its view
+    doc["accessors"].push_back(beyond);
+    nlohmann::json noBounds = doc["accessors"][0];
+    noBounds.erase("min");
+    noBounds.erase("max");
+    doc["accessors"].push_back(noBounds);
+    const int noBoundsAccessor = int(doc["accessors"].size()) - 1;
+    doc["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", noBoundsAccessor}}}, {"material", 0}}}}});
+    doc["nodes"].push_back({{"name", "Sheared"}, {"matrix", {1, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}});
+    const std::map<std::string, std::string> unused = {
+        {"cameras[0]", "zfar"}, {"materials[0]", "baseColorFactor"}, {"accessors[" + std::to_string(noBoundsAccessor - 1) + "]", "past the end"},
+        {"meshes[1]", "min and max"}, {"nodes[2]", "shears"}};
+    const fs::path dir = testScratchDir("hostile-unused");
+    auto write = [&](const std::string& name, const nlohmann::json& d) {
+        std::ofstream(dir / name) << d.dump();
+        return (dir / name).string();
+    };
+    const std::string file = write("unused.gltf", doc);
+    const CommandResult lenient = runQsgi("inspect " + file);
+    ASSERT_EQ(lenient.exitCode, 0) << lenient.output;
+    for (const auto& [object, rule] : unused) {
+        const size_t at = lenient.output.find(object + " is not in the rendered scene");
+        EXPECT_NE(at, std::string::npos) << object << "\n" << lenient.output;
+        const size_t lineStart = lenient.output.rfind('\n', at);
+        EXPECT_NE(lenient.output.substr(lineStart, at - lineStart).find(rule), std::string::npos) << object << ": " << rule;
+    }
+    const CommandResult strict = runQsgi("inspect --strict " + file);
+    EXPECT_EQ(strict.exitCode, 2) << strict.output;
+    EXPECT_NE(strict.output.find("--strict refuses it"), std::string::npos) << strict.output;
+    EXPECT_EQ(std::count(strict.output.begin(), strict.output.end(), '\n'), 1) << strict.output;
+
+    // Put each object where the render reads it: refused without --strict, naming it.
+    auto used = [&](const std::string& name, const std::function<void(nlohmann::json&)>& edit, const std::string& names) {
+        nlohmann::json d = doc;
+        edit(d);
+        const CommandResult r = runQsgi("inspect " + write(name, d));
+        EXPECT_EQ(r.exitCode, 2) << name << ": " << r.output;
+        EXPECT_NE(r.output.find(names), std::string::npos) << name << ": " << r.output;
+        EXPECT_EQ(r.output.find("not in the rendered scene"), std::string::npos) << name << ": " << r.output;
+    };
+    used("camera.gltf", [](nlohmann::json& d) { d["nodes"][0]["camera"] = 0; }, "cameras[0]");
+    used("material.gltf", [](nlohmann::json& d) { d["meshes"][0]["primitives"][0]["material"] = 0; }, "materials[0]");
+    used("mesh.gltf", [](nlohmann::json& d) { d["nodes"][0]["mesh"] = 1; }, "min and max");
+    used("node.gltf", [](nlohmann::json& d) { d["scenes"][0]["nodes"].push_back(2); }, "nodes[2]");
 }
 
 TEST(HostileInput, MemoryBeyondTheProcesssLimitIsRefusedNamingTheLimit) {

@@ -70,7 +70,7 @@ Camera resolveCamera(const RenderSettings& s, const Scene& scene, Warnings& warn
 RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     : settings_(std::move(settings)), scene_(), animation_() {
     validateSettings(settings_);
-    scene_ = loadGltfScene(settings_.scenePath, warnings);
+    scene_ = loadGltfScene(settings_.scenePath, warnings, GltfReadOptions{settings_.strict});
     for (PunctualLight light : settings_.extraLights) {
         light.position = Vec3f(Vec3d(light.position) - scene_.worldOrigin);
         scene_.lights.push_back(light);

@@ -126,6 +126,11 @@ std::vector<RenderOption> declareOptions() {
                      s.animationPath = gltfAnimationSelector(a, src.file) ? a : resolved(a, src);
                  },
                  [](const RenderSettings& s) { return s.animationPath.empty() ? json(nullptr) : json(s.animationPath); }});
+    o.push_back({"strict", "--strict", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "refuse (exit 2) glTF errors in objects the render does not use, which are otherwise warnings; for "
+                 "pipelines that gate exporters",
+                 false, true, [](RenderSettings& s, const json& v, const OptionSource&) { s.strict = v; },
+                 [](const RenderSettings& s) { return json(s.strict); }});
     o.push_back({"fps", "--fps", T::Number, 0, 1e6, "", {}, true, "F", "24",
                  "frames per second at which a glTF animation is sampled (glTF has no frame rate)", true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.fps = v.get<double>(); },

@@ -24,6 +24,7 @@ struct FrameRange {
 struct RenderSettings {
     std::string configPath;     // the config file read, if any (for messages)
     std::string scenePath;
+    bool strict = false;  // glTF errors in unused objects refused, not warned (GltfReadOptions)
     std::string animationPath;  // empty: no animation (one frame, 0); "gltf" or "gltf:N": the scene's own
     std::optional<double> fps;  // frames per second at which a glTF animation is sampled (default 24)
     std::string outDir = "out";

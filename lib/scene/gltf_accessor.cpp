@@ -46,6 +46,7 @@ AccessorData AccessorReader::read(int accessorIndex, const std::string& usedBy, 
     if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
         throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) +
                                             ", which does not exist");
+    read_.insert(accessorIndex);
     const tinygltf::Accessor& acc = model_.accessors[accessorIndex];
     checkFormat(acc, format, place);
     AccessorData out;
@@ -53,8 +54,7 @@ AccessorData AccessorReader::read(int accessorIndex, const std::string& usedBy, 
     out.components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
     refuseBeyondMemory(saturatingMultiply(acc.count, uint64_t(out.components) * sizeof(double)), file_, place,
                        "its " + std::to_string(acc.count) + " elements");
-    if (acc.bufferView >= 0)
-        checkRange(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, out.components, place);
+    checkLayout(acc, out.components, place);
     out.values.assign(acc.count * size_t(out.components), 0.0);
     // Without a bufferView the elements are zeros, typically overridden by sparse values.
     if (acc.bufferView >= 0)
@@ -64,6 +64,33 @@ AccessorData AccessorReader::read(int accessorIndex, const std::string& usedBy, 
     for (double v : out.values)
         if (!std::isfinite(v)) throw InputError(file_, place, "holds a non-finite number (NaN or Inf)");
     return out;
+}
+
+void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) const {
+    if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
+        throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) + ", which does not exist");
+    const tinygltf::Accessor& acc = model_.accessors[size_t(accessorIndex)];
+    const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
+    if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
+        throw InputError(file_, usedBy, "unknown accessor type or componentType");
+    checkLayout(acc, components, usedBy);
+}
+
+void AccessorReader::checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place) const {
+    if (acc.bufferView >= 0) checkRange(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, components, place);
+    if (!acc.sparse.isSparse) return;
+    if (acc.sparse.count < 1 || size_t(acc.sparse.count) > acc.count)
+        throw InputError(file_, place + ".sparse.count", std::to_string(acc.sparse.count) +
+                                                             " is outside 1..count of the accessor");
+    const size_t n = size_t(acc.sparse.count);
+    const int indexType = acc.sparse.indices.componentType;
+    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        throw InputError(file_, place + ".sparse.indices.componentType", "must be an unsigned integer type");
+    checkRange(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, 1,
+               place + ".sparse.indices");
+    checkRange(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType, components,
+               place + ".sparse.values");
 }
 
 void AccessorReader::checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const {
@@ -161,18 +188,9 @@ double AccessorReader::component(const unsigned char* p, int type, bool normaliz
 }
 
 void AccessorReader::applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const {
-    if (acc.sparse.count < 1 || size_t(acc.sparse.count) > out.count)
-        throw InputError(file_, place + ".sparse.count", std::to_string(acc.sparse.count) +
-                                                             " is outside 1..count of the accessor");
+    // checkLayout has checked the count, the index type and both ranges.
     const size_t n = size_t(acc.sparse.count);
     const int indexType = acc.sparse.indices.componentType;
-    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-        throw InputError(file_, place + ".sparse.indices.componentType", "must be an unsigned integer type");
-    checkRange(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, 1,
-               place + ".sparse.indices");
-    checkRange(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType,
-               out.components, place + ".sparse.values");
     std::vector<size_t> targets(n);
     decode(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, false, 1, nullptr,
            &targets);

@@ -48,6 +48,13 @@ public:
     // Throws InputError naming the file and the place.
     AccessorData read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const;
 
+    // Checks an accessor nothing reads as read() would check its layout (it exists, its type
+    // and componentType are known, its elements and sparse parts lie inside their views and
+    // buffers), without decoding or allocating anything.
+    void checkUnread(int accessorIndex, const std::string& usedBy) const;
+    // Whether read() was called for the accessor (whatever it found): the objects the render used.
+    bool wasRead(int accessorIndex) const { return read_.count(accessorIndex) > 0; }
+
     // The bytes of a whole buffer view (an embedded image, say), after checking that the view and
     // its buffer exist and that the view lies inside the buffer. `usedBy` names the referring place.
     struct Bytes {
@@ -60,6 +67,8 @@ private:
     // The view, checked as viewBytes checks it.
     const tinygltf::BufferView& checkedView(int viewIndex, const std::string& place) const;
     void checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const;
+    // The elements' and the sparse parts' ranges, the sparse count and index type.
+    void checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place) const;
     // Checks that `count` elements from a buffer view lie inside the view and its buffer, with
     // the alignment and stride the specification requires.
     void checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
@@ -75,6 +84,7 @@ private:
     const std::set<int>& absentBuffers_;
     std::string file_;
     bool quantized_ = false;
+    mutable std::set<int> read_;
 };
 
 }  // namespace qsgi

@@ -172,12 +172,21 @@ Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTr
     return t;
 }
 
-std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::string& file) {
+// The node tree. A node whose own transform breaks the rules is given the identity, and the
+// error kept in `transformErrors` for the caller, who refuses it if the render uses the node
+// and warns otherwise; a broken tree (a missing child, two parents, a cycle) is refused at once.
+std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::string& file,
+                                      std::map<int, InputError>& transformErrors) {
     std::vector<SceneNode> nodes(model.nodes.size());
     for (size_t i = 0; i < model.nodes.size(); ++i) {
         nodes[i].name = model.nodes[i].name;
         nodes[i].trs = nodeTrs(model.nodes[i]);
-        nodes[i].local = nodeLocalTransform(model.nodes[i], nodes[i].trs, file, int(i));
+        try {
+            nodes[i].local = nodeLocalTransform(model.nodes[i], nodes[i].trs, file, int(i));
+        } catch (const InputError& e) {
+            transformErrors.emplace(int(i), e);
+            nodes[i].trs.reset();
+        }
         for (int c : model.nodes[i].children) {
             if (c < 0 || c >= int(nodes.size()))
                 throw InputError(file, gltfPlace("nodes", int(i)) + ".children", "refers to node " + std::to_string(c) + ", which does not exist");
@@ -231,15 +240,22 @@ std::vector<uint32_t> triangleIndices(int mode, const std::vector<uint32_t>& idx
 
 class SceneBuilder {
 public:
-    SceneBuilder(const GltfDocument& document, const std::string& file, Warnings& warnings)
-        : model_(document.model), file_(file), warnings_(warnings), reader_(document, file) {}
+    SceneBuilder(const GltfDocument& document, const std::string& file, Warnings& warnings, const GltfReadOptions& options)
+        : model_(document.model), file_(file), warnings_(warnings), options_(options), reader_(document, file) {}
 
     Scene build() {
         Scene scene;
         scene.sourcePath = file_;
-        scene.nodes = buildHierarchy(model_, file_);
-        for (size_t i = 0; i < model_.materials.size(); ++i)
-            scene.materials.push_back(convertMaterial(model_, reader_, int(i), file_, warnings_));
+        std::map<int, InputError> nodeErrors, materialErrors;
+        scene.nodes = buildHierarchy(model_, file_, nodeErrors);
+        for (size_t i = 0; i < model_.materials.size(); ++i) {
+            try {
+                scene.materials.push_back(convertMaterial(model_, reader_, int(i), file_, warnings_));
+            } catch (const InputError& e) {
+                materialErrors.emplace(int(i), e);  // refused below if a rendered primitive uses it
+                scene.materials.push_back(Material{"(unusable)", Vec3f(1.0f), Vec3f(0.0f)});
+            }
+        }
         defaultMaterial_ = uint32_t(scene.materials.size());
         scene.materials.push_back(Material{"(default)", Vec3f(1.0f), Vec3f(0.0f)});
 
@@ -273,18 +289,83 @@ public:
         }
         scene.cameras.resize(model_.cameras.size());
         scene.animations = readGltfAnimations(model_, reader_, file_, warnings_);
+        // What the render used is now known: errors there are refusals, errors elsewhere warnings.
+        std::vector<uint8_t> usedNodes = visited;
+        for (const auto& [gltfSkin, sceneSkin] : skinOf_)
+            for (int j : scene.skins[size_t(sceneSkin)].joints) usedNodes[size_t(j)] = 1;
+        for (const auto& [n, e] : nodeErrors)
+            if (usedNodes[size_t(n)]) throw e;
+        for (const auto& [m, e] : materialErrors)
+            if (usedMaterials_.count(m)) throw e;
+        for (const auto& [n, e] : nodeErrors) unusedObjectError(e, gltfPlace("nodes", n));
+        for (const auto& [m, e] : materialErrors) unusedObjectError(e, gltfPlace("materials", m));
+        checkUnusedObjects(scene);
         scene.finalize();
         checkSceneExtent(scene.positions, scene.bounds(), file_, "nodes");
         return scene;
     }
 
 private:
+    // An error in an object the render does not use (glTF objects nothing in the default scene
+    // reaches): a warning naming it, or, under --strict, a refusal.
+    void unusedObjectError(const InputError& e, const std::string& object) {
+        if (options_.strict)
+            throw InputError(e.file(), e.place(), e.problem() + " (" + object + " is not in the rendered scene; --strict refuses it)");
+        warnings_.add(std::string(e.what()) + " (" + object + " is not in the rendered scene, so it is ignored)");
+    }
+
+    // The meshes, skins, cameras and accessors the default scene does not reach are checked by
+    // the same code that reads the used ones, into a scratch scene that is thrown away.
+    void checkUnusedObjects(const Scene& scene) {
+        Scene scratch;
+        scratch.materials = scene.materials;
+        scratch.nodes.resize(1);
+        const std::map<int, int> usedSkins = skinOf_;
+        for (size_t m = 0; m < model_.meshes.size(); ++m) {
+            if (usedMeshes_.count(int(m))) continue;
+            try {
+                if (model_.meshes[m].primitives.empty())
+                    throw InputError(file_, gltfPlace("meshes", int(m)) + ".primitives", "is empty (glTF requires at least one primitive)");
+                for (size_t p = 0; p < model_.meshes[m].primitives.size(); ++p)
+                    addPrimitive(scratch, 0, Transform(), model_.meshes[m].primitives[p],
+                                 gltfPlace("meshes", int(m)) + "." + gltfPlace("primitives", int(p)), -1, {});
+            } catch (const InputError& e) {
+                unusedObjectError(e, gltfPlace("meshes", int(m)));
+            }
+        }
+        for (size_t s = 0; s < model_.skins.size(); ++s) {
+            if (usedSkins.count(int(s))) continue;
+            try {
+                addSkin(scratch, int(s), gltfPlace("skins", int(s)));
+            } catch (const InputError& e) {
+                unusedObjectError(e, gltfPlace("skins", int(s)));
+            }
+        }
+        for (size_t c = 0; c < model_.cameras.size(); ++c) {
+            if (scene.cameras[c]) continue;
+            try {
+                readLens(int(c));
+            } catch (const InputError& e) {
+                unusedObjectError(e, gltfPlace("cameras", int(c)));
+            }
+        }
+        for (size_t a = 0; a < model_.accessors.size(); ++a) {
+            if (reader_.wasRead(int(a))) continue;
+            try {
+                reader_.checkUnread(int(a), gltfPlace("accessors", int(a)));
+            } catch (const InputError& e) {
+                unusedObjectError(e, gltfPlace("accessors", int(a)));
+            }
+        }
+    }
+
     void visitNode(Scene& scene, int n, const Transform& world) {
         const tinygltf::Node& node = model_.nodes[n];
         if (node.mesh >= 0) {
             if (node.mesh >= int(model_.meshes.size()))
                 throw InputError(file_, gltfPlace("nodes", n) + ".mesh", "refers to mesh " + std::to_string(node.mesh) + ", which does not exist");
             const tinygltf::Mesh& mesh = model_.meshes[node.mesh];
+            usedMeshes_.insert(node.mesh);
             if (mesh.primitives.empty())
                 throw InputError(file_, gltfPlace("meshes", node.mesh) + ".primitives",
                                  "is empty (glTF requires at least one primitive), and node " + std::to_string(n) + " uses the mesh");
@@ -385,6 +466,7 @@ private:
             if (prim.material >= int(model_.materials.size()))
                 throw InputError(file_, place + ".material", "refers to material " + std::to_string(prim.material) + ", which does not exist");
             material = uint32_t(prim.material);
+            usedMaterials_.insert(prim.material);
         }
 
         std::vector<Vec3f> objectPositions(vertexCount);
@@ -518,44 +600,51 @@ private:
         const tinygltf::Node& node = model_.nodes[n];
         if (node.camera >= int(model_.cameras.size()))
             throw InputError(file_, gltfPlace("nodes", n) + ".camera", "refers to a camera that does not exist");
-        const tinygltf::Camera& cam = model_.cameras[node.camera];
         scene.cameras.resize(model_.cameras.size());
         if (scene.cameras[node.camera]) return;  // the first node using a camera places it
-        Camera lens;
+        Camera lens = readLens(node.camera);
         lens.node = n;
-        if (cam.type == "perspective") {
-            lens.yfov = float(cam.perspective.yfov);
-            lens.aspect = float(cam.perspective.aspectRatio);
-            lens.znear = float(cam.perspective.znear);
-            if (!(lens.yfov > 0 && lens.yfov < 3.14159f))
-                throw InputError(file_, gltfPlace("cameras", node.camera) + ".perspective.yfov", "must lie in (0, pi)");
-        } else if (cam.type == "orthographic") {
-            lens.projection = Projection::Orthographic;
-            // The specification forbids zero magnifications and advises against negative ones.
-            const double xmag = std::fabs(cam.orthographic.xmag), ymag = std::fabs(cam.orthographic.ymag);
-            if (!(xmag > 0 && ymag > 0 && xmag < 1e30 && ymag < 1e30))
-                throw InputError(file_, gltfPlace("cameras", node.camera) + ".orthographic",
-                                 "xmag and ymag must be non-zero and finite");
-            lens.ymag = float(ymag);
-            lens.aspect = float(xmag / ymag);
-            lens.znear = float(cam.orthographic.znear);
-        } else {
-            throw InputError(file_, gltfPlace("cameras", node.camera) + ".type",
-                             "'" + cam.type + "' is not perspective or orthographic");
-        }
-        if (!(lens.znear >= 0) || !std::isfinite(lens.znear))
-            throw InputError(file_, gltfPlace("cameras", node.camera), "znear must be non-negative and finite");
-        // zfar: beyond znear (a perspective camera may omit it: infinite).
-        const double zfar = cam.type == "perspective" ? cam.perspective.zfar : cam.orthographic.zfar;
-        if ((cam.type == "orthographic" || zfar != 0) && !(zfar > lens.znear))
-            throw InputError(file_, gltfPlace("cameras", node.camera) + "." + cam.type + ".zfar",
-                             "must lie beyond znear (" + std::to_string(lens.znear) + ")");
         // World space here: Scene::finalize re-centres it with the lights.
         const Camera c = placeCamera(lens, world, Vec3d(0.0));
         if (!isFinite(c.position) || !isFinite(c.forward) || !isFinite(c.up))
             throw InputError(file_, gltfPlace("nodes", n), "the camera node's transform is not finite or not invertible");
         scene.cameras[node.camera] = c;
         if (!scene.camera) scene.camera = c;
+    }
+
+    // glTF camera `index`'s lens, checked as glTF 2.0 (§5.12) requires.
+    Camera readLens(int index) const {
+        const tinygltf::Camera& cam = model_.cameras[size_t(index)];
+        const int camera = index;  // as the messages name it
+        Camera lens;
+        if (cam.type == "perspective") {
+            lens.yfov = float(cam.perspective.yfov);
+            lens.aspect = float(cam.perspective.aspectRatio);
+            lens.znear = float(cam.perspective.znear);
+            if (!(lens.yfov > 0 && lens.yfov < 3.14159f))
+                throw InputError(file_, gltfPlace("cameras", camera) + ".perspective.yfov", "must lie in (0, pi)");
+        } else if (cam.type == "orthographic") {
+            lens.projection = Projection::Orthographic;
+            // The specification forbids zero magnifications and advises against negative ones.
+            const double xmag = std::fabs(cam.orthographic.xmag), ymag = std::fabs(cam.orthographic.ymag);
+            if (!(xmag > 0 && ymag > 0 && xmag < 1e30 && ymag < 1e30))
+                throw InputError(file_, gltfPlace("cameras", camera) + ".orthographic",
+                                 "xmag and ymag must be non-zero and finite");
+            lens.ymag = float(ymag);
+            lens.aspect = float(xmag / ymag);
+            lens.znear = float(cam.orthographic.znear);
+        } else {
+            throw InputError(file_, gltfPlace("cameras", camera) + ".type",
+                             "'" + cam.type + "' is not perspective or orthographic");
+        }
+        if (!(lens.znear >= 0) || !std::isfinite(lens.znear))
+            throw InputError(file_, gltfPlace("cameras", camera), "znear must be non-negative and finite");
+        // zfar: beyond znear (a perspective camera may omit it: infinite).
+        const double zfar = cam.type == "perspective" ? cam.perspective.zfar : cam.orthographic.zfar;
+        if ((cam.type == "orthographic" || zfar != 0) && !(zfar > lens.znear))
+            throw InputError(file_, gltfPlace("cameras", camera) + "." + cam.type + ".zfar",
+                             "must lie beyond znear (" + std::to_string(lens.znear) + ")");
+        return lens;
     }
 
     void addLight(Scene& scene, int n, const Transform& world, const tinygltf::Value& ref) {
@@ -596,8 +685,10 @@ private:
     const tinygltf::Model& model_;
     const std::string& file_;
     Warnings& warnings_;
+    GltfReadOptions options_;
     AccessorReader reader_;
     std::map<int, int> skinOf_;  // glTF skin -> Scene::skins
+    std::set<int> usedMeshes_, usedMaterials_;
     uint32_t defaultMaterial_ = 0;
 };
 
@@ -605,7 +696,7 @@ private:
 
 namespace {
 
-Scene buildScene(const GltfDocument& document, const std::string& path, Warnings& warnings) {
+Scene buildScene(const GltfDocument& document, const std::string& path, Warnings& warnings, const GltfReadOptions& options) {
     const tinygltf::Model& model = document.model;
     for (const auto& ext : model.extensionsRequired) {
         // glTF 2.0 (§3.12): every required extension is also listed as used.
@@ -617,18 +708,18 @@ Scene buildScene(const GltfDocument& document, const std::string& path, Warnings
     for (const auto& ext : model.extensionsUsed)
         if (!kSupportedExtensions.count(ext)) warnings.add(path + ": extension " + ext + " is ignored");
 
-    return SceneBuilder(document, path, warnings).build();
+    return SceneBuilder(document, path, warnings, options).build();
 }
 
 }  // namespace
 
-Scene loadGltfScene(const std::string& path, Warnings& warnings) {
-    return buildScene(readGltfDocument(path, warnings), path, warnings);
+Scene loadGltfScene(const std::string& path, Warnings& warnings, const GltfReadOptions& options) {
+    return buildScene(readGltfDocument(path, warnings), path, warnings, options);
 }
 
 Scene loadGltfSceneFromMemory(const std::string& path, std::string bytes, const std::string& baseDir,
-                              Warnings& warnings) {
-    return buildScene(parseGltfDocument(path, std::move(bytes), baseDir, warnings), path, warnings);
+                              Warnings& warnings, const GltfReadOptions& options) {
+    return buildScene(parseGltfDocument(path, std::move(bytes), baseDir, warnings), path, warnings, options);
 }
 
 }  // namespace qsgi

@@ -9,11 +9,21 @@
 
 namespace qsgi {
 
-// Throws InputError naming the file and the place in it when the file cannot be used.
-// Recoverable oddities (ignored extensions, morph targets, missing images, …) go to warnings.
-Scene loadGltfScene(const std::string& path, Warnings& warnings);
+struct GltfReadOptions {
+    // Refuse errors in objects the render does not use (nodes outside the default scene, their
+    // meshes, skins, cameras, materials, accessors), which are otherwise warnings: for pipelines
+    // that gate exporters (--strict).
+    bool strict = false;
+};
+
+// Throws InputError naming the file and the place in it when the file cannot be used: any
+// error in what the render reads (the default scene's nodes, their meshes, accessors, materials,
+// skins and morph targets, the animations, the cameras used); errors elsewhere are warnings
+// (refusals under options.strict). Recoverable oddities (ignored extensions, missing images, …)
+// go to warnings.
+Scene loadGltfScene(const std::string& path, Warnings& warnings, const GltfReadOptions& options = {});
 // The same for a file in memory (see parseGltfDocument).
 Scene loadGltfSceneFromMemory(const std::string& path, std::string bytes, const std::string& baseDir,
-                              Warnings& warnings);
+                              Warnings& warnings, const GltfReadOptions& options = {});
 
 }  // namespace qsgi
