@@ -25,7 +25,8 @@ namespace {
 // A second mesh, "Blob" (a quad at y = 1), has one morph target lifting vertex 2 by (0, 0, 1),
 // its weight 0.25 at rest (mesh.weights) and animated from 0 to 1 over 1 s.
 // unweightedJoint: the joint vertex 0 names in its third influence, whose weight is 0.
-fs::path writeDeformingScene(const std::string& name, bool withFloorAndLamp, uint8_t unweightedJoint = 0) {
+fs::path writeDeformingScene(const std::string& name, bool withFloorAndLamp, uint8_t unweightedJoint = 0,
+                             float inverseBindCorner = 1) {
     testscenes::GltfWriter w;
     const int stripPositions = w.accessor({0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 0.2f, 0, 1, 0.2f, 0, 2, 0.2f, 0}, "VEC3");
     const int stripNormals = w.accessor({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
@@ -41,7 +42,7 @@ fs::path writeDeformingScene(const std::string& name, bool withFloorAndLamp, uin
                                   {"count", 6}, {"type", "VEC4"}});
     const int joints = int(w.doc["accessors"].size()) - 1;
     const int inverseBind = w.accessor({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,
-                                        1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1}, "MAT4");
+                                        1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, inverseBindCorner}, "MAT4");
     const int quad = w.accessor({-0.5f, 1, 0, 0.5f, 1, 0, 0.5f, 1.5f, 0, -0.5f, 1.5f, 0}, "VEC3");
     const int quadIndices = w.indices({0, 1, 2, 0, 2, 3});
     const int lift = w.accessor({0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}, "VEC3");
@@ -241,6 +242,37 @@ TEST(Deformation, AMeshDeformingInOneRegionRetracesAndRecomputesOnlyNearIt) {
 
 // A joint index names a joint of the skin even where its weight is 0 (glTF 2.0; issue 23): the
 // strip's skin has 2 joints, and vertex 0 names joint 7 with weight 0.
+// glTF 2.0 (§5.28): inverse bind matrices are affine. Only the last row is checked (a joint
+// under a non-uniformly scaled parent legitimately has a sheared one).
+TEST(Deformation, AnInverseBindMatrixWhoseLastRowIsNotAffineIsRefused) {
+    Warnings warnings;
+    try {
+        loadGltfScene(writeDeformingScene("ibm-projective", false, 0, 2.0f).string(), warnings);
+        ADD_FAILURE() << "a projective inverse bind matrix was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("skins[0].inverseBindMatrices"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("matrix 1"), std::string::npos) << e.what();
+    }
+}
+
+// A joint scaled to zero hides what it alone holds (glTF's visibility, DESIGN §3): the strip's
+// vertices weighted wholly to Tip, not those it shares with Root (their blend, ½ I, is invertible).
+TEST(Deformation, AJointScaledToZeroHidesTheVerticesItAloneHolds) {
+    Warnings warnings;
+    Scene scene = loadGltfScene(writeDeformingScene("joint-zero", false).string(), warnings);
+    const MeshInstance& strip = scene.instances[0];
+    std::vector<Transform> locals = scene.restLocals();
+    locals[1] = locals[1] * Transform::fromTRS(Vec3d(0.0), {0, 0, 0, 1}, Vec3d(0.0));
+    scene.applyPose(Pose(locals));
+    for (uint32_t v = 0; v < 6; ++v) {
+        const bool tipOnly = v == 2 || v == 5;
+        EXPECT_EQ(bool(scene.vertexHidden[strip.firstVertex + v]), tipOnly) << v;
+        EXPECT_TRUE(isFinite(scene.normals[strip.firstVertex + v]) && length(scene.normals[strip.firstVertex + v]) > 0.99f) << v;
+    }
+    scene.applyPose(scene.restPose());
+    for (uint32_t v = 0; v < 6; ++v) EXPECT_FALSE(scene.vertexHidden[strip.firstVertex + v]) << v;
+}
+
 TEST(Deformation, AJointIndexBeyondTheSkinIsRefusedEvenWithWeightZero) {
     Warnings warnings;
     EXPECT_NO_THROW(loadGltfScene(writeDeformingScene("joints-valid", false, 1).string(), warnings));

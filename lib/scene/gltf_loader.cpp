@@ -506,7 +506,16 @@ private:
             if (m.count < skin.joints.size())
                 throw InputError(file_, place + ".inverseBindMatrices", "has " + std::to_string(m.count) + " matrices for " +
                                                                           std::to_string(skin.joints.size()) + " joints");
-            for (size_t j = 0; j < skin.joints.size(); ++j) skin.inverseBind[j] = Transform::fromColumnMajor(&m.values[16 * j]);
+            for (size_t j = 0; j < skin.joints.size(); ++j) {
+                skin.inverseBind[j] = Transform::fromColumnMajor(&m.values[16 * j]);
+                // glTF 2.0 (§5.28): an inverse bind matrix is affine. Only its last row is checked:
+                // a joint under a non-uniformly scaled parent legitimately has a sheared one.
+                const Transform& ibm = skin.inverseBind[j];
+                if (ibm.at(3, 0) != 0 || ibm.at(3, 1) != 0 || ibm.at(3, 2) != 0 || ibm.at(3, 3) != 1)
+                    throw InputError(file_, place + ".inverseBindMatrices",
+                                     "matrix " + std::to_string(j) + " has a last row other than 0 0 0 1 (glTF requires "
+                                     "an affine matrix)");
+            }
         }
         scene.skins.push_back(std::move(skin));
         return skinOf_[index] = int(scene.skins.size()) - 1;

@@ -38,6 +38,13 @@ void checkSceneExtent(const std::vector<Vec3f>& positions, const Bounds3f& bound
         throw InputError(file, place, std::string("the scene spans ") + spans + " units; qsgi supports up to 1e15 "
                                       "(beyond that float areas overflow)");
     }
+    // An empty extent is a scene whose every node is hidden (a zero scale), which is allowed.
+    if (extent > 0 && extent < kMinSceneExtent) {
+        char spans[32];
+        std::snprintf(spans, sizeof spans, "%.3g", extent);
+        throw InputError(file, place, std::string("the scene spans only ") + spans + " units; qsgi supports down to "
+                                      "1e-9 (below that float areas underflow): scale the scene up");
+    }
 }
 
 void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, const std::string& configFile) {

@@ -103,9 +103,14 @@ struct Pose {
 // densities overflow (a triangle of side 1e19 has an area beyond float range), so a file or an
 // animation that places geometry further out is refused rather than rendered to Inf and NaN.
 constexpr double kMaxSceneExtent = 1e15;
+// The smallest, likewise: the estimators resolve detail down to 10^-6 of the scene's size
+// (sceneEpsilon), whose areas must stay normal floats (above 1.2e-38); a scene of 1e-9 units
+// keeps them above 1e-30. A scene scaled by 1e-30 reported "no lights" (its lamp's area had
+// underflowed to 0) instead of naming its scale.
+constexpr double kMinSceneExtent = 1e-9;
 
 // Throws InputError(file, place, …) if any vertex position is non-finite or `bounds` (the scene's
-// or its animation's) spans more than kMaxSceneExtent.
+// or its animation's) spans more than kMaxSceneExtent or less than kMinSceneExtent (but not 0).
 void checkSceneExtent(const std::vector<Vec3f>& positions, const Bounds3f& bounds, const std::string& file,
                       const std::string& place);
 

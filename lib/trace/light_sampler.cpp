@@ -14,6 +14,19 @@ namespace {
 // 0.25 s per 100,000 triangles on two cores, once per run.
 constexpr int kMapDepth = 8;
 
+// Every aimed light's map together holds at most what 64 full maps do: set-up time and memory
+// then stop growing with the light count (10,000 lights at 10 ms each took 100 s; issue 23). Past
+// 64 lights each map is a level coarser per factor 4: 10,000 lights get 2^4 × 2^4 cells each.
+// A coarser map is as unbiased (it is conservative at any depth) and aims a little less tightly,
+// which matters less as each light's share of the photons shrinks.
+constexpr double kMapCellBudget = 64.0 * double(1 << (2 * kMapDepth));
+
+int mapDepthFor(size_t aimedLights) {
+    int depth = kMapDepth;
+    while (depth > 2 && double(aimedLights) * double(uint64_t(1) << (2 * depth)) > kMapCellBudget) --depth;
+    return depth;
+}
+
 }  // namespace
 
 LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim,
@@ -47,6 +60,9 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         // One-sided Lambertian emitter: exitance π L_e over the area.
         emitters_.push_back({Emitter::Triangle, t, m.emission * (kPi * area), Vec3f(0.0f), -1, scene.geometricNormal(t)});
     }
+    size_t aimedLights = 0;
+    for (const Emitter& e : emitters_) aimedLights += aim.enabled && e.kind != Emitter::Triangle;
+    mapDepth_ = mapDepthFor(aimedLights);
     double unaimed = 0;
     for (Emitter& e : emitters_) {
         if (e.kind == Emitter::Triangle || !aim.enabled) {
@@ -114,7 +130,7 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
         a.axis = normalize(Vec3d(l.direction));
         a.halfSize = reach;
         targets = mapTargets(scene_, epsilon, settings.margin, [&](const Vec3d&) { return a.axis; });
-        a.map = footprintMap(centre, a.axis, a.halfSize, targets, kMapDepth);
+        a.map = footprintMap(centre, a.axis, a.halfSize, targets, mapDepth_);
         e.power = l.intensity * float(4 * reach * reach * a.map.keptFraction());
     } else {
         const Vec3d apex = Vec3d(l.position);
@@ -137,7 +153,7 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
             }
         }
         targets = mapTargets(scene_, epsilon, settings.margin, [&](const Vec3d& q) { return normalize(q - apex); });
-        a.map = directionMap(apex, a.axis, a.cosMax, spotAxis, a.spotAxis ? cosSpot : -1.0, targets, kMapDepth);
+        a.map = directionMap(apex, a.axis, a.cosMax, spotAxis, a.spotAxis ? cosSpot : -1.0, targets, mapDepth_);
         // A light inside the scene whose every direction may reach something emits as unaimed.
         if (a.map.keptFraction() == 1 && !outside && !a.spotAxis) return;
         e.power = l.intensity * float(2 * M_PI * (1 - a.cosMax) * a.map.keptFraction());

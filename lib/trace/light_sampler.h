@@ -90,6 +90,7 @@ private:
     Vec3f boundsCentre_;
     float boundsRadius_ = 0;
     float rayEpsilon_;
+    int mapDepth_ = 0;  // of every light's projection map: finer for fewer lights (mapDepthFor)
 };
 
 }  // namespace qsgi

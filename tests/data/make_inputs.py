@@ -382,6 +382,8 @@ bad("animation", "moves_the_light.json", anim([{"frame": 0}, {"frame": 1, "nodes
 bad("animation", "translation_overflows_float.json",
     anim([{"frame": 0}, {"frame": 1, "nodes": {"Floor": {"translation": [3.3e38, 0, 0], "scale": [1e38, 1, 1]}}}]),
     "supports up to 1e15")
+bad("gltf", "scene_scaled_1e-30.gltf", edited(lambda m: m["nodes"][0].update(scale=[1e-30, 1e-30, 1e-30])),
+    "spans only 2.83e-30 units")
 bad("animation", "scene_spans_too_far.json",
     anim([{"frame": 0}, {"frame": 1, "nodes": {"Floor": {"translation": [1e20, 0, 0]}}}]), "supports up to 1e15")
 bad("animation", "not_json.json", "frames: [0, 1, 2]", "not valid JSON")
