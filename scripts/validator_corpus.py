@@ -11,8 +11,11 @@ reason alone and say nothing about their real error. Each file is therefore run 
          not in the rendered scene, so qsgi should refuse the file when the error is in something it
          reads anyway, and at least warn about it otherwise; with --strict it should refuse (exit 2).
   all    the same, but with every original mesh and camera in the rendered scene (a new node for
-         each, appended), so the render uses every object the errors can be in: qsgi should refuse
-         every invalid file (exit 2).
+         each, appended) and every original root node, so the render uses every object the errors
+         can be in that a scene can reach: qsgi should refuse every invalid file (exit 2). An
+         object no scene can reach (an accessor no mesh reads, a texture no material names) is
+         still unread; a warning naming it as "not in the rendered scene" is then its class
+         (warned-unreachable), not "accepted".
 
 Valid files (numErrors 0) are also run unchanged ("original"); their variants must load. The
 original of a valid file may be refused for a reason of qsgi's own (it has no scene or no light),
@@ -30,7 +33,7 @@ errors, a missing "asset") counts as named by any refusal, since there is no obj
   scene           refused-own, refused-other (refused, naming something else), warned (loaded with a
                   warning naming the object), silent (loaded without one), crash
   scene --strict  refused, accepted, crash
-  all             refused-own, refused-other, accepted, crash
+  all             refused-own, refused-other, warned-unreachable, accepted, crash
   valid files     loaded, refused, crash (for "original", "scene", "scene --strict" and "all")
 
 A crash is any exit code other than 0 and 2: 1, a signal, or no answer within 60 s.
@@ -172,6 +175,11 @@ def appended_scene(doc, error_pointers, with_every_mesh_and_camera):
                              "name": APPENDED_NAME})
     scene_nodes = [append("nodes", {"mesh": mesh, "name": APPENDED_NAME})]
     if with_every_mesh_and_camera:
+        # The original hierarchy's roots too, so that their skins, weights and children are read.
+        original_nodes = len(doc["nodes"]) - 1
+        children = {c for n in doc["nodes"][:original_nodes] if isinstance(n, dict)
+                    for c in (n.get("children") if isinstance(n.get("children"), list) else []) if isinstance(c, int)}
+        scene_nodes += [n for n in range(original_nodes) if n not in children]
         scene_nodes += [append("nodes", {"mesh": i}) for i in range(mesh_count)]
         scene_nodes += [append("nodes", {"camera": j}) for j in range(len(doc.get("cameras", [])))]
     doc["scene"] = append("scenes", {"nodes": scene_nodes, "name": APPENDED_NAME})
@@ -344,6 +352,12 @@ def class_of_invalid(variant, run, names, whole_file):
         run["message"] = line or run["message"]
         return "refused-own" if whole_file or line else "refused-other"
     if variant == "all":
+        # Loaded with a warning that the flagged object is in no rendered scene: nothing the
+        # variant renders reaches it (an accessor no mesh reads, a texture no material names).
+        line = naming_line([w for w in run["warnings"] if "not in the rendered scene" in w], names)
+        if line:
+            run["message"] = line
+            return "warned-unreachable"
         return "accepted"
     line = naming_line(run["warnings"], names)
     run["message"] = line or run["message"]

@@ -133,8 +133,10 @@ TEST(Deformation, TwoBoneStripAndOneTargetMorphGiveHandWorkedPositions) {
 TEST(Deformation, SkinnedAndMorphingSamplesAnimateWithFiniteGeometry) {
     const fs::path models = sharedDir() / "data/gltf-samples/models";
     if (!fs::exists(models)) GTEST_SKIP() << "../shared is absent: " << models;
-    for (const char* file : {"Fox/glTF-Binary/Fox.glb", "CesiumMan/glTF-Binary/CesiumMan.glb",
-                             "RiggedFigure/glTF-Binary/RiggedFigure.glb", "MorphStressTest/glTF-Binary/MorphStressTest.glb"}) {
+    // CesiumMan was here; its weights do not sum to 1 (the glTF-Validator reports 19 errors), so
+    // it is refused now (GltfLoader.EveryValidAndModelSample…). Fox and RiggedFigure are skinned.
+    for (const char* file : {"Fox/glTF-Binary/Fox.glb", "RiggedFigure/glTF-Binary/RiggedFigure.glb",
+                             "MorphStressTest/glTF-Binary/MorphStressTest.glb"}) {
         SCOPED_TRACE(file);
         Warnings warnings;
         Scene scene = loadGltfScene((models / file).string(), warnings);

@@ -72,6 +72,9 @@ size_t primitiveModeTriangles(int model) { return (model <= 3 || (model >= 7 && 
 constexpr const char* kNoSharedSamples = "../shared/data/gltf-samples is absent (only beside the repository in CI)";
 fs::path samplesDir() { return sharedDir() / "data" / "gltf-samples"; }
 
+// The one sample of valid/ and models/ that the glTF-Validator itself rejects.
+constexpr const char* kValidatorRefuses = "models/CesiumMan/glTF-Binary/CesiumMan.glb";
+
 bool isGltf(const fs::path& p) { return p.extension() == ".gltf" || p.extension() == ".glb"; }
 
 }  // namespace
@@ -98,6 +101,18 @@ TEST(GltfLoader, EveryValidAndModelSampleLoadsWithTheDocumentedTriangleCount) {
             }
             Warnings warnings;
             Scene scene;
+            if (rel == kValidatorRefuses) {
+                // The Khronos glTF-Validator reports 19 errors in it (ACCESSOR_WEIGHTS_NON_NORMALIZED:
+                // sums as low as 0.185), so it is refused, naming the rule (issue 23).
+                try {
+                    loadGltfScene(entry.path().string(), warnings);
+                    ADD_FAILURE() << rel << " loaded although its weights do not sum to 1";
+                } catch (const InputError& e) {
+                    EXPECT_NE(e.problem().find("weights sum to"), std::string::npos) << e.what();
+                }
+                ++checked;
+                continue;
+            }
             ASSERT_NO_THROW(scene = loadGltfScene(entry.path().string(), warnings)) << rel;
             EXPECT_EQ(scene.triangleCount(), expected) << rel;
             for (const auto& p : scene.positions) ASSERT_TRUE(isFinite(p)) << rel;

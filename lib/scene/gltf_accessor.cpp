@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "util/error.h"
@@ -42,6 +43,12 @@ AccessorReader::AccessorReader(const GltfDocument& document, const std::string& 
 }
 
 AccessorData AccessorReader::read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const {
+    AccessorData out = readUnbounded(accessorIndex, usedBy, format);
+    checkDeclaredBounds(accessorIndex, out, usedBy);
+    return out;
+}
+
+AccessorData AccessorReader::readUnbounded(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const {
     const std::string place = usedBy + " -> " + gltfPlace("accessors", accessorIndex);
     if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
         throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) +
@@ -64,6 +71,56 @@ AccessorData AccessorReader::read(int accessorIndex, const std::string& usedBy, 
     for (double v : out.values)
         if (!std::isfinite(v)) throw InputError(file_, place, "holds a non-finite number (NaN or Inf)");
     return out;
+}
+
+void AccessorReader::checkDeclaredBounds(int accessorIndex, const AccessorData& data, const std::string& usedBy) const {
+    const tinygltf::Accessor& acc = model_.accessors[size_t(accessorIndex)];
+    const std::string place = usedBy + " -> " + gltfPlace("accessors", accessorIndex);
+    const int components = data.components;
+    if (data.count == 0) return;
+    // glTF 2.0 (§3.6.2.5): min and max, where given, are the elements' exact bounds, per component,
+    // in the components' own type (a normalised integer's raw value). They are compared here
+    // after the same normalisation, with a relative 10^-5 for the decimal digits a float loses.
+    auto normalised = [&](double raw) {
+        if (!acc.normalized) return raw;
+        switch (acc.componentType) {
+            case TINYGLTF_COMPONENT_TYPE_BYTE: return std::max(raw / 127.0, -1.0);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return raw / 255.0;
+            case TINYGLTF_COMPONENT_TYPE_SHORT: return std::max(raw / 32767.0, -1.0);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return raw / 65535.0;
+            default: return raw;
+        }
+    };
+    for (const auto* bound : {&acc.minValues, &acc.maxValues}) {
+        if (bound->empty()) continue;
+        if (int(bound->size()) != components)
+            throw InputError(file_, place, std::string(bound == &acc.minValues ? "min" : "max") + " has " +
+                                               std::to_string(bound->size()) + " numbers for " + std::to_string(components) +
+                                               " components");
+    }
+    if (acc.minValues.empty() && acc.maxValues.empty()) return;
+    for (int c = 0; c < components; ++c) {
+        double lowest = data(0, c), highest = data(0, c);
+        for (size_t e = 1; e < data.count; ++e) {
+            lowest = std::min(lowest, data(e, c));
+            highest = std::max(highest, data(e, c));
+        }
+        const double tolerance = 1e-5 * std::max({std::fabs(lowest), std::fabs(highest), 1e-30});
+        auto differs = [&](double declared, double actual) { return std::fabs(normalised(declared) - actual) > tolerance; };
+        auto text = [](double v) {
+            char out[32];
+            std::snprintf(out, sizeof out, "%.9g", v);
+            return std::string(out);
+        };
+        if (!acc.minValues.empty() && differs(acc.minValues[size_t(c)], lowest))
+            throw InputError(file_, place + ".min", "component " + std::to_string(c) + " is declared " +
+                                                        text(acc.minValues[size_t(c)]) + " but the elements' least is " +
+                                                        text(lowest) + " (glTF requires the exact bounds)");
+        if (!acc.maxValues.empty() && differs(acc.maxValues[size_t(c)], highest))
+            throw InputError(file_, place + ".max", "component " + std::to_string(c) + " is declared " +
+                                                        text(acc.maxValues[size_t(c)]) + " but the elements' greatest is " +
+                                                        text(highest) + " (glTF requires the exact bounds)");
+    }
 }
 
 void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) const {
@@ -115,6 +172,7 @@ const tinygltf::BufferView& AccessorReader::checkedView(int viewIndex, const std
     if (viewIndex < 0 || viewIndex >= int(model_.bufferViews.size()))
         throw InputError(file_, place, "refers to bufferView " + std::to_string(viewIndex) + ", which does not exist");
     const std::string viewPlace = gltfPlace("bufferViews", viewIndex);
+    viewsRead_.insert(viewIndex);
     const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
     if (view.buffer < 0 || view.buffer >= int(model_.buffers.size()))
         throw InputError(file_, viewPlace, "refers to a buffer that does not exist");

@@ -47,6 +47,12 @@ public:
     // The accessor's elements, checked against `format`; `usedBy` names the referring place.
     // Throws InputError naming the file and the place.
     AccessorData read(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const;
+    // The same, leaving the check of the accessor's declared min and max to the caller
+    // (checkDeclaredBounds), who has a more telling check to run first (indices beyond the
+    // vertices).
+    AccessorData readUnbounded(int accessorIndex, const std::string& usedBy, const AccessorFormat& format) const;
+    // The accessor's min and max, where given, against its elements (glTF 2.0 §3.6.2.5).
+    void checkDeclaredBounds(int accessorIndex, const AccessorData& data, const std::string& usedBy) const;
 
     // Checks an accessor nothing reads as read() would check its layout (it exists, its type
     // and componentType are known, its elements and sparse parts lie inside their views and
@@ -54,6 +60,8 @@ public:
     void checkUnread(int accessorIndex, const std::string& usedBy) const;
     // Whether read() was called for the accessor (whatever it found): the objects the render used.
     bool wasRead(int accessorIndex) const { return read_.count(accessorIndex) > 0; }
+    // Whether a read went through the buffer view (an accessor's, an embedded image's).
+    bool viewWasRead(int viewIndex) const { return viewsRead_.count(viewIndex) > 0; }
 
     // The bytes of a whole buffer view (an embedded image, say), after checking that the view and
     // its buffer exist and that the view lies inside the buffer. `usedBy` names the referring place.
@@ -84,7 +92,7 @@ private:
     const std::set<int>& absentBuffers_;
     std::string file_;
     bool quantized_ = false;
-    mutable std::set<int> read_;
+    mutable std::set<int> read_, viewsRead_;
 };
 
 }  // namespace qsgi

@@ -99,6 +99,11 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
 
             const AccessorData input = reader.read(sampler.input, samplerPlace + ".input", kTimeFormat);
             if (input.count == 0) throw InputError(file, samplerPlace + ".input", "has no key times");
+            // glTF 2.0 (§5.1.3): an animation input accessor states its bounds, as POSITION does.
+            const tinygltf::Accessor& times = model.accessors[size_t(sampler.input)];
+            if (times.minValues.size() != 1 || times.maxValues.size() != 1)
+                throw InputError(file, gltfPlace("accessors", sampler.input),
+                                 "is an animation input without min and max (glTF requires both)");
             for (size_t k = 0; k < input.count; ++k) {
                 if (input.values[k] < 0)
                     throw InputError(file, samplerPlace + ".input", "key time " + std::to_string(input.values[k]) +

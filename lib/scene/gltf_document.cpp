@@ -289,6 +289,7 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     refuseRemoteUris(path, doc, "images");
 
     GltfDocument out;
+    out.findings = findReferenceProblems(doc);
     out.absentBuffers = replaceAbsentBuffers(doc, binary);
     if (!out.absentBuffers.empty()) {
         std::string rewritten = doc.dump();

@@ -14,6 +14,7 @@
 #include <set>
 #include <string>
 
+#include "scene/gltf_references.h"
 #include "util/error.h"
 
 namespace qsgi {
@@ -21,6 +22,9 @@ namespace qsgi {
 struct GltfDocument {
     tinygltf::Model model;
     std::set<int> absentBuffers;  // buffers that have no data (no uri, not the BIN chunk)
+    // Broken references, empty arrays and cameras with two projections, wherever they are: the
+    // loader refuses those in objects the render reads and warns about the others.
+    std::vector<GltfFinding> findings;
 };
 
 // Throws InputError naming the file and the place in it; tinygltf's own warnings go to warnings.

@@ -50,6 +50,17 @@ const AccessorFormat kWeightsFormat{
      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
     {}};
 const AccessorFormat kMatrixFormat{TINYGLTF_TYPE_MAT4, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, {}};
+// The glTF-Validator's tolerances for unit vectors (normals) and quaternions.
+constexpr double kUnitVectorTolerance = 0.00674;
+constexpr double kUnitQuaternionTolerance = 0.00769;
+
+const AccessorFormat kColourRgbFormat{
+    TINYGLTF_TYPE_VEC3,
+    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
+     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
+    {}};
+const AccessorFormat kColourRgbaFormat{TINYGLTF_TYPE_VEC4, kColourRgbFormat.allowed, {}};
+
 const AccessorFormat kIndexFormat{
     TINYGLTF_TYPE_SCALAR,
     {{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false},
@@ -154,6 +165,12 @@ Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTr
         !(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
               n.rotation[3] * n.rotation[3] > 1e-12))
         throw InputError(file, place + ".rotation", "is a zero quaternion (a rotation must be a unit quaternion)");
+    if (n.rotation.size() == 4) {
+        const double norm = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] +
+                                      n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
+        if (!(std::fabs(norm - 1) <= kUnitQuaternionTolerance))
+            throw InputError(file, place + ".rotation", "has length " + std::to_string(norm) + ", not 1 (a rotation must be a unit quaternion)");
+    }
     const Transform t = trs ? trs->matrix() : Transform::fromColumnMajor(n.matrix.data());
     if (!t.isFinite()) throw InputError(file, place, "transform holds a non-finite number");
     if (!trs) {
@@ -241,7 +258,8 @@ std::vector<uint32_t> triangleIndices(int mode, const std::vector<uint32_t>& idx
 class SceneBuilder {
 public:
     SceneBuilder(const GltfDocument& document, const std::string& file, Warnings& warnings, const GltfReadOptions& options)
-        : model_(document.model), file_(file), warnings_(warnings), options_(options), reader_(document, file) {}
+        : model_(document.model), findings_(document.findings), file_(file), warnings_(warnings), options_(options),
+          reader_(document, file) {}
 
     Scene build() {
         Scene scene;
@@ -299,7 +317,14 @@ public:
             if (usedMaterials_.count(m)) throw e;
         for (const auto& [n, e] : nodeErrors) unusedObjectError(e, gltfPlace("nodes", n));
         for (const auto& [m, e] : materialErrors) unusedObjectError(e, gltfPlace("materials", m));
-        checkUnusedObjects(scene);
+        // Before the unused objects are checked: reading them marks accessors and views as read.
+        const UsedObjects used = usedObjects(scene, usedNodes);
+        checkUnusedObjects(scene, usedNodes);
+        for (const GltfFinding& f : findings_) {
+            const InputError e(file_, f.place, f.problem);
+            if (used.contains(f.object)) throw e;
+            unusedObjectError(e, f.object.empty() ? "it" : f.object);
+        }
         scene.finalize();
         checkSceneExtent(scene.positions, scene.bounds(), file_, "nodes");
         return scene;
@@ -314,15 +339,62 @@ private:
         warnings_.add(std::string(e.what()) + " (" + object + " is not in the rendered scene, so it is ignored)");
     }
 
-    // The meshes, skins, cameras and accessors the default scene does not reach are checked by
-    // the same code that reads the used ones, into a scratch scene that is thrown away.
-    void checkUnusedObjects(const Scene& scene) {
+    // Which top-level objects the render read, by name ("nodes[3]"); the document itself ("")
+    // is not one of them: what is wrong there (an empty top-level array) is in no object it reads.
+    struct UsedObjects {
+        std::set<std::string> names;
+        bool contains(const std::string& object) const { return names.count(object) > 0; }
+    };
+    UsedObjects usedObjects(const Scene& scene, const std::vector<uint8_t>& usedNodes) const {
+        UsedObjects used;
+        auto add = [&](const char* array, int index) { used.names.insert(gltfPlace(array, index)); };
+        for (size_t n = 0; n < usedNodes.size(); ++n)
+            if (usedNodes[n]) add("nodes", int(n));
+        for (int m : usedMeshes_) add("meshes", m);
+        for (int m : usedMaterials_) {
+            add("materials", m);
+            const tinygltf::Material& material = model_.materials[size_t(m)];
+            // The textures whose colours the render reads, and their images and samplers.
+            for (int t : {material.pbrMetallicRoughness.baseColorTexture.index, material.emissiveTexture.index}) {
+                if (t < 0 || t >= int(model_.textures.size())) continue;
+                add("textures", t);
+                if (model_.textures[size_t(t)].source >= 0) add("images", model_.textures[size_t(t)].source);
+                if (model_.textures[size_t(t)].sampler >= 0) add("samplers", model_.textures[size_t(t)].sampler);
+            }
+        }
+        for (size_t a = 0; a < model_.accessors.size(); ++a)
+            if (reader_.wasRead(int(a))) add("accessors", int(a));
+        for (size_t v = 0; v < model_.bufferViews.size(); ++v)
+            if (reader_.viewWasRead(int(v))) {
+                add("bufferViews", int(v));
+                add("buffers", model_.bufferViews[v].buffer);
+            }
+        for (const auto& [gltfSkin, sceneSkin] : skinOf_) add("skins", gltfSkin);
+        for (size_t c = 0; c < scene.cameras.size(); ++c)
+            if (scene.cameras[c]) add("cameras", int(c));
+        for (size_t a = 0; a < model_.animations.size(); ++a) add("animations", int(a));  // all are read
+        add("scenes", model_.defaultScene >= 0 ? model_.defaultScene : 0);
+        return used;
+    }
+
+    // The nodes, meshes, skins, cameras and accessors the default scene does not reach are
+    // checked by the same code that reads the used ones, into a scratch scene that is thrown away.
+    void checkUnusedObjects(const Scene& scene, const std::vector<uint8_t>& usedNodes) {
         Scene scratch;
         scratch.materials = scene.materials;
-        scratch.nodes.resize(1);
+        scratch.nodes = scene.nodes;
         const std::map<int, int> usedSkins = skinOf_;
+        const std::set<int> usedMeshes = usedMeshes_;
+        for (size_t n = 0; n < model_.nodes.size(); ++n) {
+            if (usedNodes[n]) continue;
+            try {
+                visitNode(scratch, int(n), Transform());
+            } catch (const InputError& e) {
+                unusedObjectError(e, gltfPlace("nodes", int(n)));
+            }
+        }
         for (size_t m = 0; m < model_.meshes.size(); ++m) {
-            if (usedMeshes_.count(int(m))) continue;
+            if (usedMeshes.count(int(m))) continue;
             try {
                 if (model_.meshes[m].primitives.empty())
                     throw InputError(file_, gltfPlace("meshes", int(m)) + ".primitives", "is empty (glTF requires at least one primitive)");
@@ -385,13 +457,67 @@ private:
                 addPrimitive(scene, n, world, mesh.primitives[p], place, skin, weights);
             }
         }
+        // glTF 2.0 (§5.25): a skin or morph weights belong to a node's mesh.
+        if (node.mesh < 0 && node.skin >= 0)
+            throw InputError(file_, gltfPlace("nodes", n) + ".skin", "is given on a node without a mesh");
+        if (node.mesh < 0 && !node.weights.empty())
+            throw InputError(file_, gltfPlace("nodes", n) + ".weights", "are given on a node without a mesh");
         if (node.camera >= 0) addCamera(scene, n, world);
         auto light = node.extensions.find("KHR_lights_punctual");
         if (light != node.extensions.end() && light->second.Has("light")) addLight(scene, n, world, light->second.Get("light"));
     }
 
+    // glTF 2.0 (§3.7.2.1): attribute names are the spec's semantics or custom ones starting
+    // with "_"; indexed sets (TEXCOORD_n, COLOR_n, JOINTS_n, WEIGHTS_n) count up from 0 without
+    // gaps; JOINTS_n comes with WEIGHTS_n; a morph target moves only attributes the primitive has.
+    void checkAttributeNames(const tinygltf::Primitive& prim, const std::string& place) const {
+        std::map<std::string, std::set<int>> sets;
+        for (const auto& [name, accessor] : prim.attributes) {
+            if (name == "POSITION" || name == "NORMAL" || name == "TANGENT" || (!name.empty() && name[0] == '_')) continue;
+            const size_t underscore = name.rfind('_');
+            const std::string family = underscore == std::string::npos ? name : name.substr(0, underscore);
+            const std::string number = underscore == std::string::npos ? "" : name.substr(underscore + 1);
+            const bool counted = !number.empty() && number.size() < 6 &&
+                                 number.find_first_not_of("0123456789") == std::string::npos && (number == "0" || number[0] != '0');
+            if (!counted || (family != "TEXCOORD" && family != "COLOR" && family != "JOINTS" && family != "WEIGHTS"))
+                throw InputError(file_, place + ".attributes." + name,
+                                 "is no attribute glTF defines (custom attributes start with '_')");
+            sets[family].insert(std::stoi(number));
+        }
+        for (const auto& [family, numbers] : sets)
+            if (*numbers.rbegin() != int(numbers.size()) - 1)
+                throw InputError(file_, place + ".attributes",
+                                 "has " + family + "_" + std::to_string(*numbers.rbegin()) + " without every " + family +
+                                     " set below it (glTF numbers them from 0 without gaps)");
+        if (sets["JOINTS"] != sets["WEIGHTS"])
+            throw InputError(file_, place + ".attributes", "has JOINTS_n and WEIGHTS_n sets that do not pair up");
+        for (size_t t = 0; t < prim.targets.size(); ++t)
+            for (const auto& [name, accessor] : prim.targets[t])
+                if (!prim.attributes.count(name))
+                    throw InputError(file_, place + "." + gltfPlace("targets", int(t)) + "." + name,
+                                     "morphs an attribute the primitive does not have");
+    }
+
+    // Attributes the render does not use still follow the rules of their semantics: vertex
+    // colours lie in [0, 1] (glTF 2.0 §3.7.2.1).
+    void checkColours(const tinygltf::Primitive& prim, const std::string& place) const {
+        for (const auto& [name, accessor] : prim.attributes) {
+            if (name.rfind("COLOR_", 0) != 0) continue;
+            const bool rgba = accessor >= 0 && accessor < int(model_.accessors.size()) &&
+                              model_.accessors[size_t(accessor)].type == TINYGLTF_TYPE_VEC4;
+            const AccessorData colours = reader_.read(accessor, place + ".attributes." + name, rgba ? kColourRgbaFormat : kColourRgbFormat);
+            for (size_t i = 0; i < colours.values.size(); ++i)
+                if (colours.values[i] < 0 || colours.values[i] > 1)
+                    throw InputError(file_, place + ".attributes." + name,
+                                     "vertex " + std::to_string(i / size_t(colours.components)) + " has a component " +
+                                         std::to_string(colours.values[i]) + " outside [0, 1]");
+        }
+    }
+
     void addPrimitive(Scene& scene, int nodeIndex, const Transform& world, const tinygltf::Primitive& prim,
                       const std::string& place, int skin, const std::vector<double>& morphWeights) {
+        checkAttributeNames(prim, place);
+        checkColours(prim, place);
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
             warnings_.add(file_ + ": point and line primitives are skipped");
@@ -415,6 +541,13 @@ private:
                 throw InputError(file_, place + ".attributes.NORMAL",
                                  "has " + std::to_string(normals->count) + " elements but POSITION has " +
                                      std::to_string(vertexCount) + " (attribute arrays must have equal lengths)");
+            // Unit length, within the glTF-Validator's own tolerance (0.00674).
+            for (size_t i = 0; i < normals->count; ++i) {
+                const double len = length(Vec3d((*normals)(i, 0), (*normals)(i, 1), (*normals)(i, 2)));
+                if (!(std::fabs(len - 1) <= kUnitVectorTolerance))
+                    throw InputError(file_, place + ".attributes.NORMAL", "vertex " + std::to_string(i) + "'s normal has length " +
+                                                                              std::to_string(len) + ", not 1 (glTF requires unit normals)");
+            }
         }
         for (const auto& [name, accessor] : prim.attributes) {
             if (accessor >= 0 && accessor < int(model_.accessors.size()) && model_.accessors[accessor].count != vertexCount)
@@ -432,7 +565,7 @@ private:
                     throw InputError(file_, gltfPlace("bufferViews", view) + ".byteStride",
                                      "is set on a view that holds indices (" + place + ".indices), which glTF forbids");
             }
-            const AccessorData idx = reader_.read(prim.indices, place + ".indices", kIndexFormat);
+            const AccessorData idx = reader_.readUnbounded(prim.indices, place + ".indices", kIndexFormat);
             indices.resize(idx.count);
             // The largest value of the index type means "primitive restart", which glTF forbids.
             const double restart = double((uint64_t(1) << (8 * tinygltf::GetComponentSizeInBytes(
@@ -448,6 +581,7 @@ private:
                                                                     std::to_string(vertexCount) + " vertices");
                 indices[i] = uint32_t(v);
             }
+            reader_.checkDeclaredBounds(prim.indices, idx, place + ".indices");
         } else {
             indices.resize(vertexCount);
             for (size_t i = 0; i < vertexCount; ++i) indices[i] = uint32_t(i);
@@ -536,22 +670,34 @@ private:
             jointSets.push_back(reader_.read(j->second, place + ".attributes." + j->first, kJointsFormat));
             weightSets.push_back(reader_.read(w->second, place + ".attributes." + w->first, kWeightsFormat));
         }
-        if (jointSets.empty()) {
-            warnings_.add(file_ + ": " + place + " is on a skinned node but has no JOINTS_0/WEIGHTS_0; it is not skinned");
-            return;
-        }
+        if (jointSets.empty())
+            throw InputError(file_, place + ".attributes",
+                             "has no JOINTS_0 and WEIGHTS_0, yet its node has a skin (glTF requires them)");
         const size_t n = instance.vertexCount;
         instance.skin = skin;
         instance.influences = int(4 * jointSets.size());
         instance.skinJoints.assign(n * size_t(instance.influences), 0);
         instance.skinWeights.assign(n * size_t(instance.influences), 0.0f);
+        std::vector<double> namedJoints;
         for (size_t v = 0; v < n; ++v) {
             double total = 0;
+            // The sum as the glTF-Validator forms it (in float), and its tolerance: 2e-7 a weight.
+            float floatTotal = 0, tolerance = 0;
+            namedJoints.clear();
             for (size_t s = 0; s < jointSets.size(); ++s)
                 for (int k = 0; k < 4; ++k) {
                     const double joint = jointSets[s](v, k), weight = weightSets[s](v, k);
                     if (weight < 0)
                         throw InputError(file_, place + ".attributes.WEIGHTS_" + std::to_string(s), "holds a negative weight");
+                    if (weight > 0) {
+                        if (std::find(namedJoints.begin(), namedJoints.end(), joint) != namedJoints.end())
+                            throw InputError(file_, place + ".attributes.JOINTS_" + std::to_string(s),
+                                             "vertex " + std::to_string(v) + " names joint " + std::to_string(size_t(joint)) +
+                                                 " twice with non-zero weights");
+                        namedJoints.push_back(joint);
+                        floatTotal += float(weight);
+                        tolerance += 2e-7f;
+                    }
                     // Every joint index names a joint of the skin, also where its weight is 0 (glTF 2.0).
                     if (joint >= double(joints))
                         throw InputError(file_, place + ".attributes.JOINTS_" + std::to_string(s),
@@ -562,8 +708,13 @@ private:
                     instance.skinWeights[at] = float(weight);
                     total += weight;
                 }
-            // Exporters leave sums a little off 1 (CesiumMan's reach 0.185): normalised, so a
-            // vertex is never shrunk towards the origin.
+            // glTF 2.0 (§3.7.3.3): the weights sum to 1. CesiumMan's reach 0.185, and the
+            // validator refuses it (19 errors); sums within its tolerance are normalised here,
+            // so a vertex is never shrunk towards the origin.
+            if (!(std::fabs(floatTotal - 1.0f) <= tolerance))
+                throw InputError(file_, place + ".attributes.WEIGHTS_0",
+                                 "vertex " + std::to_string(v) + "'s weights sum to " + std::to_string(floatTotal) +
+                                     ", not 1 (glTF requires normalised weights)");
             if (total > 0)
                 for (int k = 0; k < instance.influences; ++k)
                     instance.skinWeights[v * size_t(instance.influences) + size_t(k)] =
@@ -692,6 +843,7 @@ private:
     }
 
     const tinygltf::Model& model_;
+    const std::vector<GltfFinding>& findings_;
     const std::string& file_;
     Warnings& warnings_;
     GltfReadOptions options_;

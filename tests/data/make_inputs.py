@@ -156,7 +156,9 @@ m["extensionsUsed"].append("KHR_mesh_quantization")
 m["extensionsRequired"] = ["KHR_mesh_quantization"]
 m["bufferViews"][0] = {"buffer": 0, "byteOffset": 0, "byteLength": 32, "byteStride": 8}
 m["bufferViews"].append({"buffer": 0, "byteOffset": 32, "byteLength": 16, "byteStride": 4})
-m["accessors"][0].update({"componentType": 5122, "normalized": True, "count": 4})
+# min and max in the components' own (raw) values, as glTF requires.
+m["accessors"][0].update({"componentType": 5122, "normalized": True, "count": 4,
+                          "min": [-32767, 0, -32767], "max": [32767, 0, 32767]})
 m["accessors"].append({"bufferView": 2, "componentType": 5120, "normalized": True, "count": 4, "type": "VEC3"})
 m["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 2
 m["nodes"][0]["scale"] = [1, 1, 1]
