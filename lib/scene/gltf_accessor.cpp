@@ -77,6 +77,9 @@ void AccessorReader::checkDeclaredBounds(int accessorIndex, const AccessorData& 
     const tinygltf::Accessor& acc = model_.accessors[size_t(accessorIndex)];
     const std::string place = usedBy + " -> " + gltfPlace("accessors", accessorIndex);
     const int components = data.components;
+    // An accessor without a bufferView or sparse values holds zeros only by default: like the
+    // glTF-Validator, which has no elements to compare, its bounds are taken as given.
+    if (acc.bufferView < 0 && !acc.sparse.isSparse) return;
     if (data.count == 0) return;
     // glTF 2.0 (§3.6.2.5): min and max, where given, are the elements' exact bounds, per component,
     // in the components' own type (a normalised integer's raw value). They are compared here
@@ -130,6 +133,10 @@ void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) c
     const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
     if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
         throw InputError(file_, usedBy, "unknown accessor type or componentType");
+    // A view into a buffer without data (no uri) is valid while nothing reads it.
+    if (acc.bufferView >= 0 && acc.bufferView < int(model_.bufferViews.size()) &&
+        absentBuffers_.count(model_.bufferViews[size_t(acc.bufferView)].buffer))
+        return;
     checkLayout(acc, components, usedBy);
 }
 

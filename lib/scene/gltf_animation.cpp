@@ -104,7 +104,11 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
             if (times.minValues.size() != 1 || times.maxValues.size() != 1)
                 throw InputError(file, gltfPlace("accessors", sampler.input),
                                  "is an animation input without min and max (glTF requires both)");
-            for (size_t k = 0; k < input.count; ++k) {
+            // An input accessor without a bufferView or sparse values holds zeros by default: valid
+            // glTF (the validator has no elements to check), but keys all at 0 s animate nothing.
+            // The channel is checked like any other and then left out, with a warning.
+            const bool timesStated = times.bufferView >= 0 || times.sparse.isSparse;
+            for (size_t k = 0; timesStated && k < input.count; ++k) {
                 if (input.values[k] < 0)
                     throw InputError(file, samplerPlace + ".input", "key time " + std::to_string(input.values[k]) +
                                                                         " is negative");
@@ -142,6 +146,11 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
                         throw InputError(file, samplerPlace + ".output",
                                          "key " + std::to_string(k) + " is a zero quaternion, which is no rotation");
                 }
+            if (!timesStated) {
+                warnings.add(file + ": " + samplerPlace + ".input has no data (an accessor without a bufferView holds "
+                                    "zeros), so " + place + " animates nothing and is left out");
+                continue;
+            }
             animation.startTime = first ? track.times.front() : std::min(animation.startTime, track.times.front());
             animation.endTime = first ? track.times.back() : std::max(animation.endTime, track.times.back());
             first = false;

@@ -12,6 +12,12 @@
 
 #include "util/json_file.h"
 
+// Part of libtinygltf's exported API, though its header declares it only for the translation
+// unit that compiles the implementation.
+namespace tinygltf {
+std::string base64_encode(unsigned char const* bytes, unsigned int length);
+}
+
 namespace qsgi {
 namespace {
 
@@ -19,6 +25,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr uint32_t kGlbJsonChunk = 0x4E4F534A;  // "JSON"
+
+unsigned char uchar(char c) { return static_cast<unsigned char>(c); }
 
 uint32_t readU32(const std::string& bytes, size_t offset) {
     uint32_t v;
@@ -104,8 +112,11 @@ void checkAsset(const std::string& path, const json& doc) {
 // glTF 2.0 schema's integer fields that index or measure bytes and elements: each must be an
 // integer >= 0 (its "minimum": 0; componentType, mode and target have enumerated values, checked
 // where they are read). tinygltf takes a negative byteOffset as 0 in one place and reads before
-// the view in another, so every one of them is checked here, before it reads any.
-void refuseNegativeIndices(const std::string& path, const json& doc) {
+// the view in another, so every one of them is checked here, before it reads any. An integer
+// written as a float (1.0) is an integer to JSON Schema but not to tinygltf, which refuses the
+// file: such values are rewritten as integers. Returns whether any was.
+bool refuseNegativeIndices(const std::string& path, json& doc) {
+    bool rewritten = false;
     static const std::pair<const char*, std::vector<const char*>> kFields[] = {
         {"accessors", {"bufferView", "byteOffset", "count", "sparse.count", "sparse.indices.bufferView",
                        "sparse.indices.byteOffset", "sparse.values.bufferView", "sparse.values.byteOffset"}},
@@ -118,19 +129,23 @@ void refuseNegativeIndices(const std::string& path, const json& doc) {
         {"skins", {"inverseBindMatrices", "skeleton"}},
         {"textures", {"source", "sampler"}},
     };
-    auto check = [&](const json& value, const std::string& place) {
-        const bool ok = value.is_number_unsigned() ||
-                        (value.is_number_float() && value.get<double>() >= 0 && value.get<double>() < 9.0e15 &&
-                         std::floor(value.get<double>()) == value.get<double>());
-        if (!ok) throw InputError(path, place, value.dump().substr(0, 40) + " is not a non-negative integer below 2^53 (glTF 2.0 requires one)");
+    auto check = [&](json& value, const std::string& place) {
+        const bool integralFloat = value.is_number_float() && value.get<double>() >= 0 && value.get<double>() < 9.0e15 &&
+                                   std::floor(value.get<double>()) == value.get<double>();
+        if (!value.is_number_unsigned() && !integralFloat)
+            throw InputError(path, place, value.dump().substr(0, 40) + " is not a non-negative integer below 2^53 (glTF 2.0 requires one)");
+        if (integralFloat) {
+            value = uint64_t(value.get<double>());
+            rewritten = true;
+        }
     };
     for (const auto& [array, fields] : kFields) {
         if (!doc.contains(array) || !doc[array].is_array()) continue;
-        const json& items = doc[array];
+        json& items = doc[array];
         for (size_t i = 0; i < items.size(); ++i) {
             const std::string item = std::string(array) + "[" + std::to_string(i) + "]";
             for (const char* field : fields) {
-                const json* at = &items[i];
+                json* at = &items[i];
                 std::string dotted = field;
                 for (size_t start = 0; at && start <= dotted.size();) {
                     const size_t dot = std::min(dotted.find('.', start), dotted.size());
@@ -144,7 +159,7 @@ void refuseNegativeIndices(const std::string& path, const json& doc) {
     }
     // Lists of indices: a node's children, a scene's nodes, a skin's joints; a primitive's indices
     // and material, and its attributes' and targets' accessors; an animation's samplers and targets.
-    auto checkList = [&](const json& list, const std::string& place) {
+    auto checkList = [&](json& list, const std::string& place) {
         if (!list.is_array()) return;
         for (size_t k = 0; k < list.size(); ++k) check(list[k], place + "[" + std::to_string(k) + "]");
     };
@@ -153,18 +168,18 @@ void refuseNegativeIndices(const std::string& path, const json& doc) {
         for (size_t i = 0; i < doc[array].size(); ++i)
             if (doc[array][i].is_object()) visit(doc[array][i], std::string(array) + "[" + std::to_string(i) + "]");
     };
-    each("nodes", [&](const json& n, const std::string& at) {
+    each("nodes", [&](json& n, const std::string& at) {
         if (n.contains("children")) checkList(n["children"], at + ".children");
         // glTF 2.0 (§5.25): a matrix or TRS properties, not both (tinygltf keeps one silently).
         if (n.contains("matrix") && (n.contains("translation") || n.contains("rotation") || n.contains("scale")))
             throw InputError(path, at, "has both a matrix and translation, rotation or scale (glTF allows one or the other)");
     });
-    each("scenes", [&](const json& s, const std::string& at) { if (s.contains("nodes")) checkList(s["nodes"], at + ".nodes"); });
-    each("skins", [&](const json& s, const std::string& at) { if (s.contains("joints")) checkList(s["joints"], at + ".joints"); });
-    each("meshes", [&](const json& m, const std::string& at) {
+    each("scenes", [&](json& s, const std::string& at) { if (s.contains("nodes")) checkList(s["nodes"], at + ".nodes"); });
+    each("skins", [&](json& s, const std::string& at) { if (s.contains("joints")) checkList(s["joints"], at + ".joints"); });
+    each("meshes", [&](json& m, const std::string& at) {
         if (!m.contains("primitives") || !m["primitives"].is_array()) return;
         for (size_t p = 0; p < m["primitives"].size(); ++p) {
-            const json& prim = m["primitives"][p];
+            json& prim = m["primitives"][p];
             const std::string place = at + ".primitives[" + std::to_string(p) + "]";
             if (!prim.is_object()) continue;
             for (const char* key : {"indices", "material"})
@@ -179,10 +194,10 @@ void refuseNegativeIndices(const std::string& path, const json& doc) {
                             check(it.value(), place + ".targets[" + std::to_string(t) + "]." + it.key());
         }
     });
-    each("animations", [&](const json& a, const std::string& at) {
+    each("animations", [&](json& a, const std::string& at) {
         if (a.contains("channels") && a["channels"].is_array())
             for (size_t c = 0; c < a["channels"].size(); ++c) {
-                const json& ch = a["channels"][c];
+                json& ch = a["channels"][c];
                 const std::string place = at + ".channels[" + std::to_string(c) + "]";
                 if (!ch.is_object()) continue;
                 if (ch.contains("sampler")) check(ch["sampler"], place + ".sampler");
@@ -191,12 +206,42 @@ void refuseNegativeIndices(const std::string& path, const json& doc) {
             }
         if (a.contains("samplers") && a["samplers"].is_array())
             for (size_t s = 0; s < a["samplers"].size(); ++s) {
-                const json& sm = a["samplers"][s];
+                json& sm = a["samplers"][s];
                 if (!sm.is_object()) continue;
                 for (const char* key : {"input", "output"})
                     if (sm.contains(key)) check(sm[key], at + ".samplers[" + std::to_string(s) + "]." + key);
             }
     });
+    return rewritten;
+}
+
+// A data URI need not be base64 (RFC 2397: "data:application/gltf-buffer,%00%01" is the bytes
+// 0 1), but tinygltf reads only base64 ones: others are percent-decoded and handed to it as
+// base64. Returns whether any was.
+bool rewritePlainDataUris(json& doc, const char* array) {
+    if (!doc.contains(array) || !doc[array].is_array()) return false;
+    bool rewritten = false;
+    for (json& item : doc[array]) {
+        if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+        const std::string uri = item["uri"];
+        const size_t comma = uri.find(',');
+        if (uri.rfind("data:", 0) != 0 || comma == std::string::npos) continue;
+        const std::string header = uri.substr(0, comma);
+        if (header.size() >= 7 && header.compare(header.size() - 7, 7, ";base64") == 0) continue;
+        std::string bytes;
+        for (size_t i = comma + 1; i < uri.size(); ++i) {
+            if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(uchar(uri[i + 1])) && std::isxdigit(uchar(uri[i + 2]))) {
+                bytes += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+                i += 2;
+            } else {
+                bytes += uri[i];
+            }
+        }
+        item["uri"] = header + ";base64," +
+                      tinygltf::base64_encode(reinterpret_cast<const unsigned char*>(bytes.data()), unsigned(bytes.size()));
+        rewritten = true;
+    }
+    return rewritten;
 }
 
 void refuseRemoteUris(const std::string& path, const json& doc, const char* array) {
@@ -269,6 +314,13 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     refuseBeyondGltfSize(path, bytes.size());
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     GlbLayout glb;
+    if (binary && bytes.size() >= 20 && readU32(bytes, 8) >= 20 && readU32(bytes, 8) < bytes.size()) {
+        // Bytes after the length the header declares are no part of the file (glTF 2.0 §4.4.2:
+        // the validator lets them pass with a note); they are left unread.
+        warnings.add(path + ": GLB header: " + std::to_string(bytes.size() - readU32(bytes, 8)) +
+                     " bytes follow the declared end of the file and are ignored");
+        bytes.resize(readU32(bytes, 8));
+    }
     if (binary) glb = readGlbLayout(path, bytes);
     const std::string& jsonText = binary ? glb.jsonText : bytes;
     // Before any parser: tinygltf copies extras recursively and would overflow the stack.
@@ -284,14 +336,16 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     }
     if (!doc.is_object()) throw InputError(path, "", "the glTF JSON must be an object");
     checkAsset(path, doc);
-    refuseNegativeIndices(path, doc);
+    bool rewritten = refuseNegativeIndices(path, doc);
+    rewritten = rewritePlainDataUris(doc, "buffers") || rewritten;
+    rewritten = rewritePlainDataUris(doc, "images") || rewritten;
     refuseRemoteUris(path, doc, "buffers");
     refuseRemoteUris(path, doc, "images");
 
     GltfDocument out;
     out.findings = findReferenceProblems(doc);
     out.absentBuffers = replaceAbsentBuffers(doc, binary);
-    if (!out.absentBuffers.empty()) {
+    if (!out.absentBuffers.empty() || rewritten) {
         std::string rewritten = doc.dump();
         if (binary) {
             while (rewritten.size() % 4) rewritten += ' ';

@@ -524,7 +524,11 @@ private:
             return;
         }
         auto pos = prim.attributes.find("POSITION");
-        if (pos == prim.attributes.end()) throw InputError(file_, place, "has no POSITION attribute");
+        if (pos == prim.attributes.end()) {
+            // Valid glTF: "client implementations should skip" a primitive without positions.
+            warnings_.add(file_ + ": " + place + " has no POSITION attribute and is skipped");
+            return;
+        }
         const AccessorData positions = reader_.read(pos->second, place + ".attributes.POSITION", kPositionFormat);
         // glTF 2.0 (§5.1.3): a POSITION accessor states its bounds (min and max), which viewers use.
         if (pos->second >= 0 && size_t(pos->second) < model_.accessors.size() &&
@@ -640,8 +644,11 @@ private:
             if (m.count < skin.joints.size())
                 throw InputError(file_, place + ".inverseBindMatrices", "has " + std::to_string(m.count) + " matrices for " +
                                                                           std::to_string(skin.joints.size()) + " joints");
+            const tinygltf::Accessor& matrices = model_.accessors[size_t(source.inverseBindMatrices)];
+            const bool stated = matrices.bufferView >= 0 || matrices.sparse.isSparse;  // else zeros by default
             for (size_t j = 0; j < skin.joints.size(); ++j) {
                 skin.inverseBind[j] = Transform::fromColumnMajor(&m.values[16 * j]);
+                if (!stated) continue;
                 // glTF 2.0 (§5.28): an inverse bind matrix is affine. Only its last row is checked:
                 // a joint under a non-uniformly scaled parent legitimately has a sheared one.
                 const Transform& ibm = skin.inverseBind[j];
@@ -764,6 +771,10 @@ private:
         if (scene.cameras[node.camera]) return;  // the first node using a camera places it
         Camera lens = readLens(node.camera);
         lens.node = n;
+        // glTF only asks for a positive field of view; a picture needs it below pi.
+        if (lens.projection == Projection::Perspective && !(lens.yfov < 3.14159f))
+            throw InputError(file_, gltfPlace("cameras", node.camera) + ".perspective.yfov",
+                             "must lie below pi for the camera to render a picture");
         // World space here: Scene::finalize re-centres it with the lights.
         const Camera c = placeCamera(lens, world, Vec3d(0.0));
         if (!isFinite(c.position) || !isFinite(c.forward) || !isFinite(c.up))
@@ -781,8 +792,8 @@ private:
             lens.yfov = float(cam.perspective.yfov);
             lens.aspect = float(cam.perspective.aspectRatio);
             lens.znear = float(cam.perspective.znear);
-            if (!(lens.yfov > 0 && lens.yfov < 3.14159f))
-                throw InputError(file_, gltfPlace("cameras", camera) + ".perspective.yfov", "must lie in (0, pi)");
+            if (!(lens.yfov > 0) || !std::isfinite(lens.yfov))
+                throw InputError(file_, gltfPlace("cameras", camera) + ".perspective.yfov", "must be positive");
         } else if (cam.type == "orthographic") {
             lens.projection = Projection::Orthographic;
             // The specification forbids zero magnifications and advises against negative ones.
