@@ -133,15 +133,19 @@ void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) c
     const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
     if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
         throw InputError(file_, usedBy, "unknown accessor type or componentType");
-    // A view into a buffer without data (no uri) is valid while nothing reads it.
-    if (acc.bufferView >= 0 && acc.bufferView < int(model_.bufferViews.size()) &&
-        absentBuffers_.count(model_.bufferViews[size_t(acc.bufferView)].buffer))
-        return;
-    checkLayout(acc, components, usedBy);
+    checkLayout(acc, components, usedBy, false);
 }
 
-void AccessorReader::checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place) const {
-    if (acc.bufferView >= 0) checkRange(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, components, place);
+void AccessorReader::checkUnreadView(int viewIndex) const {
+    const tinygltf::BufferView& view = checkedView(viewIndex, gltfPlace("bufferViews", viewIndex), false);
+    if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
+        throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
+                         std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
+}
+
+void AccessorReader::checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place, bool needData) const {
+    if (acc.bufferView >= 0)
+        checkRange(acc.bufferView, acc.byteOffset, acc.count, acc.componentType, components, place, needData);
     if (!acc.sparse.isSparse) return;
     if (acc.sparse.count < 1 || size_t(acc.sparse.count) > acc.count)
         throw InputError(file_, place + ".sparse.count", std::to_string(acc.sparse.count) +
@@ -152,9 +156,9 @@ void AccessorReader::checkLayout(const tinygltf::Accessor& acc, int components, 
         indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
         throw InputError(file_, place + ".sparse.indices.componentType", "must be an unsigned integer type");
     checkRange(acc.sparse.indices.bufferView, size_t(acc.sparse.indices.byteOffset), n, indexType, 1,
-               place + ".sparse.indices");
+               place + ".sparse.indices", needData);
     checkRange(acc.sparse.values.bufferView, size_t(acc.sparse.values.byteOffset), n, acc.componentType, components,
-               place + ".sparse.values");
+               place + ".sparse.values", needData);
 }
 
 void AccessorReader::checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const {
@@ -175,14 +179,16 @@ void AccessorReader::checkFormat(const tinygltf::Accessor& acc, const AccessorFo
     throw InputError(file_, place, what + " components are not allowed here by the glTF 2.0 specification");
 }
 
-const tinygltf::BufferView& AccessorReader::checkedView(int viewIndex, const std::string& place) const {
+const tinygltf::BufferView& AccessorReader::checkedView(int viewIndex, const std::string& place, bool needData) const {
     if (viewIndex < 0 || viewIndex >= int(model_.bufferViews.size()))
         throw InputError(file_, place, "refers to bufferView " + std::to_string(viewIndex) + ", which does not exist");
     const std::string viewPlace = gltfPlace("bufferViews", viewIndex);
-    viewsRead_.insert(viewIndex);
+    if (needData) viewsRead_.insert(viewIndex);
     const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
     if (view.buffer < 0 || view.buffer >= int(model_.buffers.size()))
         throw InputError(file_, viewPlace, "refers to a buffer that does not exist");
+    if (view.byteLength == 0) throw InputError(file_, viewPlace + ".byteLength", "is 0 (glTF requires at least 1)");
+    if (absentBuffers_.count(view.buffer) && !needData) return view;
     if (absentBuffers_.count(view.buffer))
         throw InputError(file_, viewPlace, "reads buffer " + std::to_string(view.buffer) +
                                                ", which has no uri and so no data");
@@ -202,8 +208,8 @@ AccessorReader::Bytes AccessorReader::viewBytes(int viewIndex, const std::string
 }
 
 void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
-                const std::string& place) const {
-    const tinygltf::BufferView& view = checkedView(viewIndex, place);
+                const std::string& place, bool needData) const {
+    const tinygltf::BufferView& view = checkedView(viewIndex, place, needData);
     const std::string viewPlace = gltfPlace("bufferViews", viewIndex);
     const uint64_t componentSize = uint64_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
     const uint64_t elementSize = componentSize * uint64_t(components);

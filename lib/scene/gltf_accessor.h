@@ -58,6 +58,8 @@ public:
     // and componentType are known, its elements and sparse parts lie inside their views and
     // buffers), without decoding or allocating anything.
     void checkUnread(int accessorIndex, const std::string& usedBy) const;
+    // The same for a buffer view nothing reads: inside its buffer, a stride glTF allows.
+    void checkUnreadView(int viewIndex) const;
     // Whether read() was called for the accessor (whatever it found): the objects the render used.
     bool wasRead(int accessorIndex) const { return read_.count(accessorIndex) > 0; }
     // Whether a read went through the buffer view (an accessor's, an embedded image's).
@@ -72,15 +74,16 @@ public:
     Bytes viewBytes(int viewIndex, const std::string& usedBy) const;
 
 private:
-    // The view, checked as viewBytes checks it.
-    const tinygltf::BufferView& checkedView(int viewIndex, const std::string& place) const;
+    // The view, checked as viewBytes checks it. needData false: a view into a buffer without
+    // data (no uri) passes, since nothing reads it (checkUnread).
+    const tinygltf::BufferView& checkedView(int viewIndex, const std::string& place, bool needData = true) const;
     void checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const;
     // The elements' and the sparse parts' ranges, the sparse count and index type.
-    void checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place) const;
+    void checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place, bool needData = true) const;
     // Checks that `count` elements from a buffer view lie inside the view and its buffer, with
     // the alignment and stride the specification requires.
     void checkRange(int viewIndex, size_t byteOffset, size_t count, int componentType, int components,
-                    const std::string& place) const;
+                    const std::string& place, bool needData = true) const;
     // Decodes `count` elements (checked by checkRange) into `doubles` or, for sparse indices,
     // into `indices`.
     void decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized, int components,

@@ -25,6 +25,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr uint32_t kGlbJsonChunk = 0x4E4F534A;  // "JSON"
+constexpr uint32_t kGlbBinChunk = 0x004E4942;   // "BIN\0"
 
 unsigned char uchar(char c) { return static_cast<unsigned char>(c); }
 
@@ -40,6 +41,7 @@ void appendU32(std::string& bytes, uint32_t v) { bytes.append(reinterpret_cast<c
 struct GlbLayout {
     std::string jsonText;
     size_t afterJson = 0;
+    int binChunks = 0;
 };
 
 GlbLayout readGlbLayout(const std::string& path, const std::string& bytes) {
@@ -58,14 +60,16 @@ GlbLayout readGlbLayout(const std::string& path, const std::string& bytes) {
     if (jsonLength % 4 != 0)
         throw InputError(path, "GLB chunk 0", "its length " + std::to_string(jsonLength) +
                                                   " is not a multiple of 4 (GLB pads chunks with spaces or zeros)");
+    int binChunks = 0;
     for (uint64_t at = 20 + uint64_t(jsonLength); at + 8 <= bytes.size();) {
         const uint32_t chunkLength = readU32(bytes, size_t(at));
+        binChunks += readU32(bytes, size_t(at) + 4) == kGlbBinChunk;
         if (chunkLength % 4 != 0)
             throw InputError(path, "GLB chunk at byte " + std::to_string(at),
                              "its length " + std::to_string(chunkLength) + " is not a multiple of 4 (GLB pads chunks)");
         at += 8 + uint64_t(chunkLength);
     }
-    return {bytes.substr(20, jsonLength), 20 + size_t(jsonLength)};
+    return {bytes.substr(20, jsonLength), 20 + size_t(jsonLength), binChunks};
 }
 
 // "https://host/a.bin" -> "https"; "" for relative paths, data URIs and Windows drive letters.
@@ -344,6 +348,11 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
 
     GltfDocument out;
     out.findings = findReferenceProblems(doc);
+    // Document-level slips that leave the file readable: warnings, refused under --strict.
+    if (jsonText.size() >= 3 && jsonText.compare(0, 3, "\xEF\xBB\xBF") == 0)
+        out.findings.push_back({"", binary ? "GLB chunk 0" : "byte 0", "starts with a byte-order mark, which glTF forbids"});
+    if (binary && glb.binChunks > 1)
+        out.findings.push_back({"", "GLB", "has " + std::to_string(glb.binChunks) + " BIN chunks; glTF allows one (the first is read)"});
     out.absentBuffers = replaceAbsentBuffers(doc, binary);
     if (!out.absentBuffers.empty() || rewritten) {
         std::string rewritten = doc.dump();

@@ -323,7 +323,7 @@ public:
         for (const GltfFinding& f : findings_) {
             const InputError e(file_, f.place, f.problem);
             if (used.contains(f.object)) throw e;
-            unusedObjectError(e, f.object.empty() ? "it" : f.object);
+            unusedObjectError(e, f.object);
         }
         scene.finalize();
         checkSceneExtent(scene.positions, scene.bounds(), file_, "nodes");
@@ -333,10 +333,14 @@ public:
 private:
     // An error in an object the render does not use (glTF objects nothing in the default scene
     // reaches): a warning naming it, or, under --strict, a refusal.
+    // object "": a slip in the document itself that leaves it readable (an empty top-level
+    // array, a byte-order mark).
     void unusedObjectError(const InputError& e, const std::string& object) {
         if (options_.strict)
-            throw InputError(e.file(), e.place(), e.problem() + " (" + object + " is not in the rendered scene; --strict refuses it)");
-        warnings_.add(std::string(e.what()) + " (" + object + " is not in the rendered scene, so it is ignored)");
+            throw InputError(e.file(), e.place(), e.problem() + (object.empty() ? " (--strict refuses it)"
+                                                                                 : " (" + object + " is not in the rendered scene; --strict refuses it)"));
+        warnings_.add(std::string(e.what()) + (object.empty() ? " (the file is read all the same)"
+                                                              : " (" + object + " is not in the rendered scene, so it is ignored)"));
     }
 
     // Which top-level objects the render read, by name ("nodes[3]"); the document itself ("")
@@ -419,6 +423,14 @@ private:
                 readLens(int(c));
             } catch (const InputError& e) {
                 unusedObjectError(e, gltfPlace("cameras", int(c)));
+            }
+        }
+        for (size_t v = 0; v < model_.bufferViews.size(); ++v) {
+            if (reader_.viewWasRead(int(v))) continue;
+            try {
+                reader_.checkUnreadView(int(v));
+            } catch (const InputError& e) {
+                unusedObjectError(e, gltfPlace("bufferViews", int(v)));
             }
         }
         for (size_t a = 0; a < model_.accessors.size(); ++a) {

@@ -51,6 +51,12 @@ public:
                         field(at, a["sparse"][part], "bufferView", "bufferViews", at + ".sparse." + part);
         });
         each("bufferViews", [&](const json& v, const std::string& at) { field(at, v, "buffer", "buffers"); });
+        each("buffers", [&](const json& b, const std::string& at) {
+            if (!b.contains("byteLength"))
+                add(at, at, "has no byteLength (glTF requires one)");
+            else if (b["byteLength"].is_number() && b["byteLength"].get<double>() < 1)
+                add(at, at + ".byteLength", "is 0 (glTF requires at least 1)");
+        });
         each("images", [&](const json& i, const std::string& at) { field(at, i, "bufferView", "bufferViews"); });
         each("textures", [&](const json& t, const std::string& at) {
             field(at, t, "source", "images");
