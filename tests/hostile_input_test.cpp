@@ -101,7 +101,9 @@ TEST(HostileInput, ValidEdgeCasesLoadWithTheGeometryTheyHold) {
     const std::vector<Vec3f> floor = {{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}};
     for (const char* name : {"base.gltf", "accessor_without_bufferview.gltf", "buffer_gltf_buffer_data_uri.gltf",
                              "buffer_without_uri_unused.gltf", "quantized.gltf", "glb_with_unused_second_buffer.glb",
-                             "texture_embedded.gltf", "texture_data_uri.gltf", "texture_unreadable.gltf"}) {
+                             "texture_embedded.gltf", "texture_data_uri.gltf", "texture_unreadable.gltf",
+                             "integer_written_as_float.gltf", "data_uri_percent_encoded.gltf", "glb_trailing_bytes.glb",
+                             "primitive_without_position.gltf"}) {
         SCOPED_TRACE(name);
         Warnings warnings;
         Scene scene;

@@ -79,7 +79,7 @@ void AccessorReader::checkDeclaredBounds(int accessorIndex, const AccessorData& 
     const int components = data.components;
     // An accessor without a bufferView or sparse values holds zeros only by default: like the
     // glTF-Validator, which has no elements to compare, its bounds are taken as given.
-    if (acc.bufferView < 0 && !acc.sparse.isSparse) return;
+    if (!hasData(accessorIndex)) return;
     if (data.count == 0) return;
     // glTF 2.0 (§3.6.2.5): min and max, where given, are the elements' exact bounds, per component,
     // in the components' own type (a normalised integer's raw value). They are compared here
@@ -126,6 +126,17 @@ void AccessorReader::checkDeclaredBounds(int accessorIndex, const AccessorData& 
     }
 }
 
+bool AccessorReader::viewHasData(int viewIndex) const {
+    return viewIndex >= 0 && viewIndex < int(model_.bufferViews.size()) &&
+           !absentBuffers_.count(model_.bufferViews[size_t(viewIndex)].buffer);
+}
+
+bool AccessorReader::hasData(int accessorIndex) const {
+    if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size())) return false;
+    const tinygltf::Accessor& acc = model_.accessors[size_t(accessorIndex)];
+    return viewHasData(acc.bufferView) || (acc.sparse.isSparse && viewHasData(acc.sparse.values.bufferView));
+}
+
 void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) const {
     if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size()))
         throw InputError(file_, usedBy, "refers to accessor " + std::to_string(accessorIndex) + ", which does not exist");
@@ -134,6 +145,10 @@ void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) c
     if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
         throw InputError(file_, usedBy, "unknown accessor type or componentType");
     checkLayout(acc, components, usedBy, false);
+    // With data to read, it is read as what it says it is: finite, within its stated bounds.
+    if (!hasData(accessorIndex)) return;
+    const AccessorFormat itself{acc.type, {{acc.componentType, acc.normalized}}, {}};
+    read(accessorIndex, usedBy, itself);
 }
 
 void AccessorReader::checkUnreadView(int viewIndex) const {
@@ -141,6 +156,9 @@ void AccessorReader::checkUnreadView(int viewIndex) const {
     if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
         throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
                          std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
+    if (view.byteStride != 0 && view.target == TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER)
+        throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
+                         "is set on a view of indices (target 34963), which glTF forbids");
 }
 
 void AccessorReader::checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place, bool needData) const {
@@ -165,6 +183,11 @@ void AccessorReader::checkFormat(const tinygltf::Accessor& acc, const AccessorFo
     const int components = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
     if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
         throw InputError(file_, place, "unknown accessor type or componentType");
+    // glTF 2.0 (§3.6.2.2): "normalized" applies to 8- and 16-bit integers only.
+    if (acc.normalized && (acc.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                           acc.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+        throw InputError(file_, place + ".normalized", "is true for " + componentTypeName(acc.componentType) +
+                                                           " components (glTF allows it for 8- and 16-bit integers only)");
     if (acc.type != format.type)
         throw InputError(file_, place, "must be of type " + typeName(format.type));
     const std::pair<int, bool> used{acc.componentType, acc.normalized};
@@ -188,7 +211,7 @@ const tinygltf::BufferView& AccessorReader::checkedView(int viewIndex, const std
     if (view.buffer < 0 || view.buffer >= int(model_.buffers.size()))
         throw InputError(file_, viewPlace, "refers to a buffer that does not exist");
     if (view.byteLength == 0) throw InputError(file_, viewPlace + ".byteLength", "is 0 (glTF requires at least 1)");
-    if (absentBuffers_.count(view.buffer) && !needData) return view;
+    if (absentBuffers_.count(view.buffer) && (!needData || tolerateAbsent_)) return view;
     if (absentBuffers_.count(view.buffer))
         throw InputError(file_, viewPlace, "reads buffer " + std::to_string(view.buffer) +
                                                ", which has no uri and so no data");
@@ -230,6 +253,10 @@ void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, 
 
 void AccessorReader::decode(int viewIndex, size_t byteOffset, size_t count, int componentType, bool normalized,
             int components, double* doubles, std::vector<size_t>* indices) const {
+    if (!viewHasData(viewIndex)) {  // tolerated (tolerateAbsentData): zeros
+        if (indices) indices->assign(count, 0);
+        return;
+    }
     const tinygltf::BufferView& view = model_.bufferViews[viewIndex];
     const tinygltf::Buffer& buffer = model_.buffers[view.buffer];
     const size_t componentSize = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));

@@ -60,6 +60,14 @@ public:
     void checkUnread(int accessorIndex, const std::string& usedBy) const;
     // The same for a buffer view nothing reads: inside its buffer, a stride glTF allows.
     void checkUnreadView(int viewIndex) const;
+    // Whether the accessor's elements are stated in the file: a bufferView into a buffer with
+    // data, or sparse values. Otherwise they are zeros by default, and data-level rules (bounds,
+    // unit normals, weights summing to 1) have nothing to judge, as for the glTF-Validator.
+    bool hasData(int accessorIndex) const;
+    // While set, a read through a buffer without data (no uri) gives zeros instead of an error:
+    // for checking objects nothing reads, where such buffers are valid (the loader's
+    // checkUnusedObjects).
+    void tolerateAbsentData(bool tolerate) const { tolerateAbsent_ = tolerate; }
     // Whether read() was called for the accessor (whatever it found): the objects the render used.
     bool wasRead(int accessorIndex) const { return read_.count(accessorIndex) > 0; }
     // Whether a read went through the buffer view (an accessor's, an embedded image's).
@@ -96,6 +104,8 @@ private:
     std::string file_;
     bool quantized_ = false;
     mutable std::set<int> read_, viewsRead_;
+    mutable bool tolerateAbsent_ = false;
+    bool viewHasData(int viewIndex) const;
 };
 
 }  // namespace qsgi

@@ -107,7 +107,7 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
             // An input accessor without a bufferView or sparse values holds zeros by default: valid
             // glTF (the validator has no elements to check), but keys all at 0 s animate nothing.
             // The channel is checked like any other and then left out, with a warning.
-            const bool timesStated = times.bufferView >= 0 || times.sparse.isSparse;
+            const bool timesStated = reader.hasData(sampler.input);
             for (size_t k = 0; timesStated && k < input.count; ++k) {
                 if (input.values[k] < 0)
                     throw InputError(file, samplerPlace + ".input", "key time " + std::to_string(input.values[k]) +

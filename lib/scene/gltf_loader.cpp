@@ -60,6 +60,17 @@ const AccessorFormat kColourRgbFormat{
      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
     {}};
 const AccessorFormat kColourRgbaFormat{TINYGLTF_TYPE_VEC4, kColourRgbFormat.allowed, {}};
+// Attributes qsgi does not use, read only to hold them to the specification's formats.
+const AccessorFormat kTexcoordFormat{
+    TINYGLTF_TYPE_VEC2,
+    {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
+     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
+    {{TINYGLTF_COMPONENT_TYPE_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_BYTE, true},
+     {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false}, {TINYGLTF_COMPONENT_TYPE_SHORT, false},
+     {TINYGLTF_COMPONENT_TYPE_SHORT, true}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false}}};
+const AccessorFormat kTangentFormat{
+    TINYGLTF_TYPE_VEC4, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}},
+    {{TINYGLTF_COMPONENT_TYPE_BYTE, true}, {TINYGLTF_COMPONENT_TYPE_SHORT, true}}};
 
 const AccessorFormat kIndexFormat{
     TINYGLTF_TYPE_SCALAR,
@@ -384,6 +395,12 @@ private:
     // The nodes, meshes, skins, cameras and accessors the default scene does not reach are
     // checked by the same code that reads the used ones, into a scratch scene that is thrown away.
     void checkUnusedObjects(const Scene& scene, const std::vector<uint8_t>& usedNodes) {
+        // A buffer without data is valid while nothing reads it: here reads through it give zeros.
+        struct Tolerate {
+            const AccessorReader& reader;
+            explicit Tolerate(const AccessorReader& r) : reader(r) { reader.tolerateAbsentData(true); }
+            ~Tolerate() { reader.tolerateAbsentData(false); }
+        } tolerate(reader_);
         Scene scratch;
         scratch.materials = scene.materials;
         scratch.nodes = scene.nodes;
@@ -402,6 +419,7 @@ private:
             try {
                 if (model_.meshes[m].primitives.empty())
                     throw InputError(file_, gltfPlace("meshes", int(m)) + ".primitives", "is empty (glTF requires at least one primitive)");
+                checkMorphTargetCounts(int(m));
                 for (size_t p = 0; p < model_.meshes[m].primitives.size(); ++p)
                     addPrimitive(scratch, 0, Transform(), model_.meshes[m].primitives[p],
                                  gltfPlace("meshes", int(m)) + "." + gltfPlace("primitives", int(p)), -1, {});
@@ -443,6 +461,21 @@ private:
         }
     }
 
+    // glTF 2.0 (§3.7.2.2): every primitive of a mesh has as many morph targets, and the mesh's
+    // default weights, where given, one for each.
+    void checkMorphTargetCounts(int meshIndex) const {
+        const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+        for (size_t p = 0; p < mesh.primitives.size(); ++p)
+            if (mesh.primitives[p].targets.size() != mesh.primitives[0].targets.size())
+                throw InputError(file_, gltfPlace("meshes", meshIndex) + "." + gltfPlace("primitives", int(p)) + ".targets",
+                                 "has " + std::to_string(mesh.primitives[p].targets.size()) +
+                                     " morph targets but primitive 0 has " + std::to_string(mesh.primitives[0].targets.size()));
+        if (!mesh.weights.empty() && !mesh.primitives.empty() && mesh.weights.size() != mesh.primitives[0].targets.size())
+            throw InputError(file_, gltfPlace("meshes", meshIndex) + ".weights",
+                             "has " + std::to_string(mesh.weights.size()) + " weights for " +
+                                 std::to_string(mesh.primitives[0].targets.size()) + " morph targets");
+    }
+
     void visitNode(Scene& scene, int n, const Transform& world) {
         const tinygltf::Node& node = model_.nodes[n];
         if (node.mesh >= 0) {
@@ -456,16 +489,13 @@ private:
             const int skin = node.skin >= 0 ? addSkin(scene, node.skin, gltfPlace("nodes", n) + ".skin") : -1;
             // Morph target weights: the node's, else the mesh's, else zeros (glTF 2.0 §3.7.2.2).
             const std::vector<double>& weights = !node.weights.empty() ? node.weights : mesh.weights;
+            checkMorphTargetCounts(node.mesh);
+            if (!node.weights.empty() && node.weights.size() != mesh.primitives[0].targets.size())
+                throw InputError(file_, gltfPlace("nodes", n) + ".weights",
+                                 "has " + std::to_string(node.weights.size()) + " weights for " +
+                                     std::to_string(mesh.primitives[0].targets.size()) + " morph targets");
             for (size_t p = 0; p < mesh.primitives.size(); ++p) {
                 const std::string place = gltfPlace("meshes", node.mesh) + "." + gltfPlace("primitives", int(p));
-                if (mesh.primitives[p].targets.size() != mesh.primitives[0].targets.size())
-                    throw InputError(file_, place + ".targets", "has " + std::to_string(mesh.primitives[p].targets.size()) +
-                                                                   " morph targets but primitive 0 has " +
-                                                                   std::to_string(mesh.primitives[0].targets.size()));
-                if (!weights.empty() && weights.size() != mesh.primitives[p].targets.size())
-                    throw InputError(file_, (!node.weights.empty() ? gltfPlace("nodes", n) : gltfPlace("meshes", node.mesh)) + ".weights",
-                                     "has " + std::to_string(weights.size()) + " weights for " +
-                                         std::to_string(mesh.primitives[p].targets.size()) + " morph targets");
                 addPrimitive(scene, n, world, mesh.primitives[p], place, skin, weights);
             }
         }
@@ -510,10 +540,12 @@ private:
                                      "morphs an attribute the primitive does not have");
     }
 
-    // Attributes the render does not use still follow the rules of their semantics: vertex
-    // colours lie in [0, 1] (glTF 2.0 §3.7.2.1).
+    // Attributes the render does not use still follow the rules of their semantics (glTF 2.0
+    // §3.7.2.1): their formats, and vertex colours within [0, 1].
     void checkColours(const tinygltf::Primitive& prim, const std::string& place) const {
         for (const auto& [name, accessor] : prim.attributes) {
+            if (name.rfind("TEXCOORD_", 0) == 0) reader_.read(accessor, place + ".attributes." + name, kTexcoordFormat);
+            if (name == "TANGENT") reader_.read(accessor, place + ".attributes." + name, kTangentFormat);
             if (name.rfind("COLOR_", 0) != 0) continue;
             const bool rgba = accessor >= 0 && accessor < int(model_.accessors.size()) &&
                               model_.accessors[size_t(accessor)].type == TINYGLTF_TYPE_VEC4;
@@ -558,7 +590,7 @@ private:
                                  "has " + std::to_string(normals->count) + " elements but POSITION has " +
                                      std::to_string(vertexCount) + " (attribute arrays must have equal lengths)");
             // Unit length, within the glTF-Validator's own tolerance (0.00674).
-            for (size_t i = 0; i < normals->count; ++i) {
+            for (size_t i = 0; reader_.hasData(nrm->second) && i < normals->count; ++i) {
                 const double len = length(Vec3d((*normals)(i, 0), (*normals)(i, 1), (*normals)(i, 2)));
                 if (!(std::fabs(len - 1) <= kUnitVectorTolerance))
                     throw InputError(file_, place + ".attributes.NORMAL", "vertex " + std::to_string(i) + "'s normal has length " +
@@ -656,8 +688,7 @@ private:
             if (m.count < skin.joints.size())
                 throw InputError(file_, place + ".inverseBindMatrices", "has " + std::to_string(m.count) + " matrices for " +
                                                                           std::to_string(skin.joints.size()) + " joints");
-            const tinygltf::Accessor& matrices = model_.accessors[size_t(source.inverseBindMatrices)];
-            const bool stated = matrices.bufferView >= 0 || matrices.sparse.isSparse;  // else zeros by default
+            const bool stated = reader_.hasData(source.inverseBindMatrices);  // else zeros by default
             for (size_t j = 0; j < skin.joints.size(); ++j) {
                 skin.inverseBind[j] = Transform::fromColumnMajor(&m.values[16 * j]);
                 if (!stated) continue;
@@ -679,6 +710,7 @@ private:
                        const std::string& place, int skin) {
         const size_t joints = scene.skins[size_t(skin)].joints.size();
         std::vector<AccessorData> jointSets, weightSets;
+        bool weightsStated = true;  // else zeros by default: no sums to judge
         for (int set = 0;; ++set) {
             auto j = prim.attributes.find("JOINTS_" + std::to_string(set));
             auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
@@ -688,6 +720,7 @@ private:
                                                                    std::to_string(set) + " without the other");
             jointSets.push_back(reader_.read(j->second, place + ".attributes." + j->first, kJointsFormat));
             weightSets.push_back(reader_.read(w->second, place + ".attributes." + w->first, kWeightsFormat));
+            weightsStated = weightsStated && reader_.hasData(w->second);
         }
         if (jointSets.empty())
             throw InputError(file_, place + ".attributes",
@@ -730,7 +763,7 @@ private:
             // glTF 2.0 (§3.7.3.3): the weights sum to 1. CesiumMan's reach 0.185, and the
             // validator refuses it (19 errors); sums within its tolerance are normalised here,
             // so a vertex is never shrunk towards the origin.
-            if (!(std::fabs(floatTotal - 1.0f) <= tolerance))
+            if (weightsStated && !(std::fabs(floatTotal - 1.0f) <= tolerance))
                 throw InputError(file_, place + ".attributes.WEIGHTS_0",
                                  "vertex " + std::to_string(v) + "'s weights sum to " + std::to_string(floatTotal) +
                                      ", not 1 (glTF requires normalised weights)");
@@ -750,6 +783,10 @@ private:
             auto pos = prim.targets[t].find("POSITION");
             if (pos != prim.targets[t].end()) {
                 const AccessorData d = reader_.read(pos->second, targetPlace + ".POSITION", kPositionFormat);
+                if (model_.accessors[size_t(pos->second)].minValues.size() != 3 ||
+                    model_.accessors[size_t(pos->second)].maxValues.size() != 3)
+                    throw InputError(file_, gltfPlace("accessors", pos->second),
+                                     "is a morph target POSITION accessor without min and max (glTF requires both)");
                 if (d.count != n)
                     throw InputError(file_, targetPlace + ".POSITION", "has " + std::to_string(d.count) +
                                                                           " elements for " + std::to_string(n) + " vertices");

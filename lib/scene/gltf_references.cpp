@@ -14,8 +14,21 @@ public:
 
     std::vector<GltfFinding> run() {
         if (doc_.contains("scene")) refersTo("", "scene", doc_["scene"], "scenes");
+        std::vector<uint8_t> isChild(count("nodes"), 0);
+        each("nodes", [&](const json& n, const std::string&) {
+            if (n.contains("children") && n["children"].is_array())
+                for (const json& c : n["children"])
+                    if (c.is_number_unsigned() && c.get<size_t>() < isChild.size()) isChild[c.get<size_t>()] = 1;
+        });
         each("scenes", [&](const json& s, const std::string& at) {
             list(at, at + ".nodes", s, "nodes", "nodes");
+            // glTF 2.0 (§3.5.2): a scene lists root nodes only.
+            if (s.contains("nodes") && s["nodes"].is_array())
+                for (size_t k = 0; k < s["nodes"].size(); ++k)
+                    if (s["nodes"][k].is_number_unsigned() && s["nodes"][k].get<size_t>() < isChild.size() &&
+                        isChild[s["nodes"][k].get<size_t>()])
+                        add(at, at + ".nodes[" + std::to_string(k) + "]",
+                            "lists node " + s["nodes"][k].dump() + ", which is another node's child, not a root");
         });
         each("nodes", [&](const json& n, const std::string& at) {
             field(at, n, "camera", "cameras");
@@ -45,6 +58,8 @@ public:
         });
         each("accessors", [&](const json& a, const std::string& at) {
             field(at, a, "bufferView", "bufferViews");
+            if (a.contains("byteOffset") && !a.contains("bufferView"))
+                add(at, at + ".byteOffset", "is given without a bufferView (glTF allows it only with one)");
             if (a.contains("sparse") && a["sparse"].is_object())
                 for (const char* part : {"indices", "values"})
                     if (a["sparse"].contains(part) && a["sparse"][part].is_object())

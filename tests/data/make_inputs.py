@@ -204,7 +204,7 @@ bad("gltf", "position_short_without_quantization.gltf",
     edited(accessor(0, componentType=5122), scene(positions=short_pos + b"\0" * 24)), "KHR_mesh_quantization")
 bad("gltf", "position_unsigned_int.gltf", edited(accessor(0, componentType=5125)), "not allowed")
 bad("gltf", "position_vec2.gltf", edited(accessor(0, type="VEC2")), "VEC3")
-bad("gltf", "position_float_normalized.gltf", edited(accessor(0, normalized=True)), "not allowed")
+bad("gltf", "position_float_normalized.gltf", edited(accessor(0, normalized=True)), "8- and 16-bit integers only")
 bad("gltf", "quantization_used_but_not_required.gltf",
     edited(lambda m: (m["extensionsUsed"].append("KHR_mesh_quantization"), accessor(0, componentType=5122)(m)),
            scene(positions=short_pos + b"\0" * 24)), "extensionsRequired")
@@ -350,6 +350,54 @@ def glb_unaligned_bin():
     chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
     return b"glTF" + struct.pack("<II", 2, 12 + len(chunks)) + chunks
 bad("gltf", "glb_chunk_not_aligned.glb", glb_unaligned_bin(), "not a multiple of 4")
+
+
+# Rules of glTF 2.0 the render reads (issue 23): in the rendered floor, each one refused naming it.
+def with_extra_attribute(name, values, kind="VEC3", component=5126, target=None):
+    """The floor with one more attribute (4 elements of `values` packed as floats) in a new buffer."""
+    def edit(m):
+        data = struct.pack("<%df" % len(values), *values)
+        m["buffers"].append({"byteLength": len(data), "uri": b64(data)})
+        m["bufferViews"].append({"buffer": len(m["buffers"]) - 1, "byteOffset": 0, "byteLength": len(data)})
+        m["accessors"].append({"bufferView": len(m["bufferViews"]) - 1, "componentType": component, "count": 4,
+                               "type": kind})
+        prim = m["meshes"][0]["primitives"][0]
+        if target is None:
+            prim["attributes"][name] = len(m["accessors"]) - 1
+        else:
+            prim["targets"] = [{name: len(m["accessors"]) - 1}]
+    return edit
+bad("gltf", "position_bounds_wrong.gltf", edited(accessor(0, max=[1, 0, 2])), "exact bounds", "accessors[0].max")
+bad("gltf", "attribute_unknown_name.gltf", edited(with_extra_attribute("FOO", [0] * 12)), "no attribute glTF defines")
+bad("gltf", "attribute_texcoord_gap.gltf", edited(with_extra_attribute("TEXCOORD_1", [0] * 8, "VEC2")), "TEXCOORD_1 without")
+bad("gltf", "morph_target_without_base.gltf", edited(with_extra_attribute("NORMAL", [0] * 12, target=True)),
+    "morphs an attribute the primitive does not have")
+bad("gltf", "color_above_one.gltf", edited(with_extra_attribute("COLOR_0", [1, 1, 1, 2, 0, 0, 0, 0, 0, 0, 0, 0])),
+    "outside [0, 1]", "COLOR_0")
+bad("gltf", "normal_not_unit.gltf", edited(with_extra_attribute("NORMAL", [0, 2, 0] * 4)), "not 1 (glTF requires unit normals)")
+bad("gltf", "node_rotation_not_unit.gltf", edited(lambda m: m["nodes"][0].update(rotation=[0, 0, 0, 2])), "not 1", "nodes[0].rotation")
+bad("gltf", "camera_two_projections.gltf", edited(lambda m: (
+    m.update(cameras=[{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1},
+                       "orthographic": {"xmag": 1, "ymag": 1, "znear": 0, "zfar": 1}}]),
+    m["nodes"][1].update(camera=0))), "only the projection its type names", "cameras[0].orthographic")
+bad("gltf", "node_weights_without_mesh.gltf", edited(lambda m: m["nodes"][1].update(weights=[0.5])), "without a mesh")
+bad("gltf", "material_texture_missing.gltf", edited(lambda m: (
+    m.update(materials=[{"emissiveTexture": {"index": 3}}]),
+    m["meshes"][0]["primitives"][0].update(material=0))), "does not exist", "materials[0].emissiveTexture.index")
+bad("gltf", "node_children_empty.gltf", edited(lambda m: m["nodes"][0].update(children=[])), "empty array", "nodes[0].children")
+
+# Valid glTF that tinygltf alone refuses or that looks odd (issue 23): each loads as the floor.
+m = scene()
+m["bufferViews"][0]["byteLength"] = float(m["bufferViews"][0]["byteLength"])  # 48.0 is the integer 48
+write("good/integer_written_as_float.gltf", json.dumps(m, indent=1))
+m = scene()
+m["buffers"][0]["uri"] = "data:application/gltf-buffer," + "".join("%%%02X" % b for b in POS + IDX)  # RFC 2397, not base64
+write("good/data_uri_percent_encoded.gltf", json.dumps(m, indent=1))
+trailing = glb(scene(), POS + IDX) + b"\0\0\0\0"  # bytes past the declared length: ignored with a warning
+write("good/glb_trailing_bytes.glb", trailing)
+m = scene()
+m["meshes"][0]["primitives"].append({"attributes": {}})  # no POSITION: skipped, as glTF asks
+write("good/primitive_without_position.gltf", json.dumps(m, indent=1))
 
 # ---- transform files (bad/animation), rendered with good/base.gltf ----
 def anim(frames, **top):
