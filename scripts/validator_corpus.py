@@ -390,7 +390,9 @@ def class_of_invalid(variant, run, names, whole_file):
     if variant == "all":
         # Loaded with a warning that the flagged object is in no rendered scene: nothing the
         # variant renders reaches it (an accessor no mesh reads, a texture no material names).
-        line = naming_line([w for w in run["warnings"] if "not in the rendered scene" in w], names)
+        # So is a slip in the document itself (an empty top-level array, a byte-order mark).
+        unread = [w for w in run["warnings"] if "not in the rendered scene" in w or "read all the same" in w]
+        line = naming_line(unread, names) or (whole_file and next((w for w in unread if "read all the same" in w), None))
         if line:
             run["message"] = line
             return "warned-unreachable"

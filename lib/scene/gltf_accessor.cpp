@@ -145,10 +145,11 @@ void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) c
     if (components <= 0 || tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType)) <= 0)
         throw InputError(file_, usedBy, "unknown accessor type or componentType");
     checkLayout(acc, components, usedBy, false);
-    // With data to read, it is read as what it says it is: finite, within its stated bounds.
-    if (!hasData(accessorIndex)) return;
+    // As what it says it is (checkFormat's rules hold for any format) and, with data to read,
+    // finite and within its stated bounds.
     const AccessorFormat itself{acc.type, {{acc.componentType, acc.normalized}}, {}};
-    read(accessorIndex, usedBy, itself);
+    checkFormat(acc, itself, usedBy);
+    if (hasData(accessorIndex)) read(accessorIndex, usedBy, itself);
 }
 
 void AccessorReader::checkUnreadView(int viewIndex) const {
@@ -156,6 +157,9 @@ void AccessorReader::checkUnreadView(int viewIndex) const {
     if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
         throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
                          std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
+    if (view.byteStride > view.byteLength)
+        throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
+                         std::to_string(view.byteStride) + " exceeds the view's byteLength " + std::to_string(view.byteLength));
     if (view.byteStride != 0 && view.target == TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER)
         throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
                          "is set on a view of indices (target 34963), which glTF forbids");

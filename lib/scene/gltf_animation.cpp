@@ -142,9 +142,14 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
             if (channel.property == AnimatedProperty::Rotation)
                 for (size_t k = 0; k < input.count; ++k) {
                     const double* q = &track.values[(k * groups + (groups == 3 ? 1 : 0)) * 4];
-                    if (!(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 1e-12))
+                    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+                    if (!(norm > 1e-6))
                         throw InputError(file, samplerPlace + ".output",
                                          "key " + std::to_string(k) + " is a zero quaternion, which is no rotation");
+                    // Unit, within the glTF-Validator's tolerance, where the file states the keys.
+                    if (reader.hasData(sampler.output) && !(std::fabs(norm - 1) <= 0.00769))
+                        throw InputError(file, samplerPlace + ".output", "key " + std::to_string(k) + " has length " +
+                                                                             std::to_string(norm) + ", not 1 (a rotation is a unit quaternion)");
                 }
             if (!timesStated) {
                 warnings.add(file + ": " + samplerPlace + ".input has no data (an accessor without a bufferView holds "

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "scene/gltf_accessor.h"
 #include "scene/gltf_animation.h"
@@ -318,6 +319,14 @@ public:
         }
         scene.cameras.resize(model_.cameras.size());
         scene.animations = readGltfAnimations(model_, reader_, file_, warnings_);
+        // glTF 2.0 (§3.7.3.1): a rendered skin's joints are in the rendered scene.
+        for (const auto& [gltfSkin, sceneSkin] : skinOf_) {
+            int root = scene.skins[size_t(sceneSkin)].joints[0];
+            while (scene.nodes[size_t(root)].parent >= 0) root = scene.nodes[size_t(root)].parent;
+            if (!visited[size_t(root)])
+                throw InputError(file_, gltfPlace("skins", gltfSkin) + ".joints",
+                                 "hang from node " + std::to_string(root) + ", which is not in the rendered scene");
+        }
         // What the render used is now known: errors there are refusals, errors elsewhere warnings.
         std::vector<uint8_t> usedNodes = visited;
         for (const auto& [gltfSkin, sceneSkin] : skinOf_)
@@ -515,6 +524,10 @@ private:
     void checkAttributeNames(const tinygltf::Primitive& prim, const std::string& place) const {
         std::map<std::string, std::set<int>> sets;
         for (const auto& [name, accessor] : prim.attributes) {
+            if (accessor >= 0 && accessor < int(model_.accessors.size()) &&
+                model_.accessors[size_t(accessor)].componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+                throw InputError(file_, place + ".attributes." + name, "has UNSIGNED_INT components, which glTF allows "
+                                                                       "for indices only");
             if (name == "POSITION" || name == "NORMAL" || name == "TANGENT" || (!name.empty() && name[0] == '_')) continue;
             const size_t underscore = name.rfind('_');
             const std::string family = underscore == std::string::npos ? name : name.substr(0, underscore);
@@ -649,6 +662,23 @@ private:
                 throw InputError(file_, place + ".material", "refers to material " + std::to_string(prim.material) + ", which does not exist");
             material = uint32_t(prim.material);
             usedMaterials_.insert(prim.material);
+            // Every texture of the material reads a TEXCOORD_n set the primitive has (glTF 2.0 §3.9.6).
+            const tinygltf::Material& m = model_.materials[size_t(prim.material)];
+            const std::pair<const char*, const tinygltf::TextureInfo*> textures[] = {
+                {"pbrMetallicRoughness.baseColorTexture", &m.pbrMetallicRoughness.baseColorTexture},
+                {"pbrMetallicRoughness.metallicRoughnessTexture", &m.pbrMetallicRoughness.metallicRoughnessTexture},
+                {"emissiveTexture", &m.emissiveTexture}};
+            const int textureCount = int(model_.textures.size());  // a texture that does not exist is a finding
+            for (const auto& [name, info] : textures)
+                if (info->index >= 0 && info->index < textureCount && !prim.attributes.count("TEXCOORD_" + std::to_string(info->texCoord)))
+                    throw InputError(file_, place, "has no TEXCOORD_" + std::to_string(info->texCoord) + ", which " +
+                                                       gltfPlace("materials", prim.material) + "." + name + " reads");
+            for (const auto& [name, texCoord, index] :
+                 {std::tuple{"normalTexture", m.normalTexture.texCoord, m.normalTexture.index},
+                  std::tuple{"occlusionTexture", m.occlusionTexture.texCoord, m.occlusionTexture.index}})
+                if (index >= 0 && index < textureCount && !prim.attributes.count("TEXCOORD_" + std::to_string(texCoord)))
+                    throw InputError(file_, place, "has no TEXCOORD_" + std::to_string(texCoord) + ", which " +
+                                                       gltfPlace("materials", prim.material) + "." + name + " reads");
         }
 
         std::vector<Vec3f> objectPositions(vertexCount);
@@ -664,6 +694,31 @@ private:
         MeshInstance& instance = scene.instances.back();
         if (skin >= 0) addInfluences(scene, instance, prim, place, skin);
         addMorphTargets(instance, prim, place, morphWeights, normals.has_value());
+    }
+
+    // glTF 2.0 (§3.7.3.1): a skin's joints hang from one common root, and its skeleton, if
+    // given, is an ancestor of (or is) every joint. The nodes' parents are known (buildHierarchy).
+    void checkJointHierarchy(const Scene& scene, int index, const tinygltf::Skin& source) const {
+        const std::string place = gltfPlace("skins", index);
+        auto rootOf = [&](int n) {
+            while (scene.nodes[size_t(n)].parent >= 0) n = scene.nodes[size_t(n)].parent;
+            return n;
+        };
+        auto descendsFrom = [&](int n, int ancestor) {
+            for (; n >= 0; n = scene.nodes[size_t(n)].parent)
+                if (n == ancestor) return true;
+            return false;
+        };
+        const int root = rootOf(source.joints[0]);
+        for (int j : source.joints)
+            if (rootOf(j) != root)
+                throw InputError(file_, place + ".joints", "holds nodes " + std::to_string(source.joints[0]) + " and " +
+                                                               std::to_string(j) + ", which share no root (glTF requires one)");
+        if (source.skeleton >= 0 && source.skeleton < int(scene.nodes.size()))
+            for (int j : source.joints)
+                if (!descendsFrom(j, source.skeleton))
+                    throw InputError(file_, place + ".skeleton", "node " + std::to_string(source.skeleton) +
+                                                                     " is not an ancestor of joint node " + std::to_string(j));
     }
 
     // The Scene::skins index of glTF skin `index`, read on first use.
@@ -682,6 +737,7 @@ private:
                 throw InputError(file_, place + ".joints", "refers to node " + std::to_string(j) + ", which does not exist");
             skin.joints.push_back(j);
         }
+        checkJointHierarchy(scene, index, source);
         skin.inverseBind.assign(skin.joints.size(), Transform());
         if (source.inverseBindMatrices >= 0) {
             const AccessorData m = reader_.read(source.inverseBindMatrices, place + ".inverseBindMatrices", kMatrixFormat);

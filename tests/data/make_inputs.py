@@ -117,6 +117,12 @@ def textured(embedded):
         images = [{"uri": "data:image/png;base64," + base64.b64encode(image).decode()}]
     m["bufferViews"].insert(2, {"buffer": 0, "byteOffset": garbage_at, "byteLength": 19})
     images.append({"bufferView": 2, "mimeType": "image/png"})
+    # The texture coordinates the texture reads (glTF requires the TEXCOORD_n it names).
+    data += b"\0" * (-len(data) % 4)
+    m["bufferViews"].append({"buffer": 0, "byteOffset": len(data), "byteLength": 32})
+    data += struct.pack("<8f", 0, 0, 1, 0, 1, 1, 0, 1)
+    m["accessors"].append({"bufferView": len(m["bufferViews"]) - 1, "componentType": 5126, "count": 4, "type": "VEC2"})
+    m["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = len(m["accessors"]) - 1
     m["buffers"][0] = {"byteLength": len(data), "uri": b64(data)}
     m.update(images=images, textures=[{"source": 0}, {"source": 1}],
              materials=[{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": [1, 1, 1, 1]}}])
@@ -202,7 +208,7 @@ bad("gltf", "asset_min_version_2_1.gltf", edited(lambda m: m["asset"].update(min
 short_pos = struct.pack("<12h", -1, 0, 1, 1, 0, 1, 1, 0, -1, -1, 0, -1)
 bad("gltf", "position_short_without_quantization.gltf",
     edited(accessor(0, componentType=5122), scene(positions=short_pos + b"\0" * 24)), "KHR_mesh_quantization")
-bad("gltf", "position_unsigned_int.gltf", edited(accessor(0, componentType=5125)), "not allowed")
+bad("gltf", "position_unsigned_int.gltf", edited(accessor(0, componentType=5125)), "UNSIGNED_INT")
 bad("gltf", "position_vec2.gltf", edited(accessor(0, type="VEC2")), "VEC3")
 bad("gltf", "position_float_normalized.gltf", edited(accessor(0, normalized=True)), "8- and 16-bit integers only")
 bad("gltf", "quantization_used_but_not_required.gltf",
