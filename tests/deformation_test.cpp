@@ -257,6 +257,21 @@ TEST(Deformation, AnInverseBindMatrixWhoseLastRowIsNotAffineIsRefused) {
     }
 }
 
+// A node outside the default scene that reuses the rendered skinned mesh and its skin is
+// checked in a scratch scene of its own (the real scene's skins are set aside: reusing their
+// indices there read past the scratch scene's skins).
+TEST(Deformation, AnUnrenderedNodeReusingTheRenderedSkinLoadsCleanly) {
+    const fs::path file = writeDeformingScene("skin-reused", false);
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(file));
+    doc["nodes"].push_back({{"name", "Elsewhere"}, {"mesh", 0}, {"skin", 0}});
+    std::ofstream(file.parent_path() / "skin-reused-orphan.gltf") << doc.dump();
+    Warnings warnings;
+    Scene scene;
+    ASSERT_NO_THROW(scene = loadGltfScene((file.parent_path() / "skin-reused-orphan.gltf").string(), warnings));
+    EXPECT_EQ(scene.skins.size(), 1u);
+    for (const std::string& w : warnings.messages) EXPECT_EQ(w.find("rendered scene"), std::string::npos) << w;
+}
+
 // A joint scaled to zero hides what it alone holds (glTF's visibility, DESIGN §3): the strip's
 // vertices weighted wholly to Tip, not those it shares with Root (their blend, ½ I, is invertible).
 TEST(Deformation, AJointScaledToZeroHidesTheVerticesItAloneHolds) {

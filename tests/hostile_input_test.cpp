@@ -223,6 +223,25 @@ TEST(HostileInput, ErrorsInUnusedObjectsWarnAndStrictRefusesThem) {
     used("node.gltf", [](nlohmann::json& d) { d["scenes"][0]["nodes"].push_back(2); }, "nodes[2]");
 }
 
+// A hidden node is fine; a hidden camera has no direction to look in: refused before any frame
+// is written, naming the frame.
+TEST(HostileInput, ACameraScaledToZeroIsRefusedNamingTheFrame) {
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(dataDir() / "good" / "base.gltf"));
+    doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}}};
+    doc["nodes"].push_back({{"name", "Cam"}, {"camera", 0}, {"translation", {0, 0.5, 3}}});
+    doc["scenes"][0]["nodes"].push_back(int(doc["nodes"].size()) - 1);
+    const fs::path dir = testScratchDir("hostile-camera-zero");
+    std::ofstream(dir / "scene.gltf") << doc.dump();
+    std::ofstream(dir / "hide.json") << R"({"format":"qsgi-animation","version":1,"frames":[{"frame":0},)"
+                                     << R"({"frame":2,"nodes":{"Cam":{"scale":[0,0,0]}}}]})";
+    const CommandResult r = runQsgi("render " + (dir / "scene.gltf").string() + " --animation " + (dir / "hide.json").string() +
+                                    " --photons 1000 --out " + (dir / "out").string());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("frame 2"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("'Cam'"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out")) << "nothing may be written";
+}
+
 TEST(HostileInput, MemoryBeyondTheProcesssLimitIsRefusedNamingTheLimit) {
     if (kSanitized) GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space, so ulimit -v cannot apply";
     const std::string base = (dataDir() / "good" / "base.gltf").string();

@@ -64,9 +64,12 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     PoseChange change;
     // Only instances the animation moves can move: keep their positions to compare with.
     previousPositions_.resize(scene_.vertexCount());
+    previousHidden_.resize(scene_.vertexCount());
     for (const MeshInstance& inst : scene_.instances)
-        if (inst.vertexCount > 0 && scene_.vertexDynamic[inst.firstVertex])
+        if (inst.vertexCount > 0 && scene_.vertexDynamic[inst.firstVertex]) {
             std::copy_n(scene_.positions.begin() + inst.firstVertex, inst.vertexCount, previousPositions_.begin() + inst.firstVertex);
+            std::copy_n(scene_.vertexHidden.begin() + inst.firstVertex, inst.vertexCount, previousHidden_.begin() + inst.firstVertex);
+        }
     std::vector<uint32_t> instances;
     change.any = scene_.applyPose(target, &instances);
     // Moved is decided per vertex and triangle: an instance re-placed by a transform that leaves
@@ -77,8 +80,11 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     change.triangleMoved.assign(scene_.triangleCount(), 0);
     for (uint32_t i : instances) {
         const MeshInstance& inst = scene_.instances[i];
+        // A vertex hidden or shown again (a zero scale, DESIGN §3) counts as moved even where it
+        // stays put (a vertex at its node's origin): its radiosity is 0 only while hidden.
         for (uint32_t v = inst.firstVertex; v < inst.firstVertex + inst.vertexCount; ++v)
-            change.vertexMoved[v] = std::memcmp(&previousPositions_[v], &scene_.positions[v], sizeof(Vec3f)) != 0;
+            change.vertexMoved[v] = std::memcmp(&previousPositions_[v], &scene_.positions[v], sizeof(Vec3f)) != 0 ||
+                                    previousHidden_[v] != scene_.vertexHidden[v];
         Bounds3f before, after;
         for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t) {
             for (uint32_t v : scene_.triangles[t].v) change.triangleMoved[t] |= change.vertexMoved[v];

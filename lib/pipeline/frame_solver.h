@@ -99,6 +99,7 @@ private:
     bool regionsValid_ = false;
     bool solved_ = false;
     std::vector<Vec3f> previousPositions_;  // the moving instances' vertices before a pose
+    std::vector<uint8_t> previousHidden_;   // and whether they were hidden
     // After a frame solved from scratch, its cache; the tracked paths are made from it only when
     // the next frame updates (a frame that falls back to scratch again needs none).
     std::optional<RayCache> lastCache_;

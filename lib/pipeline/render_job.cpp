@@ -116,6 +116,17 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                              std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the animation's last frame " +
                                  std::to_string(animation_.lastFrame()));
     }
+    // A camera hung from a node the animation scales to zero has no direction: refused before
+    // any frame is written, naming the first such frame (a hidden node is fine, a hidden camera
+    // is not).
+    if (camera_.node >= 0 && !animation_.movedNodes().empty())
+        for (int frame = first_; frame <= last_; ++frame) {
+            const Camera c = cameraAt(frame);
+            if (!(length(c.forward) > 0.5f) || !(length(c.up) > 0.5f) || !(length(cross(c.forward, c.up)) > 0.5f))
+                throw InputError(animationSource, "frame " + std::to_string(frame),
+                                 "the camera's node '" + scene_.nodes[size_t(camera_.node)].name +
+                                     "' has a singular transform (a zero scale), so the camera has no direction");
+        }
     std::string animationBytes;
     if (gltfAnimation) {
         // The keyframes the run samples (the fps is among the fingerprinted options): their size

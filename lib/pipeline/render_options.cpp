@@ -107,8 +107,6 @@ json getCamera(const RenderSettings& s) {
     return s.cameraIndex ? json(*s.cameraIndex) : json(nullptr);
 }
 
-constexpr int64_t kInt32Max = std::numeric_limits<int32_t>::max();
-
 std::vector<RenderOption> declareOptions() {
     using T = OptionType;
     std::vector<RenderOption> o;

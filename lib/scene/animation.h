@@ -30,7 +30,7 @@ public:
     // The scene's glTF animation `index` (all of them at once if -1), sampled at `fps` from time
     // 0 through the last key. `source` names the animation in messages (e.g. "scene.gltf,
     // --animation gltf:1"). Throws InputError if there is no such animation, if animations played
-    // together drive the same node property, or if a frame's transform is not invertible.
+    // together drive the same node property, or if a frame's transform is not finite (a singular one hides the node, DESIGN §3).
     static Animation fromGltf(const Scene& scene, int index, double fps, const std::string& source);
     // The last frame of a glTF animation whose keys end at endSeconds, sampled at fps.
     static double lastFrameAt(double endSeconds, double fps);

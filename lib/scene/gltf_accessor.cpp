@@ -134,7 +134,8 @@ bool AccessorReader::viewHasData(int viewIndex) const {
 bool AccessorReader::hasData(int accessorIndex) const {
     if (accessorIndex < 0 || accessorIndex >= int(model_.accessors.size())) return false;
     const tinygltf::Accessor& acc = model_.accessors[size_t(accessorIndex)];
-    return viewHasData(acc.bufferView) || (acc.sparse.isSparse && viewHasData(acc.sparse.values.bufferView));
+    return viewHasData(acc.bufferView) || (acc.sparse.isSparse && viewHasData(acc.sparse.indices.bufferView) &&
+                                           viewHasData(acc.sparse.values.bufferView));
 }
 
 void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) const {
@@ -290,7 +291,9 @@ double AccessorReader::component(const unsigned char* p, int type, bool normaliz
 }
 
 void AccessorReader::applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const {
-    // checkLayout has checked the count, the index type and both ranges.
+    // checkLayout has checked the count, the index type and both ranges. Sparse parts in a
+    // buffer without data (only read while tolerated) change nothing.
+    if (!viewHasData(acc.sparse.indices.bufferView) || !viewHasData(acc.sparse.values.bufferView)) return;
     const size_t n = size_t(acc.sparse.count);
     const int indexType = acc.sparse.indices.componentType;
     std::vector<size_t> targets(n);

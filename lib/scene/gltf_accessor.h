@@ -56,7 +56,7 @@ public:
 
     // Checks an accessor nothing reads as read() would check its layout (it exists, its type
     // and componentType are known, its elements and sparse parts lie inside their views and
-    // buffers), without decoding or allocating anything.
+    // buffers) and, where the file holds its data, decodes it to check its values.
     void checkUnread(int accessorIndex, const std::string& usedBy) const;
     // The same for a buffer view nothing reads: inside its buffer, a stride glTF allows.
     void checkUnreadView(int viewIndex) const;
@@ -68,7 +68,12 @@ public:
     // for checking objects nothing reads, where such buffers are valid (the loader's
     // checkUnusedObjects).
     void tolerateAbsentData(bool tolerate) const { tolerateAbsent_ = tolerate; }
-    // Whether read() was called for the accessor (whatever it found): the objects the render used.
+    // Whether read() was called for the accessor (whatever it found) since forgetReads(): the
+    // loader asks before it checks the unread ones, so this is what the render used.
+    void forgetReads() const {
+        read_.clear();
+        viewsRead_.clear();
+    }
     bool wasRead(int accessorIndex) const { return read_.count(accessorIndex) > 0; }
     // Whether a read went through the buffer view (an accessor's, an embedded image's).
     bool viewWasRead(int viewIndex) const { return viewsRead_.count(viewIndex) > 0; }

@@ -99,6 +99,8 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
 
             const AccessorData input = reader.read(sampler.input, samplerPlace + ".input", kTimeFormat);
             if (input.count == 0) throw InputError(file, samplerPlace + ".input", "has no key times");
+            if (track.interpolation == Interpolation::CubicSpline && input.count < 2)
+                throw InputError(file, samplerPlace + ".input", "has 1 key; CUBICSPLINE needs at least 2 (glTF 2.0)");
             // glTF 2.0 (§5.1.3): an animation input accessor states its bounds, as POSITION does.
             const tinygltf::Accessor& times = model.accessors[size_t(sampler.input)];
             if (times.minValues.size() != 1 || times.maxValues.size() != 1)
@@ -139,21 +141,25 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
                                      " " + animatedPropertyName(channel.property) + " need " + std::to_string(expected));
             track.components = int(perKey);
             track.values = output.values;
-            if (channel.property == AnimatedProperty::Rotation)
+            // Keys are judged where the file states them; a channel with an input or output of
+            // default zeros is left out below.
+            const bool keysStated = timesStated && reader.hasData(sampler.output);
+            if (channel.property == AnimatedProperty::Rotation && reader.hasData(sampler.output))
                 for (size_t k = 0; k < input.count; ++k) {
                     const double* q = &track.values[(k * groups + (groups == 3 ? 1 : 0)) * 4];
                     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
                     if (!(norm > 1e-6))
                         throw InputError(file, samplerPlace + ".output",
                                          "key " + std::to_string(k) + " is a zero quaternion, which is no rotation");
-                    // Unit, within the glTF-Validator's tolerance, where the file states the keys.
-                    if (reader.hasData(sampler.output) && !(std::fabs(norm - 1) <= 0.00769))
+                    // Unit, within the glTF-Validator's tolerance.
+                    if (!(std::fabs(norm - 1) <= 0.00769))
                         throw InputError(file, samplerPlace + ".output", "key " + std::to_string(k) + " has length " +
                                                                              std::to_string(norm) + ", not 1 (a rotation is a unit quaternion)");
                 }
-            if (!timesStated) {
-                warnings.add(file + ": " + samplerPlace + ".input has no data (an accessor without a bufferView holds "
-                                    "zeros), so " + place + " animates nothing and is left out");
+            if (!keysStated) {
+                warnings.add(file + ": " + samplerPlace + (timesStated ? ".output" : ".input") +
+                             " has no data (an accessor without a bufferView holds zeros), so " + place +
+                             " animates nothing and is left out");
                 continue;
             }
             animation.startTime = first ? track.times.front() : std::min(animation.startTime, track.times.front());

@@ -286,6 +286,10 @@ public:
                 scene.materials.push_back(Material{"(unusable)", Vec3f(1.0f), Vec3f(0.0f)});
             }
         }
+        // Every material's textures were decoded whether or not the render uses the material:
+        // which views were read is learnt from here on, and the used images' views are added
+        // by usedObjects.
+        reader_.forgetReads();
         defaultMaterial_ = uint32_t(scene.materials.size());
         scene.materials.push_back(Material{"(default)", Vec3f(1.0f), Vec3f(0.0f)});
 
@@ -382,7 +386,15 @@ private:
             for (int t : {material.pbrMetallicRoughness.baseColorTexture.index, material.emissiveTexture.index}) {
                 if (t < 0 || t >= int(model_.textures.size())) continue;
                 add("textures", t);
-                if (model_.textures[size_t(t)].source >= 0) add("images", model_.textures[size_t(t)].source);
+                const int image = model_.textures[size_t(t)].source;
+                if (image >= 0 && image < int(model_.images.size())) {
+                    add("images", image);
+                    const int view = model_.images[size_t(image)].bufferView;
+                    if (view >= 0 && view < int(model_.bufferViews.size())) {
+                        add("bufferViews", view);
+                        add("buffers", model_.bufferViews[size_t(view)].buffer);
+                    }
+                }
                 if (model_.textures[size_t(t)].sampler >= 0) add("samplers", model_.textures[size_t(t)].sampler);
             }
         }
@@ -410,11 +422,27 @@ private:
             explicit Tolerate(const AccessorReader& r) : reader(r) { reader.tolerateAbsentData(true); }
             ~Tolerate() { reader.tolerateAbsentData(false); }
         } tolerate(reader_);
+        // The scratch scene has skins of its own: the real scene's map of skins is set aside
+        // (and put back however this ends), as are the sets of used meshes and materials.
+        struct SetAside {
+            SceneBuilder& builder;
+            std::map<int, int> skins;
+            std::set<int> meshes, materials;
+            explicit SetAside(SceneBuilder& b)
+                : builder(b), skins(std::move(b.skinOf_)), meshes(b.usedMeshes_), materials(b.usedMaterials_) {
+                builder.skinOf_.clear();
+            }
+            ~SetAside() {
+                builder.skinOf_ = std::move(skins);
+                builder.usedMeshes_ = std::move(meshes);
+                builder.usedMaterials_ = std::move(materials);
+            }
+        } setAside(*this);
         Scene scratch;
         scratch.materials = scene.materials;
         scratch.nodes = scene.nodes;
-        const std::map<int, int> usedSkins = skinOf_;
-        const std::set<int> usedMeshes = usedMeshes_;
+        const std::map<int, int>& usedSkins = setAside.skins;
+        const std::set<int> usedMeshes = setAside.meshes;
         for (size_t n = 0; n < model_.nodes.size(); ++n) {
             if (usedNodes[n]) continue;
             try {
@@ -776,7 +804,7 @@ private:
                                                                    std::to_string(set) + " without the other");
             jointSets.push_back(reader_.read(j->second, place + ".attributes." + j->first, kJointsFormat));
             weightSets.push_back(reader_.read(w->second, place + ".attributes." + w->first, kWeightsFormat));
-            weightsStated = weightsStated && reader_.hasData(w->second);
+            weightsStated = weightsStated && reader_.hasData(w->second) && reader_.hasData(j->second);
         }
         if (jointSets.empty())
             throw InputError(file_, place + ".attributes",
@@ -798,7 +826,7 @@ private:
                     if (weight < 0)
                         throw InputError(file_, place + ".attributes.WEIGHTS_" + std::to_string(s), "holds a negative weight");
                     if (weight > 0) {
-                        if (std::find(namedJoints.begin(), namedJoints.end(), joint) != namedJoints.end())
+                        if (weightsStated && std::find(namedJoints.begin(), namedJoints.end(), joint) != namedJoints.end())
                             throw InputError(file_, place + ".attributes.JOINTS_" + std::to_string(s),
                                              "vertex " + std::to_string(v) + " names joint " + std::to_string(size_t(joint)) +
                                                  " twice with non-zero weights");
@@ -882,7 +910,8 @@ private:
                              "must lie below pi for the camera to render a picture");
         // World space here: Scene::finalize re-centres it with the lights.
         const Camera c = placeCamera(lens, world, Vec3d(0.0));
-        if (!isFinite(c.position) || !isFinite(c.forward) || !isFinite(c.up))
+        if (!isFinite(c.position) || !isFinite(c.forward) || !isFinite(c.up) || !(length(c.forward) > 0.5f) ||
+            !(length(c.up) > 0.5f) || !(length(cross(c.forward, c.up)) > 0.5f))
             throw InputError(file_, gltfPlace("nodes", n), "the camera node's transform is not finite or not invertible");
         scene.cameras[node.camera] = c;
         if (!scene.camera) scene.camera = c;

@@ -38,7 +38,8 @@ void checkSceneExtent(const std::vector<Vec3f>& positions, const Bounds3f& bound
         throw InputError(file, place, std::string("the scene spans ") + spans + " units; qsgi supports up to 1e15 "
                                       "(beyond that float areas overflow)");
     }
-    // An empty extent is a scene whose every node is hidden (a zero scale), which is allowed.
+    // An empty extent is a scene whose geometry all lies at one point (every node hidden by a
+    // zero scale, at one origin), which is allowed.
     if (extent > 0 && extent < kMinSceneExtent) {
         char spans[32];
         std::snprintf(spans, sizeof spans, "%.3g", extent);
@@ -172,7 +173,10 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world, const st
         positions[v] = Vec3f((rigidHidden ? m.applyPoint(Vec3d(0.0)) : m.applyPoint(objectPosition[i])) - worldOrigin);
         if (hidden) {
             // The last finite normal stays; one never placed visible takes its object-space normal.
-            if (!(dot(normals[v], normals[v]) > 0)) normals[v] = objectNormal.empty() ? Vec3f(0, 1, 0) : Vec3f(normalize(objectNormal[i]));
+            if (!(dot(normals[v], normals[v]) > 0)) {
+                const Vec3d n = objectNormal.empty() ? Vec3d(0.0) : normalize(objectNormal[i]);
+                normals[v] = dot(n, n) > 0 && isFinite(Vec3f(n)) ? Vec3f(n) : Vec3f(0, 1, 0);  // any unit normal
+            }
             continue;
         }
         if (transformNormals) {
