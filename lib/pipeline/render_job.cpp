@@ -121,8 +121,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     // is not).
     if (camera_.node >= 0 && !animation_.movedNodes().empty())
         for (int frame = first_; frame <= last_; ++frame) {
-            const Camera c = cameraAt(frame);
-            if (!(length(c.forward) > 0.5f) || !(length(c.up) > 0.5f) || !(length(cross(c.forward, c.up)) > 0.5f))
+            if (!hasDirection(cameraAt(frame)))
                 throw InputError(animationSource, "frame " + std::to_string(frame),
                                  "the camera's node '" + scene_.nodes[size_t(camera_.node)].name +
                                      "' has a singular transform (a zero scale), so the camera has no direction");

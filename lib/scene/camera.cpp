@@ -28,6 +28,10 @@ Camera framingCamera(const Bounds3f& bounds, float aspect) {
     return lookAtCamera(centre + direction * distance, centre, Vec3f(0, 1, 0), yfov);
 }
 
+bool hasDirection(const Camera& c) {
+    return length(c.forward) > 0.5f && length(c.up) > 0.5f && length(cross(c.forward, c.up)) > 0.5f;
+}
+
 Camera placeCamera(Camera lens, const Transform& world, const Vec3d& worldOrigin) {
     lens.position = Vec3f(world.applyPoint(Vec3d(0.0)) - worldOrigin);
     lens.forward = Vec3f(normalize(world.applyVector(Vec3d(0, 0, -1))));

@@ -36,4 +36,8 @@ struct CameraRay {
 };
 CameraRay cameraRay(const Camera& c, float x, float y, int width, int height);
 
+// Whether the camera looks somewhere: unit forward and up that are not parallel. A camera placed
+// by a singular transform (its node scaled to zero) has none.
+bool hasDirection(const Camera& c);
+
 }  // namespace qsgi

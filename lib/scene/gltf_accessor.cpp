@@ -13,6 +13,19 @@ namespace qsgi {
 std::string gltfPlace(const std::string& what, int index) { return what + "[" + std::to_string(index) + "]"; }
 
 namespace {
+// A normalised integer component's value (glTF 2.0 §3.11): its raw value over the type's
+// largest, signed ones clamped at −1.
+double normalised(double raw, int componentType) {
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return std::max(raw / 127.0, -1.0);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return raw / 255.0;
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return std::max(raw / 32767.0, -1.0);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return raw / 65535.0;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return raw / 4294967295.0;
+        default: return raw;
+    }
+}
+
 std::string typeName(int type) {
     switch (type) {
         case TINYGLTF_TYPE_SCALAR: return "SCALAR";
@@ -84,16 +97,6 @@ void AccessorReader::checkDeclaredBounds(int accessorIndex, const AccessorData& 
     // glTF 2.0 (§3.6.2.5): min and max, where given, are the elements' exact bounds, per component,
     // in the components' own type (a normalised integer's raw value). They are compared here
     // after the same normalisation, with a relative 10^-5 for the decimal digits a float loses.
-    auto normalised = [&](double raw) {
-        if (!acc.normalized) return raw;
-        switch (acc.componentType) {
-            case TINYGLTF_COMPONENT_TYPE_BYTE: return std::max(raw / 127.0, -1.0);
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return raw / 255.0;
-            case TINYGLTF_COMPONENT_TYPE_SHORT: return std::max(raw / 32767.0, -1.0);
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return raw / 65535.0;
-            default: return raw;
-        }
-    };
     for (const auto* bound : {&acc.minValues, &acc.maxValues}) {
         if (bound->empty()) continue;
         if (int(bound->size()) != components)
@@ -102,6 +105,11 @@ void AccessorReader::checkDeclaredBounds(int accessorIndex, const AccessorData& 
                                                " components");
     }
     if (acc.minValues.empty() && acc.maxValues.empty()) return;
+    auto text = [](double v) {
+        char out[32];
+        std::snprintf(out, sizeof out, "%.9g", v);
+        return std::string(out);
+    };
     for (int c = 0; c < components; ++c) {
         double lowest = data(0, c), highest = data(0, c);
         for (size_t e = 1; e < data.count; ++e) {
@@ -109,11 +117,8 @@ void AccessorReader::checkDeclaredBounds(int accessorIndex, const AccessorData& 
             highest = std::max(highest, data(e, c));
         }
         const double tolerance = 1e-5 * std::max({std::fabs(lowest), std::fabs(highest), 1e-30});
-        auto differs = [&](double declared, double actual) { return std::fabs(normalised(declared) - actual) > tolerance; };
-        auto text = [](double v) {
-            char out[32];
-            std::snprintf(out, sizeof out, "%.9g", v);
-            return std::string(out);
+        auto differs = [&](double declared, double actual) {
+            return std::fabs((acc.normalized ? normalised(declared, acc.componentType) : declared) - actual) > tolerance;
         };
         if (!acc.minValues.empty() && differs(acc.minValues[size_t(c)], lowest))
             throw InputError(file_, place + ".min", "component " + std::to_string(c) + " is declared " +
@@ -153,11 +158,15 @@ void AccessorReader::checkUnread(int accessorIndex, const std::string& usedBy) c
     if (hasData(accessorIndex)) read(accessorIndex, usedBy, itself);
 }
 
-void AccessorReader::checkUnreadView(int viewIndex) const {
-    const tinygltf::BufferView& view = checkedView(viewIndex, gltfPlace("bufferViews", viewIndex), false);
+void AccessorReader::checkStride(const tinygltf::BufferView& view, int viewIndex) const {
     if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
         throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
                          std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
+}
+
+void AccessorReader::checkUnreadView(int viewIndex) const {
+    const tinygltf::BufferView& view = checkedView(viewIndex, gltfPlace("bufferViews", viewIndex), false);
+    checkStride(view, viewIndex);
     if (view.byteStride > view.byteLength)
         throw InputError(file_, gltfPlace("bufferViews", viewIndex) + ".byteStride",
                          std::to_string(view.byteStride) + " exceeds the view's byteLength " + std::to_string(view.byteLength));
@@ -241,9 +250,7 @@ void AccessorReader::checkRange(int viewIndex, size_t byteOffset, size_t count, 
     const std::string viewPlace = gltfPlace("bufferViews", viewIndex);
     const uint64_t componentSize = uint64_t(tinygltf::GetComponentSizeInBytes(uint32_t(componentType)));
     const uint64_t elementSize = componentSize * uint64_t(components);
-    if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
-        throw InputError(file_, viewPlace + ".byteStride",
-                         std::to_string(view.byteStride) + " is not a multiple of 4 in 4..252");
+    checkStride(view, viewIndex);
     if (view.byteStride != 0 && view.byteStride < elementSize)
         throw InputError(file_, viewPlace + ".byteStride", std::to_string(view.byteStride) + " is smaller than the " +
                                                                std::to_string(elementSize) + "-byte elements of " + place);
@@ -279,15 +286,17 @@ void AccessorReader::decode(int viewIndex, size_t byteOffset, size_t count, int 
 }
 
 double AccessorReader::component(const unsigned char* p, int type, bool normalized) {
+    double raw = 0;
     switch (type) {
-        case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0, -1.0) : v; }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { uint8_t v; std::memcpy(&v, p, 1); return normalized ? v / 255.0 : v; }
-        case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? v / 4294967295.0 : v; }
+        case TINYGLTF_COMPONENT_TYPE_BYTE: { int8_t v; std::memcpy(&v, p, 1); raw = v; break; }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { uint8_t v; std::memcpy(&v, p, 1); raw = v; break; }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); raw = v; break; }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); raw = v; break; }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); raw = v; break; }
         case TINYGLTF_COMPONENT_TYPE_FLOAT: { float v; std::memcpy(&v, p, 4); return v; }
         default: return 0;
     }
+    return normalized ? normalised(raw, type) : raw;
 }
 
 void AccessorReader::applySparse(const tinygltf::Accessor& acc, AccessorData& out, const std::string& place) const {

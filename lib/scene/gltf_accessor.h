@@ -26,6 +26,11 @@ struct AccessorFormat {
     std::vector<std::pair<int, bool>> allowedQuantized;  // more, with KHR_mesh_quantization
 };
 
+// The Khronos glTF-Validator's tolerances (read from its source), which qsgi applies to the same
+// rules: |length − 1| of unit vectors (normals) and of rotation quaternions.
+constexpr double kUnitVectorTolerance = 0.00674;
+constexpr double kUnitQuaternionTolerance = 0.00769;
+
 // "FLOAT", "UNSIGNED_SHORT", …
 std::string componentTypeName(int type);
 
@@ -91,6 +96,8 @@ private:
     // data (no uri) passes, since nothing reads it (checkUnread).
     const tinygltf::BufferView& checkedView(int viewIndex, const std::string& place, bool needData = true) const;
     void checkFormat(const tinygltf::Accessor& acc, const AccessorFormat& format, const std::string& place) const;
+    // A view's byteStride: none, or a multiple of 4 in 4..252.
+    void checkStride(const tinygltf::BufferView& view, int viewIndex) const;
     // The elements' and the sparse parts' ranges, the sparse count and index type.
     void checkLayout(const tinygltf::Accessor& acc, int components, const std::string& place, bool needData = true) const;
     // Checks that `count` elements from a buffer view lie inside the view and its buffer, with

@@ -152,7 +152,7 @@ std::vector<KeyframeAnimation> readGltfAnimations(const tinygltf::Model& model, 
                         throw InputError(file, samplerPlace + ".output",
                                          "key " + std::to_string(k) + " is a zero quaternion, which is no rotation");
                     // Unit, within the glTF-Validator's tolerance.
-                    if (!(std::fabs(norm - 1) <= 0.00769))
+                    if (!(std::fabs(norm - 1) <= kUnitQuaternionTolerance))
                         throw InputError(file, samplerPlace + ".output", "key " + std::to_string(k) + " has length " +
                                                                              std::to_string(norm) + ", not 1 (a rotation is a unit quaternion)");
                 }

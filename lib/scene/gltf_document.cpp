@@ -318,12 +318,13 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     refuseBeyondGltfSize(path, bytes.size());
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     GlbLayout glb;
-    if (binary && bytes.size() >= 20 && readU32(bytes, 8) >= 20 && readU32(bytes, 8) < bytes.size()) {
+    const uint32_t declared = binary && bytes.size() >= 20 ? readU32(bytes, 8) : 0;
+    if (declared >= 20 && declared < bytes.size()) {
         // Bytes after the length the header declares are no part of the file (glTF 2.0 §4.4.2:
         // the validator lets them pass with a note); they are left unread.
-        warnings.add(path + ": GLB header: " + std::to_string(bytes.size() - readU32(bytes, 8)) +
+        warnings.add(path + ": GLB header: " + std::to_string(bytes.size() - declared) +
                      " bytes follow the declared end of the file and are ignored");
-        bytes.resize(readU32(bytes, 8));
+        bytes.resize(declared);
     }
     if (binary) glb = readGlbLayout(path, bytes);
     const std::string& jsonText = binary ? glb.jsonText : bytes;

@@ -10,7 +10,6 @@
 #include <fstream>
 #include <map>
 #include <set>
-#include <tuple>
 
 #include "scene/gltf_accessor.h"
 #include "scene/gltf_animation.h"
@@ -51,10 +50,6 @@ const AccessorFormat kWeightsFormat{
      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true}},
     {}};
 const AccessorFormat kMatrixFormat{TINYGLTF_TYPE_MAT4, {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}}, {}};
-// The glTF-Validator's tolerances for unit vectors (normals) and quaternions.
-constexpr double kUnitVectorTolerance = 0.00674;
-constexpr double kUnitQuaternionTolerance = 0.00769;
-
 const AccessorFormat kColourRgbFormat{
     TINYGLTF_TYPE_VEC3,
     {{TINYGLTF_COMPONENT_TYPE_FLOAT, false}, {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true},
@@ -173,13 +168,11 @@ std::optional<NodeTrs> nodeTrs(const tinygltf::Node& n) {
 Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTrs>& trs, const std::string& file,
                              int index) {
     const std::string place = gltfPlace("nodes", index);
-    if (n.rotation.size() == 4 &&
-        !(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
-              n.rotation[3] * n.rotation[3] > 1e-12))
-        throw InputError(file, place + ".rotation", "is a zero quaternion (a rotation must be a unit quaternion)");
     if (n.rotation.size() == 4) {
         const double norm = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] +
                                       n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
+        if (!(norm > 1e-6))
+            throw InputError(file, place + ".rotation", "is a zero quaternion (a rotation must be a unit quaternion)");
         if (!(std::fabs(norm - 1) <= kUnitQuaternionTolerance))
             throw InputError(file, place + ".rotation", "has length " + std::to_string(norm) + ", not 1 (a rotation must be a unit quaternion)");
     }
@@ -250,6 +243,12 @@ std::vector<SceneNode> buildHierarchy(const tinygltf::Model& model, const std::s
 }
 
 // Mesh Flattening
+// The root of node n's tree (the hierarchy is acyclic: buildHierarchy refuses cycles).
+int rootOf(const std::vector<SceneNode>& nodes, int n) {
+    while (nodes[size_t(n)].parent >= 0) n = nodes[size_t(n)].parent;
+    return n;
+}
+
 std::vector<uint32_t> triangleIndices(int mode, const std::vector<uint32_t>& idx) {
     std::vector<uint32_t> tri;
     const size_t n = idx.size();
@@ -325,8 +324,7 @@ public:
         scene.animations = readGltfAnimations(model_, reader_, file_, warnings_);
         // glTF 2.0 (§3.7.3.1): a rendered skin's joints are in the rendered scene.
         for (const auto& [gltfSkin, sceneSkin] : skinOf_) {
-            int root = scene.skins[size_t(sceneSkin)].joints[0];
-            while (scene.nodes[size_t(root)].parent >= 0) root = scene.nodes[size_t(root)].parent;
+            const int root = rootOf(scene.nodes, scene.skins[size_t(sceneSkin)].joints[0]);
             if (!visited[size_t(root)])
                 throw InputError(file_, gltfPlace("skins", gltfSkin) + ".joints",
                                  "hang from node " + std::to_string(root) + ", which is not in the rendered scene");
@@ -442,7 +440,7 @@ private:
         scratch.materials = scene.materials;
         scratch.nodes = scene.nodes;
         const std::map<int, int>& usedSkins = setAside.skins;
-        const std::set<int> usedMeshes = setAside.meshes;
+        const std::set<int>& usedMeshes = setAside.meshes;
         for (size_t n = 0; n < model_.nodes.size(); ++n) {
             if (usedNodes[n]) continue;
             try {
@@ -454,9 +452,7 @@ private:
         for (size_t m = 0; m < model_.meshes.size(); ++m) {
             if (usedMeshes.count(int(m))) continue;
             try {
-                if (model_.meshes[m].primitives.empty())
-                    throw InputError(file_, gltfPlace("meshes", int(m)) + ".primitives", "is empty (glTF requires at least one primitive)");
-                checkMorphTargetCounts(int(m));
+                checkMeshShape(int(m));
                 for (size_t p = 0; p < model_.meshes[m].primitives.size(); ++p)
                     addPrimitive(scratch, 0, Transform(), model_.meshes[m].primitives[p],
                                  gltfPlace("meshes", int(m)) + "." + gltfPlace("primitives", int(p)), -1, {});
@@ -498,16 +494,18 @@ private:
         }
     }
 
-    // glTF 2.0 (§3.7.2.2): every primitive of a mesh has as many morph targets, and the mesh's
-    // default weights, where given, one for each.
-    void checkMorphTargetCounts(int meshIndex) const {
+    // glTF 2.0 (§3.7.2, §3.7.2.2): a mesh has at least one primitive, every primitive as many
+    // morph targets, and the mesh's default weights, where given, one for each.
+    void checkMeshShape(int meshIndex) const {
         const tinygltf::Mesh& mesh = model_.meshes[size_t(meshIndex)];
+        if (mesh.primitives.empty())
+            throw InputError(file_, gltfPlace("meshes", meshIndex) + ".primitives", "is empty (glTF requires at least one primitive)");
         for (size_t p = 0; p < mesh.primitives.size(); ++p)
             if (mesh.primitives[p].targets.size() != mesh.primitives[0].targets.size())
                 throw InputError(file_, gltfPlace("meshes", meshIndex) + "." + gltfPlace("primitives", int(p)) + ".targets",
                                  "has " + std::to_string(mesh.primitives[p].targets.size()) +
                                      " morph targets but primitive 0 has " + std::to_string(mesh.primitives[0].targets.size()));
-        if (!mesh.weights.empty() && !mesh.primitives.empty() && mesh.weights.size() != mesh.primitives[0].targets.size())
+        if (!mesh.weights.empty() && mesh.weights.size() != mesh.primitives[0].targets.size())
             throw InputError(file_, gltfPlace("meshes", meshIndex) + ".weights",
                              "has " + std::to_string(mesh.weights.size()) + " weights for " +
                                  std::to_string(mesh.primitives[0].targets.size()) + " morph targets");
@@ -520,13 +518,10 @@ private:
                 throw InputError(file_, gltfPlace("nodes", n) + ".mesh", "refers to mesh " + std::to_string(node.mesh) + ", which does not exist");
             const tinygltf::Mesh& mesh = model_.meshes[node.mesh];
             usedMeshes_.insert(node.mesh);
-            if (mesh.primitives.empty())
-                throw InputError(file_, gltfPlace("meshes", node.mesh) + ".primitives",
-                                 "is empty (glTF requires at least one primitive), and node " + std::to_string(n) + " uses the mesh");
+            checkMeshShape(node.mesh);
             const int skin = node.skin >= 0 ? addSkin(scene, node.skin, gltfPlace("nodes", n) + ".skin") : -1;
             // Morph target weights: the node's, else the mesh's, else zeros (glTF 2.0 §3.7.2.2).
             const std::vector<double>& weights = !node.weights.empty() ? node.weights : mesh.weights;
-            checkMorphTargetCounts(node.mesh);
             if (!node.weights.empty() && node.weights.size() != mesh.primitives[0].targets.size())
                 throw InputError(file_, gltfPlace("nodes", n) + ".weights",
                                  "has " + std::to_string(node.weights.size()) + " weights for " +
@@ -583,7 +578,7 @@ private:
 
     // Attributes the render does not use still follow the rules of their semantics (glTF 2.0
     // §3.7.2.1): their formats, and vertex colours within [0, 1].
-    void checkColours(const tinygltf::Primitive& prim, const std::string& place) const {
+    void checkOtherAttributes(const tinygltf::Primitive& prim, const std::string& place) const {
         for (const auto& [name, accessor] : prim.attributes) {
             if (name.rfind("TEXCOORD_", 0) == 0) reader_.read(accessor, place + ".attributes." + name, kTexcoordFormat);
             if (name == "TANGENT") reader_.read(accessor, place + ".attributes." + name, kTangentFormat);
@@ -602,7 +597,7 @@ private:
     void addPrimitive(Scene& scene, int nodeIndex, const Transform& world, const tinygltf::Primitive& prim,
                       const std::string& place, int skin, const std::vector<double>& morphWeights) {
         checkAttributeNames(prim, place);
-        checkColours(prim, place);
+        checkOtherAttributes(prim, place);
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
             prim.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
             warnings_.add(file_ + ": point and line primitives are skipped");
@@ -630,8 +625,9 @@ private:
                 throw InputError(file_, place + ".attributes.NORMAL",
                                  "has " + std::to_string(normals->count) + " elements but POSITION has " +
                                      std::to_string(vertexCount) + " (attribute arrays must have equal lengths)");
-            // Unit length, within the glTF-Validator's own tolerance (0.00674).
-            for (size_t i = 0; reader_.hasData(nrm->second) && i < normals->count; ++i) {
+            // Unit length, within the glTF-Validator's own tolerance, where the file states them.
+            const size_t stated = reader_.hasData(nrm->second) ? normals->count : 0;
+            for (size_t i = 0; i < stated; ++i) {
                 const double len = length(Vec3d((*normals)(i, 0), (*normals)(i, 1), (*normals)(i, 2)));
                 if (!(std::fabs(len - 1) <= kUnitVectorTolerance))
                     throw InputError(file_, place + ".attributes.NORMAL", "vertex " + std::to_string(i) + "'s normal has length " +
@@ -692,18 +688,20 @@ private:
             usedMaterials_.insert(prim.material);
             // Every texture of the material reads a TEXCOORD_n set the primitive has (glTF 2.0 §3.9.6).
             const tinygltf::Material& m = model_.materials[size_t(prim.material)];
-            const std::pair<const char*, const tinygltf::TextureInfo*> textures[] = {
-                {"pbrMetallicRoughness.baseColorTexture", &m.pbrMetallicRoughness.baseColorTexture},
-                {"pbrMetallicRoughness.metallicRoughnessTexture", &m.pbrMetallicRoughness.metallicRoughnessTexture},
-                {"emissiveTexture", &m.emissiveTexture}};
+            struct TextureUse {
+                const char* name;
+                int index, texCoord;
+            };
+            const TextureUse textures[] = {
+                {"pbrMetallicRoughness.baseColorTexture", m.pbrMetallicRoughness.baseColorTexture.index,
+                 m.pbrMetallicRoughness.baseColorTexture.texCoord},
+                {"pbrMetallicRoughness.metallicRoughnessTexture", m.pbrMetallicRoughness.metallicRoughnessTexture.index,
+                 m.pbrMetallicRoughness.metallicRoughnessTexture.texCoord},
+                {"emissiveTexture", m.emissiveTexture.index, m.emissiveTexture.texCoord},
+                {"normalTexture", m.normalTexture.index, m.normalTexture.texCoord},
+                {"occlusionTexture", m.occlusionTexture.index, m.occlusionTexture.texCoord}};
             const int textureCount = int(model_.textures.size());  // a texture that does not exist is a finding
-            for (const auto& [name, info] : textures)
-                if (info->index >= 0 && info->index < textureCount && !prim.attributes.count("TEXCOORD_" + std::to_string(info->texCoord)))
-                    throw InputError(file_, place, "has no TEXCOORD_" + std::to_string(info->texCoord) + ", which " +
-                                                       gltfPlace("materials", prim.material) + "." + name + " reads");
-            for (const auto& [name, texCoord, index] :
-                 {std::tuple{"normalTexture", m.normalTexture.texCoord, m.normalTexture.index},
-                  std::tuple{"occlusionTexture", m.occlusionTexture.texCoord, m.occlusionTexture.index}})
+            for (const auto& [name, index, texCoord] : textures)
                 if (index >= 0 && index < textureCount && !prim.attributes.count("TEXCOORD_" + std::to_string(texCoord)))
                     throw InputError(file_, place, "has no TEXCOORD_" + std::to_string(texCoord) + ", which " +
                                                        gltfPlace("materials", prim.material) + "." + name + " reads");
@@ -728,18 +726,14 @@ private:
     // given, is an ancestor of (or is) every joint. The nodes' parents are known (buildHierarchy).
     void checkJointHierarchy(const Scene& scene, int index, const tinygltf::Skin& source) const {
         const std::string place = gltfPlace("skins", index);
-        auto rootOf = [&](int n) {
-            while (scene.nodes[size_t(n)].parent >= 0) n = scene.nodes[size_t(n)].parent;
-            return n;
-        };
         auto descendsFrom = [&](int n, int ancestor) {
             for (; n >= 0; n = scene.nodes[size_t(n)].parent)
                 if (n == ancestor) return true;
             return false;
         };
-        const int root = rootOf(source.joints[0]);
+        const int root = rootOf(scene.nodes, source.joints[0]);
         for (int j : source.joints)
-            if (rootOf(j) != root)
+            if (rootOf(scene.nodes, j) != root)
                 throw InputError(file_, place + ".joints", "holds nodes " + std::to_string(source.joints[0]) + " and " +
                                                                std::to_string(j) + ", which share no root (glTF requires one)");
         if (source.skeleton >= 0 && source.skeleton < int(scene.nodes.size()))
@@ -910,17 +904,15 @@ private:
                              "must lie below pi for the camera to render a picture");
         // World space here: Scene::finalize re-centres it with the lights.
         const Camera c = placeCamera(lens, world, Vec3d(0.0));
-        if (!isFinite(c.position) || !isFinite(c.forward) || !isFinite(c.up) || !(length(c.forward) > 0.5f) ||
-            !(length(c.up) > 0.5f) || !(length(cross(c.forward, c.up)) > 0.5f))
+        if (!isFinite(c.position) || !hasDirection(c))
             throw InputError(file_, gltfPlace("nodes", n), "the camera node's transform is not finite or not invertible");
         scene.cameras[node.camera] = c;
         if (!scene.camera) scene.camera = c;
     }
 
     // glTF camera `index`'s lens, checked as glTF 2.0 (§5.12) requires.
-    Camera readLens(int index) const {
-        const tinygltf::Camera& cam = model_.cameras[size_t(index)];
-        const int camera = index;  // as the messages name it
+    Camera readLens(int camera) const {
+        const tinygltf::Camera& cam = model_.cameras[size_t(camera)];
         Camera lens;
         if (cam.type == "perspective") {
             lens.yfov = float(cam.perspective.yfov);

@@ -26,38 +26,36 @@ std::vector<Vec3f> Scene::frontFaceNormals() const {
     return front;
 }
 
+namespace {
+// A quantity in a message, to three significant digits.
+std::string threeDigits(double value) {
+    char out[32];
+    std::snprintf(out, sizeof out, "%.3g", value);
+    return out;
+}
+}  // namespace
+
 void checkSceneExtent(const std::vector<Vec3f>& positions, const Bounds3f& bounds, const std::string& file,
                       const std::string& place) {
     for (const Vec3f& p : positions)
         if (!isFinite(p))
             throw InputError(file, place, "places vertices beyond the range of float (a transform or position is too large)");
     const double extent = length(Vec3d(bounds.diagonal()));
-    if (!(extent <= kMaxSceneExtent)) {
-        char spans[32];
-        std::snprintf(spans, sizeof spans, "%.3g", extent);
-        throw InputError(file, place, std::string("the scene spans ") + spans + " units; qsgi supports up to 1e15 "
+    if (!(extent <= kMaxSceneExtent))
+        throw InputError(file, place, "the scene spans " + threeDigits(extent) + " units; qsgi supports up to 1e15 "
                                       "(beyond that float areas overflow)");
-    }
     // An empty extent is a scene whose geometry all lies at one point (every node hidden by a
     // zero scale, at one origin), which is allowed.
-    if (extent > 0 && extent < kMinSceneExtent) {
-        char spans[32];
-        std::snprintf(spans, sizeof spans, "%.3g", extent);
-        throw InputError(file, place, std::string("the scene spans only ") + spans + " units; qsgi supports down to "
+    if (extent > 0 && extent < kMinSceneExtent)
+        throw InputError(file, place, "the scene spans only " + threeDigits(extent) + " units; qsgi supports down to "
                                       "1e-9 (below that float areas underflow): scale the scene up");
-    }
 }
 
 void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, const std::string& configFile) {
     constexpr double kPi = 3.14159265358979323846;
-    auto text = [](double value) {
-        char out[32];
-        std::snprintf(out, sizeof out, "%.3g", value);
-        return std::string(out);
-    };
     std::string file = sceneFile;
     auto refuse = [&](const std::string& place, double watts) {
-        throw InputError(file, place, "carries " + text(watts) + " W, beyond the " + text(kMaxLightPower) +
+        throw InputError(file, place, "carries " + threeDigits(watts) + " W, beyond the " + threeDigits(kMaxLightPower) +
                                           " W qsgi carries in float photon powers (scale the light's units down)");
     };
     const Bounds3f& bounds = scene.animationBounds;
@@ -78,7 +76,7 @@ void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, c
                                 std::max({lo.z - p.z, 0.0, p.z - hi.z}));
             const double distance = length(outside);
             if (!(distance <= kMaxSceneExtent))
-                throw InputError(file, place, "lies " + text(distance) + " units from the scene; qsgi supports scenes "
+                throw InputError(file, place, "lies " + threeDigits(distance) + " units from the scene; qsgi supports scenes "
                                               "(their lights included) spanning up to 1e15 units");
         }
     }
@@ -162,6 +160,7 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world, const st
     };
     const bool transformNormals = !objectNormal.empty();
     const bool rigidHidden = !skinned && !world.isInvertible();
+    const Vec3d hiddenAt = world.applyPoint(Vec3d(0.0));  // where a hidden rigid instance shrinks to
     const Transform rigidNormals = transformNormals && !skinned && !rigidHidden ? world.normalMatrix() : Transform();
     for (uint32_t i = 0; i < inst.vertexCount; ++i) {
         const uint32_t v = inst.firstVertex + i;
@@ -170,7 +169,7 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world, const st
         vertexHidden[v] = hidden;
         // A hidden rigid instance shrinks to a point: a zero on one axis alone would leave
         // triangles with area that still block.
-        positions[v] = Vec3f((rigidHidden ? m.applyPoint(Vec3d(0.0)) : m.applyPoint(objectPosition[i])) - worldOrigin);
+        positions[v] = Vec3f((rigidHidden ? hiddenAt : m.applyPoint(objectPosition[i])) - worldOrigin);
         if (hidden) {
             // The last finite normal stays; one never placed visible takes its object-space normal.
             if (!(dot(normals[v], normals[v]) > 0)) {
