@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <optional>
 #include <iostream>
@@ -17,6 +18,7 @@
 #include "pipeline/render_job.h"
 #include "pipeline/render_options.h"
 #include "util/error.h"
+#include "util/nearest_name.h"
 #include "pipeline/scene_inspection.h"
 #include "run_display.h"
 #include "util/progress.h"
@@ -95,6 +97,43 @@ qsgi::RenderSettings settingsFrom(const BoundOptions& bound) {
     return s;
 }
 
+// One line for a command line CLI11 cannot parse. A flag the subcommand does not know is named
+// with the nearest one it does (as a config's unknown key is); anything else keeps CLI11's words.
+std::string commandLineError(const CLI::App& app, int argc, char** argv, const CLI::ParseError& error) {
+    std::vector<std::string> subcommands;
+    const CLI::App* command = nullptr;
+    int first = 1;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) subcommands.push_back(sub->get_name());
+    for (; first < argc && !command; ++first)
+        for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+            if (sub->get_name() == argv[first]) command = sub;
+    if (!command) {
+        // No subcommand: the first word that is not a flag is a mistyped one.
+        for (int i = 1; i < argc; ++i)
+            if (argv[i][0] != '-')
+                return "unknown subcommand '" + std::string(argv[i]) + "'" + qsgi::didYouMean(argv[i], subcommands) +
+                       " (subcommands: render, inspect, compare, options; see qsgi --help)";
+        return std::string(error.what()) + " (see qsgi --help)";
+    }
+    std::vector<std::string> known{"--help", "-h"};
+    for (const CLI::Option* option : command->get_options()) {
+        for (const std::string& name : option->get_lnames()) known.push_back("--" + name);
+        for (const std::string& name : option->get_snames()) known.push_back("-" + name);
+    }
+    const std::string help = "qsgi " + command->get_name() + " --help";
+    for (int i = first; i < argc; ++i) {
+        const std::string word = argv[i];
+        if (word == "--") break;
+        // A flag: "--name" or "-x" (not a negative number, which is a value).
+        if (word.size() < 2 || word[0] != '-' || !(std::isalpha(static_cast<unsigned char>(word[1])) || word[1] == '-')) continue;
+        const std::string name = word.substr(0, word.find('='));
+        if (std::find(known.begin(), known.end(), name) == known.end())
+            return "unknown flag " + name + " for qsgi " + command->get_name() + qsgi::didYouMean(name, known) + " (" + help +
+                   " lists them)";
+    }
+    return std::string(error.what()) + " (see " + help + ")";
+}
+
 // `qsgi compare`: reads both PLYs and prints the accuracy report, overall and by edge region.
 int runCompare(const std::string& a, const std::string& b, std::optional<double> radiusOption, bool json) {
     const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(a);
@@ -134,6 +173,8 @@ int main(int argc, char** argv) {
     CLI::App app{"qsgi — global illumination at mesh vertices for animations of quasi-static scenes"};
     app.set_version_flag("--version", std::string("qsgi ") + QSGI_VERSION);
     app.require_subcommand(1);
+    app.footer("Each subcommand has its own help: qsgi render --help, qsgi inspect --help, qsgi compare --help, "
+               "qsgi options --help. Every option and config key: docs/command-line.md.");
 
     CLI::App* render = app.add_subcommand("render", "render every frame of a scene's animation to vertex-radiosity PLYs");
     const BoundOptions renderOptions = addRenderOptions(render);
@@ -149,8 +190,10 @@ int main(int argc, char** argv) {
     compare->add_flag("--json", compareJson, "print JSON instead of a table");
 
     CLI::App* inspect = app.add_subcommand(
-        "inspect", "what a render of this scene would see: meshes, materials, lights, cameras, what moves, the radius, warnings");
-    const BoundOptions inspectOptions = addRenderOptions(inspect, {"SCENE", "--animation", "--config", "--fps", "--strict"});
+        "inspect", "what a render with these options would see and do: meshes, materials, lights, cameras, what moves, "
+                   "the radius, the options set, the output folder's state, warnings");
+    // Every render option, so that a render's command line can be checked by changing the verb.
+    const BoundOptions inspectOptions = addRenderOptions(inspect);
     bool inspectJson = false;
     inspect->add_flag("--json", inspectJson, "print JSON instead of text");
 
@@ -164,7 +207,7 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         // One line, like every other bad input (CLI11's own report takes two).
-        std::fprintf(stderr, "qsgi: error: command line: %s (see qsgi --help)\n", e.what());
+        std::fprintf(stderr, "qsgi: error: command line: %s\n", commandLineError(app, argc, argv, e).c_str());
         return kExitBadInput;
     }
 
@@ -190,6 +233,7 @@ int main(int argc, char** argv) {
         installStopHandlers();
         qsgi::Warnings warnings;
         qsgi::RenderJob job(settingsFrom(renderOptions), warnings);
+        job.refuseIfUnlit();  // before any warning, so that bad input is one line
         const qsgi::RenderSettings& o = job.settings();
         if (!o.quiet)
             for (const auto& w : warnings.messages) std::fprintf(stderr, "qsgi: warning: %s\n", w.c_str());
@@ -197,19 +241,20 @@ int main(int argc, char** argv) {
         const qsgi::RunOutcome outcome = job.run(
             [&](const qsgi::FrameReport& r) {
                 // Lights far from the geometry waste photons; say so once, with the number.
+                char text[256];
                 if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet) {
-                    display.clearLine();
-                    std::fprintf(stderr, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate rests on the rest "
-                                 "(move lights closer or add photons)\n", 100 * r.missedFraction);
+                    std::snprintf(text, sizeof text, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate "
+                                  "rests on the rest (move lights closer or add photons)", 100 * r.missedFraction);
+                    display.message(text);
                 }
                 if (o.verbose) {
-                    display.clearLine();
-                    std::fprintf(stderr, "qsgi: frame %d (%d/%d) %.3f s\n", r.frame, r.index + 1, r.count, r.seconds);
+                    std::snprintf(text, sizeof text, "qsgi: frame %d (%d/%d) %.3f s", r.frame, r.index + 1, r.count, r.seconds);
+                    display.message(text);
                 }
                 display.frameDone(r);
             },
             [] { return gStopSignal != 0; }, [&](const qsgi::StageReport& r) { display.stage(r); });
-        display.clearLine();
+        display.finish();
         const std::string& out = job.outputFolder();
         if (outcome.interrupted) {
             std::fprintf(stderr, "qsgi: stopped by %s after frame %d; every frame before %d is complete in %s (add --resume "
@@ -220,7 +265,9 @@ int main(int argc, char** argv) {
         if (o.resume && !o.quiet && outcome.framesWritten == 0)
             std::fprintf(stderr, "qsgi: every frame is already complete in %s\n", out.c_str());
         else if (!o.quiet)
-            std::fprintf(stderr, "qsgi: %s\n", display.summary(out).c_str());
+            std::fprintf(stderr, "qsgi: %s\n", display.summary(out, outcome).c_str());
+        if (!o.quiet && !job.unplayedAnimationsNote().empty())
+            std::fprintf(stderr, "qsgi: note: %s: %s\n", o.scenePath.c_str(), job.unplayedAnimationsNote().c_str());
         return 0;
     });
 }

@@ -11,7 +11,7 @@ set -euo pipefail
 run_packages=(
   build-essential cmake ninja-build pkg-config
   libembree-dev
-  libopenimageio-dev libopencv-core-dev   # OpenImageIO's CMake package asks for OpenCV's
+  libopenimageio-dev        # found through its pkg-config file (CMakeLists.txt says why)
   libopenexr-dev
   libtinygltf-dev libstb-dev
   libflann-dev liblz4-dev

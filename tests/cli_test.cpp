@@ -9,6 +9,8 @@
 #include <cerrno>
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <sstream>
 #include <vector>
 
 #include "output/image_compare.h"
@@ -320,4 +322,74 @@ TEST(Cli, FrameRangeStartingMidAnimationWritesTheSequentialBytes) {
             EXPECT_EQ(a, readFileBytes(dir / "late" / name)) << name;
         }
     EXPECT_FALSE(fs::exists(dir / "late/frame_0002.ply"));
+}
+
+// A mistyped flag is named with the nearest known one, as a config's unknown key is; a mistyped
+// subcommand likewise; and the top-level help points to each subcommand's own.
+TEST(Cli, AMistypedFlagOrSubcommandNamesTheNearestOne) {
+    const fs::path out = fs::path(testScratchDir("typo")) / "out";
+    const CommandResult flag = runQsgi("render " + cornell() + " --photon 1000 --out " + out.string());
+    EXPECT_EQ(flag.exitCode, 2) << flag.output;
+    EXPECT_EQ(std::count(flag.output.begin(), flag.output.end(), '\n'), 1) << flag.output;
+    EXPECT_NE(flag.output.find("unknown flag --photon"), std::string::npos) << flag.output;
+    EXPECT_NE(flag.output.find("did you mean \"--photons\"?"), std::string::npos) << flag.output;
+    EXPECT_FALSE(fs::exists(out));
+    // With an = and on inspect, which takes the same options.
+    const CommandResult inspect = runQsgi("inspect " + cornell() + " --estimater=detp");
+    EXPECT_EQ(inspect.exitCode, 2) << inspect.output;
+    EXPECT_NE(inspect.output.find("did you mean \"--estimator\"?"), std::string::npos) << inspect.output;
+    // A negative number is a value, not a flag: the option's own rule speaks.
+    const CommandResult negative = runQsgi("render " + cornell() + " --radius -1 --out " + out.string());
+    EXPECT_EQ(negative.exitCode, 2) << negative.output;
+    EXPECT_EQ(negative.output.find("unknown flag"), std::string::npos) << negative.output;
+    const CommandResult verb = runQsgi("rendr " + cornell());
+    EXPECT_EQ(verb.exitCode, 2) << verb.output;
+    EXPECT_NE(verb.output.find("did you mean \"render\"?"), std::string::npos) << verb.output;
+    const CommandResult help = runQsgi("--help");
+    EXPECT_EQ(help.exitCode, 0);
+    for (const char* sub : {"qsgi render --help", "qsgi inspect --help", "qsgi compare --help"})
+        EXPECT_NE(help.output.find(sub), std::string::npos) << help.output;
+}
+
+// A glTF file's own animations are announced when the run does not play them: in the message that
+// refuses a frame range and in the end-of-run note, with their frame counts and the flag.
+TEST(Cli, AnimationsTheFileCarriesAreAnnouncedWhenNotPlayed) {
+    const fs::path out = fs::path(testScratchDir("unplayed")) / "out";
+    const std::string walker = (sourceDir() / "data/walker/walker.gltf").string();
+    const CommandResult range = runQsgi("render " + walker + " --frames 0:10 --out " + out.string());
+    EXPECT_EQ(range.exitCode, 2) << range.output;
+    for (const char* words : {"last frame, 0", "'Walk', 97 frames at 24 fps", "--animation gltf"})
+        EXPECT_NE(range.output.find(words), std::string::npos) << words << ": " << range.output;
+    const CommandResult still = runQsgi("render " + walker + " --fps 10 --photons 5000 --no-exr --out " + out.string());
+    ASSERT_EQ(still.exitCode, 0) << still.output;
+    EXPECT_NE(still.output.find("qsgi: note: " + walker + ": the scene file has 1 animation: 'Walk', 41 frames at 10 fps; "
+                                "--animation gltf plays it"),
+              std::string::npos)
+        << still.output;
+    // Played, nothing to announce.
+    const CommandResult played = runQsgi("render " + walker + " --animation gltf --frames 0:0 --photons 5000 --no-exr --out " +
+                                         (out.string() + "-played"));
+    ASSERT_EQ(played.exitCode, 0) << played.output;
+    EXPECT_EQ(played.output.find("note:"), std::string::npos) << played.output;
+}
+
+// The status line lives through a long stage: while disc regions are computed (2 s here, one
+// thread, a wide radius) it is redrawn with a moving clock and a growing bar of vertices.
+TEST(Cli, TheStatusLineMovesDuringALongRegionsStage) {
+    const fs::path out = fs::path(testScratchDir("status")) / "out";
+    const CommandResult t = runQsgiOnTerminal({"render", cornell(), "--estimator", "detp", "--radius", "0.3", "--threads", "1",
+                                               "--photons", "1000", "--no-exr", "--out", out.string()});
+    ASSERT_EQ(t.exitCode, 0) << t.output;
+    std::set<std::string> clocks, bars;
+    std::istringstream drawings(t.output);
+    for (std::string drawn; std::getline(drawings, drawn, '\r');) {
+        const size_t stage = drawn.find("  regions [");
+        if (stage == std::string::npos) continue;
+        const size_t elapsed = drawn.find(" elapsed");
+        ASSERT_NE(elapsed, std::string::npos) << drawn;
+        clocks.insert(drawn.substr(elapsed - 4, 4));
+        bars.insert(drawn.substr(stage));
+    }
+    EXPECT_GE(clocks.size(), 2u) << "the elapsed time never moved during the regions stage:\n" << t.output;
+    EXPECT_GE(bars.size(), 3u) << "the regions bar never moved:\n" << t.output;
 }

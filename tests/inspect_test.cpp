@@ -4,10 +4,12 @@
 // the render's message and exit code.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "output/ply_reader.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -106,4 +108,101 @@ TEST(Inspect, WalkerShowsItsSkinnedAnimationAtTheChosenRate) {
     EXPECT_TRUE(r["warnings"].empty()) << r["warnings"].dump();
     // Sampled at 10 frames a second: 41 frames over the same 4 s.
     EXPECT_EQ(inspectJson(walker + " --animation gltf --fps 10")["animation"]["frames"].get<int>(), 41);
+}
+
+namespace {
+
+// The bounds of the positions a render writes into its first frame's PLY.
+std::pair<std::array<double, 3>, std::array<double, 3>> plyBounds(const fs::path& ply) {
+    const qsgi::VertexRadiosityPly read = qsgi::readVertexRadiosityPly(ply.string());
+    std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    for (const qsgi::Vec3f& p : read.positions)
+        for (int c = 0; c < 3; ++c) {
+            lo[size_t(c)] = std::min(lo[size_t(c)], double(p[c]));
+            hi[size_t(c)] = std::max(hi[size_t(c)], double(p[c]));
+        }
+    return {lo, hi};
+}
+
+// data/cornell moved far from the origin by a new root node (its buffer copied beside it).
+fs::path translatedCornell(const fs::path& dir, const std::array<double, 3>& offset) {
+    json doc = json::parse(readFileBytes(sourceDir() / "data/cornell/cornell.gltf"));
+    json root = {{"name", "Offset"}, {"translation", offset}, {"children", doc["scenes"][0]["nodes"]}};
+    doc["nodes"].push_back(root);
+    doc["scenes"][0]["nodes"] = json::array({doc["nodes"].size() - 1});
+    fs::copy_file(sourceDir() / "data/cornell/cornell.bin", dir / "cornell.bin", fs::copy_options::overwrite_existing);
+    std::ofstream(dir / "translated.gltf") << doc.dump();
+    return dir / "translated.gltf";
+}
+
+}  // namespace
+
+// Bounds are in the file's world coordinates — what the PLYs hold and what a config's lights and
+// camera are given in — not in the re-centred coordinates the renderer works in.
+TEST(Inspect, BoundsAreTheFilesWorldCoordinatesAsThePlyHoldsThem) {
+    const fs::path dir = testScratchDir("inspect-bounds");
+    const std::array<double, 3> offset{1000.5, -20.25, 300};
+    for (const fs::path& scene : {sourceDir() / "data/cornell/cornell.gltf", translatedCornell(dir, offset)}) {
+        SCOPED_TRACE(scene.string());
+        const fs::path out = dir / ("out-" + scene.stem().string());
+        fs::remove_all(out);
+        ASSERT_EQ(runQsgi("render " + scene.string() + " --photons 2000 --no-exr --quiet --out " + out.string()).exitCode, 0);
+        const auto [lo, hi] = plyBounds(out / "frame_0000.ply");
+        const json r = inspectJson(scene.string());
+        for (size_t c = 0; c < 3; ++c) {
+            // The PLY stores floats: the inspected bounds agree to float precision at that magnitude.
+            const double tolerance = 1e-6 * std::max(1.0, std::fabs(hi[c]) + std::fabs(lo[c]));
+            EXPECT_NEAR(r["scene"]["bounds"]["min"][c].get<double>(), lo[c], tolerance) << "axis " << c;
+            EXPECT_NEAR(r["scene"]["bounds"]["max"][c].get<double>(), hi[c], tolerance) << "axis " << c;
+            EXPECT_NEAR(r["animation"]["bounds"]["min"][c].get<double>(), lo[c], tolerance) << "axis " << c;
+        }
+        // data/cornell's box stands on its floor at y = 0 (scripts/make_cornell.py).
+        const double floor = scene.stem() == "cornell" ? 0.0 : offset[1];
+        EXPECT_NEAR(r["scene"]["bounds"]["min"][1].get<double>(), floor, 1e-4);
+        EXPECT_NEAR(r["scene"]["bounds"]["max"][1].get<double>(), floor + 2, 1e-4);
+    }
+}
+
+// A scene without lights is exactly when a user needs inspect: to see the bounds before writing
+// lights into a config. It is reported, exit 0; the render still refuses it.
+TEST(Inspect, ASceneWithoutLightsIsReportedNotRefused) {
+    const std::string dark = (sourceDir() / "tests/data/bad/gltf/no_lights.gltf").string();
+    const CommandResult text = runQsgi("inspect " + dark);
+    ASSERT_EQ(text.exitCode, 0) << text.output;
+    EXPECT_NE(text.output.find("lights     none"), std::string::npos) << text.output;
+    EXPECT_NE(text.output.find("give lights in a config"), std::string::npos) << text.output;
+    const json r = inspectJson(dark);
+    EXPECT_FALSE(r["lit"].get<bool>());
+    EXPECT_GT(r["scene"]["triangles"].get<int>(), 0);
+    EXPECT_NE(r["output_folder"]["render"].get<std::string>().find("no lights"), std::string::npos);
+    const fs::path out = fs::path(testScratchDir("inspect-dark")) / "out";
+    EXPECT_EQ(runQsgi("render " + dark + " --out " + out.string()).exitCode, 2);
+}
+
+// Every render option is accepted (change a render's verb to check it), and the report says which
+// options differ from the defaults and what the render would do with its output folder.
+TEST(Inspect, TakesARendersCommandLineAndReportsItsOptionsAndTheOutputFolder) {
+    const fs::path out = fs::path(testScratchDir("inspect-options")) / "out";
+    const std::string scene = cornell() + " --animation " + (sourceDir() / "data/cornell/animation.json").string();
+    const std::string render = scene + " --estimator detp --photons 20000 --frames 0:2 --no-exr --width 20 --height 15";
+    json r = inspectJson(render + " --out " + out.string());
+    EXPECT_EQ(r["options_set"]["estimator"], "detp");
+    EXPECT_EQ(r["options_set"]["photons"], 20000);
+    EXPECT_EQ(r["options_set"]["exr"], false);
+    EXPECT_FALSE(r["options_set"].contains("radius")) << "the default radius is no choice of the user's";
+    EXPECT_FALSE(r["options_set"].contains("seed"));
+    EXPECT_EQ(r["output_folder"]["state"], "absent");
+    EXPECT_FALSE(fs::exists(out)) << "inspect writes nothing";
+
+    ASSERT_EQ(runQsgi("render " + render + " --frames 0:1 --quiet --out " + out.string()).exitCode, 0);
+    r = inspectJson(render + " --resume --out " + out.string());
+    EXPECT_EQ(r["output_folder"]["state"], "this run");
+    EXPECT_EQ(r["output_folder"]["complete_frames"], json::array({0, 1}));
+    EXPECT_NE(r["output_folder"]["render"].get<std::string>().find("resumes at frame 2"), std::string::npos)
+        << r["output_folder"].dump();
+
+    r = inspectJson(render + " --photons 30000 --out " + out.string());
+    EXPECT_EQ(r["output_folder"]["state"], "another run");
+    EXPECT_EQ(r["output_folder"]["differences"], json::array({"photons 20000 there, 30000 here"}));
+    EXPECT_NE(r["output_folder"]["render"].get<std::string>().find("refuses"), std::string::npos);
 }

@@ -8,12 +8,14 @@
 
 #include <fstream>
 #include <cctype>
+#include <optional>
 #include <set>
 
 #include "pipeline/render_options.h"
 #include "pipeline/run_fingerprint.h"
 #include "test_support.h"
 #include "util/error.h"
+#include "util/field_count.h"
 
 using namespace qsgi;
 namespace fs = std::filesystem;
@@ -135,7 +137,7 @@ TEST(RenderOptions, ExactlyTheFingerprintedOptionsChangeTheFingerprint) {
         RenderSettings base;
         base.scenePath = "scene.gltf";
         base.estimator.kind = kind;
-        const std::string reference = runFingerprint(base, scene, "", camera);
+        const std::string reference = runFingerprint(base, scene, "", camera).digest;
         for (const RenderOption& o : renderOptions()) {
             if (!o.key || !o.set) continue;
             SCOPED_TRACE(std::string(o.key) + " with " + estimatorName(kind));
@@ -147,7 +149,7 @@ TEST(RenderOptions, ExactlyTheFingerprintedOptionsChangeTheFingerprint) {
             if (meaningful) {
                 ASSERT_NE(o.get(changed), o.get(base));
             }
-            const bool differs = runFingerprint(changed, scene, "", camera) != reference;
+            const bool differs = runFingerprint(changed, scene, "", camera).digest != reference;
             if (o.fingerprinted && meaningful) {
                 EXPECT_TRUE(differs);
                 seenChanging.insert(o.key);
@@ -159,7 +161,7 @@ TEST(RenderOptions, ExactlyTheFingerprintedOptionsChangeTheFingerprint) {
         if (kind == EstimatorKind::Detp) {
             RenderSettings otherK = base;
             otherK.estimator.k = 7;
-            EXPECT_EQ(runFingerprint(otherK, scene, "", camera), reference);
+            EXPECT_EQ(runFingerprint(otherK, scene, "", camera).digest, reference);
         }
     }
     for (const RenderOption& o : renderOptions()) {
@@ -247,4 +249,41 @@ TEST(RenderOptions, TheSweepScriptsDefaultRadiusFractionIsQsgis) {
             found = true;
         }
     EXPECT_TRUE(found) << "grid.py no longer states DEFAULT_RADIUS_FRACTION";
+}
+
+namespace {
+struct ThreeFields {
+    int a = 0;
+    std::optional<double> b;
+    std::vector<std::string> c;
+};
+struct Nested {
+    ThreeFields inner;
+    bool d = false;
+};
+}  // namespace
+
+// Every setting is reachable: render_options.cpp asserts RenderSettings' field count beside the
+// table, so a field added without an option fails the build. The count it rests on is exact,
+// for the kinds of field RenderSettings holds (optionals, vectors, nested aggregates).
+TEST(RenderOptions, EverySettingIsReachableAndTheFieldCountItRestsOnIsExact) {
+    static_assert(qsgi::fieldCount<ThreeFields>() == 3);
+    static_assert(qsgi::fieldCount<Nested>() == 2);
+    // --no-aim and aim_emission, the setting an option had lost, set it again, and it reaches the
+    // fingerprint (aimed and unaimed photons differ).
+    const RenderOption* aim = optionWithKey("aim_emission");
+    ASSERT_NE(aim, nullptr);
+    ASSERT_NE(aim->flag, nullptr);
+    EXPECT_EQ(std::string(aim->flag), "--no-aim");
+    RenderSettings fromFlag, fromConfig;
+    applyCommandLineOption(*aim, "", fromFlag);
+    applyOption(*aim, false, {"test", "aim_emission", {}}, fromConfig);
+    EXPECT_FALSE(fromFlag.aimEmission);
+    EXPECT_FALSE(fromConfig.aimEmission);
+    EXPECT_TRUE(RenderSettings().aimEmission);
+    EXPECT_TRUE(aim->fingerprinted);
+    const CommandResult r = runQsgi("render " + (sourceDir() / "data/cornell/cornell.gltf").string() +
+                                    " --no-aim --photons 2000 --no-exr --quiet --out " +
+                                    (fs::path(testScratchDir("no-aim")) / "out").string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
 }

@@ -345,7 +345,8 @@ std::vector<DetpVertexSums> DetpDiscs::sums(const std::vector<Segment>& segments
 }
 
 std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, bool morton, const PowerQuantizer& q,
-                                            DetpQueryStats* stats) const {
+                                            DetpQueryStats* stats, WorkCounter* progress) const {
+    if (progress) progress->setTotal(cache.segmentCount());
     tbb::enumerable_thread_specific<VertexSums> perThread([&] { return VertexSums(scene_.vertexCount()); });
     tbb::enumerable_thread_specific<uint64_t> hitCount(0);
     // Group after group of whole blocks, each decoded and put in order on its own: memory stays
@@ -357,7 +358,7 @@ std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, bool morton, 
         size_t end = begin + 1;
         const uint64_t first = cache.blockFirstSegment(begin);
         while (end < cache.blockCount() && cache.blockFirstSegment(end) - first < kGroupSegments) ++end;
-        addCrossings(segmentsInQueryOrder(cache, begin, end, morton), q, perThread, hitCount);
+        addCrossings(segmentsInQueryOrder(cache, begin, end, morton), q, perThread, hitCount, progress);
         begin = end;
     }
     if (stats)
@@ -367,7 +368,7 @@ std::vector<DetpVertexSums> DetpDiscs::sums(const RayCache& cache, bool morton, 
 
 void DetpDiscs::addCrossings(const std::vector<Segment>& segments, const PowerQuantizer& q,
                              tbb::enumerable_thread_specific<std::vector<DetpVertexSums>>& perThread,
-                             tbb::enumerable_thread_specific<uint64_t>& hitCount) const {
+                             tbb::enumerable_thread_specific<uint64_t>& hitCount, WorkCounter* progress) const {
     const bool moments = rule_ == DetpBoundary::Linear;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, segments.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         VertexSums& sums = perThread.local();
@@ -378,6 +379,7 @@ void DetpDiscs::addCrossings(const std::vector<Segment>& segments, const PowerQu
             for (const Crossed& c : crossed) sums[c.vertex].add(segments[i].power, c.at, q, moments);
             hits += crossed.size();
         }
+        if (progress) progress->add(r.size());
     });
 }
 

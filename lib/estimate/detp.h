@@ -30,6 +30,7 @@
 #include "trace/embree_device.h"
 #include "trace/ray_cache.h"
 #include "util/enum_names.h"
+#include "util/work_counter.h"
 
 namespace qsgi {
 
@@ -105,8 +106,9 @@ public:
     // `morton`, traced in the Morton order of their end points within the group (coherent
     // tracing: most discs a segment crosses sit around its end). Integer sums: the bits do not
     // depend on the order.
+    // progress, if given, counts the segments done.
     std::vector<DetpVertexSums> sums(const RayCache& cache, bool morton, const PowerQuantizer& q,
-                                     DetpQueryStats* stats = nullptr) const;
+                                     DetpQueryStats* stats = nullptr, WorkCounter* progress = nullptr) const;
 
     // Every crossing of the given segments with the discs of `which`, decided exactly. Found in
     // parallel; the list is in segment order, each segment's crossings by vertex, the same for
@@ -123,7 +125,7 @@ private:
     struct Crossed;
     void addCrossings(const std::vector<Segment>& segments, const PowerQuantizer& q,
                       tbb::enumerable_thread_specific<std::vector<DetpVertexSums>>& perThread,
-                      tbb::enumerable_thread_specific<uint64_t>& hitCount) const;
+                      tbb::enumerable_thread_specific<uint64_t>& hitCount, WorkCounter* progress = nullptr) const;
     struct Part {
         std::vector<uint32_t> vertices;  // primID -> scene vertex
         unsigned geomId = RTC_INVALID_GEOMETRY_ID;

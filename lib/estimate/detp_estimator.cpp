@@ -30,7 +30,7 @@ class DetpEstimator final : public Estimator {
 public:
     DetpEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
         : settings_(settings), scene_(context.scene), bvh_(context.bvh), device_(context.device),
-          regions_(context.regions), moments_(settings.boundary == DetpBoundary::Linear) {
+          regions_(context.regions), progress_(context.progress), moments_(settings.boundary == DetpBoundary::Linear) {
         mayBeTouched_ = context.scene.vertexDynamic;
         mayBeTouched_.resize(scene_.vertexCount(), 0);
         if (regions_) {
@@ -60,7 +60,7 @@ public:
             return;
         } else {
             discs().updateDynamic();
-            sums_ = discs_->sums(cache, e.sortQueries, quantizer_);
+            sums_ = discs_->sums(cache, e.sortQueries, quantizer_, nullptr, progress_);
         }
         out.irradiance.resize(scene_.vertexCount());
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v) out.irradiance[v] = irradianceAt(v);
@@ -356,6 +356,7 @@ private:
     const SceneBvh& bvh_;
     const EmbreeDevice& device_;
     const DiscRegions* regions_;
+    WorkCounter* progress_;
     bool moments_;
     PowerQuantizer quantizer_{0.0f};
     std::vector<uint8_t> mayBeTouched_;  // per vertex: a move can touch it (its disc is refitted)

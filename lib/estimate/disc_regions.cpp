@@ -188,21 +188,23 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
 
 }  // namespace
 
-void DiscRegions::computeAll(const Scene& scene, const SceneBvh& bvh) {
+void DiscRegions::computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounter* progress) {
     discs_.assign(scene.vertexCount(), VertexDisc{});
     answerSlot_.clear();
     answers_.clear();
     std::vector<uint32_t> all(scene.vertexCount());
     for (uint32_t v = 0; v < all.size(); ++v) all[v] = v;
-    compute(scene, bvh, all, false);
+    compute(scene, bvh, all, false, progress);
 }
 
-std::vector<uint32_t> DiscRegions::recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices) {
-    return compute(scene, bvh, vertices, true);
+std::vector<uint32_t> DiscRegions::recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
+                                             WorkCounter* progress) {
+    return compute(scene, bvh, vertices, true, progress);
 }
 
 std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
-                                           bool keepAnswers) {
+                                           bool keepAnswers, WorkCounter* progress) {
+    if (progress) progress->setTotal(vertices.size());
     if (discs_.size() != scene.vertexCount()) discs_.resize(scene.vertexCount());
     if (vertices.empty()) return {};
     if (keepAnswers) {
@@ -228,6 +230,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);
         }
+        if (progress) progress->add(range.size());
     });
     std::vector<uint32_t> out;
     for (size_t i = 0; i < vertices.size(); ++i)

@@ -23,6 +23,7 @@
 #include "estimate/disc_pattern.h"
 #include "scene/scene.h"
 #include "trace/scene_bvh.h"
+#include "util/work_counter.h"
 
 namespace qsgi {
 
@@ -69,12 +70,14 @@ public:
     DiscRegions(float radius, bool withCoverage) : radius_(radius), withCoverage_(withCoverage) {}
 
     // Every vertex, for the scene's current pose (bvh must hold that pose).
-    void computeAll(const Scene& scene, const SceneBvh& bvh);
+    // progress, if given, counts the vertices done.
+    void computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounter* progress = nullptr);
     // The given vertices only (sorted or not); the rest keep their values. Returns those of them
     // whose disc may now decide a crossing differently: its disc changed, or it has mixed cells
     // (decided point by point against the current geometry). The others count every segment
     // exactly as before.
-    std::vector<uint32_t> recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices);
+    std::vector<uint32_t> recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
+                                    WorkCounter* progress = nullptr);
     // Vertices to recompute after a move: those whose test region overlaps one of `movedBounds`
     // (old and new bounds of each moved object), and those flagged in `vertexMoved`.
     std::vector<uint32_t> touchedBy(const Scene& scene, const std::vector<Bounds3f>& movedBounds,
@@ -105,7 +108,8 @@ public:
     };
 
 private:
-    std::vector<uint32_t> compute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices, bool keepAnswers);
+    std::vector<uint32_t> compute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices, bool keepAnswers,
+                                  WorkCounter* progress);
 
     float radius_;
     bool withCoverage_;

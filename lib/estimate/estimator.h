@@ -68,6 +68,8 @@ struct EstimatorContext {
     // Frames will be updated from this one (not --full-recompute): an estimator may keep what
     // its updates need while it solves (the photon map's neighbour lists).
     bool updatesFollow = false;
+    // Counts a solve's work for a progress display (null: none); the solver names the stage.
+    WorkCounter* progress = nullptr;
 };
 
 class Estimator {

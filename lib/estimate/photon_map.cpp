@@ -167,7 +167,8 @@ Vec3f PhotonMap::estimate(const std::vector<Neighbour>& sortedFront, size_t sort
 }
 
 void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
-                           const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) const {
+                           const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out, WorkCounter* progress) const {
+    if (progress) progress->setTotal(vertices.size());
     if (out.size() != scene.vertexCount()) out.resize(scene.vertexCount(), Vec3f(0.0f));
     if (ballsSquared_.size() != scene.vertexCount()) ballsSquared_.assign(scene.vertexCount(), kNeverEstimated);
     if (keepLists_ && lists_.size() != scene.vertexCount()) lists_.assign(scene.vertexCount(), NeighbourList());
@@ -202,6 +203,7 @@ void PhotonMap::estimateAt(const Scene& scene, const DiscRegions* regions, float
             out[v] = estimate(counted, keep, filter.disc, radius, k);
             ballsSquared_[v] = keep == size_t(k) ? counted[keep - 1].distanceSquared : radiusSquared;
         }
+        if (progress) progress->add(r.size());
     });
     lastQueries_ = size_t(std::count(queried.begin(), queried.end(), 1));
 }
@@ -301,8 +303,8 @@ std::vector<Vec3f> PhotonMap::irradiance(const Scene& scene, const DiscRegions* 
 }
 
 void PhotonMap::irradianceAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
-                             const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) {
-    estimateAt(scene, regions, radius, k, vertices, out);
+                             const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out, WorkCounter* progress) {
+    estimateAt(scene, regions, radius, k, vertices, out, progress);
 }
 
 std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* regions, float radius, int k) const {

@@ -30,6 +30,7 @@
 #include "estimate/point_index.h"
 #include "scene/scene.h"
 #include "trace/ray_cache.h"
+#include "util/work_counter.h"
 
 namespace qsgi {
 
@@ -54,8 +55,9 @@ public:
                                   const std::vector<uint32_t>& order) const;
     // The same for the given vertices only, in that order: writes out[v] (out is resized to the
     // vertex count if needed; other entries are kept) and records their balls.
+    // progress, if given, counts the vertices done.
     void irradianceAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
-                      const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out);
+                      const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out, WorkCounter* progress = nullptr);
     // The same answers without an index: every vertex against every impact. Records nothing.
     std::vector<Vec3f> bruteForce(const Scene& scene, const DiscRegions* regions, float radius, int k) const;
 
@@ -127,7 +129,7 @@ private:
     // all) of them).
     Vec3f estimate(const std::vector<Neighbour>& sortedCounted, size_t sorted, const VertexDisc* disc, float radius, int k) const;
     void estimateAt(const Scene& scene, const DiscRegions* regions, float radius, int k,
-                    const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out) const;
+                    const std::vector<uint32_t>& vertices, std::vector<Vec3f>& out, WorkCounter* progress = nullptr) const;
     struct NeighbourList;
     struct QueryScratch {  // reused across one thread's queries
         std::vector<size_t> indices;

@@ -23,7 +23,7 @@ class PhotonMapEstimator final : public Estimator {
 public:
     PhotonMapEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
         : settings_(settings), scene_(context.scene), bvh_(context.bvh), regions_(context.regions),
-          keepLists_(context.updatesFollow && settings.useIndex) {}
+          keepLists_(context.updatesFollow && settings.useIndex), progress_(context.progress) {}
 
     void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
         map_.emplace(cache, scene_, &bvh_);
@@ -31,7 +31,8 @@ public:
         const EstimatorSettings& e = settings_;
         if (e.useIndex) {
             out.irradiance.assign(scene_.vertexCount(), Vec3f(0.0f));
-            map_->irradianceAt(scene_, regions_, e.radius, e.k, queryOrder(inputOrder(scene_.vertexCount())), out.irradiance);
+            map_->irradianceAt(scene_, regions_, e.radius, e.k, queryOrder(inputOrder(scene_.vertexCount())), out.irradiance,
+                               progress_);
         } else {
             out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.k);
         }
@@ -99,6 +100,7 @@ private:
     const SceneBvh& bvh_;
     const DiscRegions* regions_;
     bool keepLists_;  // updates follow: neighbour lists kept (indexed only; brute force is the reference)
+    WorkCounter* progress_;
     std::optional<PhotonMap> map_;
 };
 

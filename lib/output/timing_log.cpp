@@ -28,6 +28,7 @@ void TimingLog::write(const std::filesystem::path& path) const {
     j["version"] = QSGI_VERSION;
     j["config"] = config;
     j["config"]["inputs_fingerprint"] = inputsFingerprint;
+    j["inputs"] = inputs;
     j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
                   {"degenerate_triangles", degenerateTriangles}, {"animation_diagonal", animationDiagonal}};
@@ -46,8 +47,13 @@ void TimingLog::write(const std::filesystem::path& path) const {
                               {"update_s", summary(updates)}};
     j["density_estimation"] = {{"initial_s", frames.empty() ? 0.0 : frames[0].estimationSeconds},
                                {"frame_s", summary(estimates)}};
+    // In frame order, however the frames were computed (a re-render of a range, a resumed run).
+    std::vector<const FrameTiming*> ordered;
+    for (const FrameTiming& f : frames) ordered.push_back(&f);
+    std::stable_sort(ordered.begin(), ordered.end(), [](const FrameTiming* a, const FrameTiming* b) { return a->frame < b->frame; });
     json list = json::array();
-    for (const FrameTiming& f : frames) {
+    for (const FrameTiming* frame : ordered) {
+        const FrameTiming& f = *frame;
         json entry;
         forEachTimingField(f, [&](const char* name, const auto& value) { entry[name] = value; });
         list.push_back(entry);
@@ -63,6 +69,7 @@ EarlierRun readTimingLog(const std::filesystem::path& path) {
     EarlierRun run;
     try {
         run.inputsFingerprint = j.at("config").at("inputs_fingerprint").get<std::string>();
+        if (j.contains("inputs")) run.inputs = j.at("inputs");
         for (const nlohmann::json& entry : j.at("frames")) {
             FrameTiming f;
             forEachTimingField(f, [&](const char* name, auto& value) { entry.at(name).get_to(value); });

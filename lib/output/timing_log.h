@@ -28,16 +28,20 @@ struct TimingLog {
     double animationDiagonal = 0;  // the diagonal of the whole animation's bounds (default radius = 1.5 % of it)
     // runFingerprint of the inputs and settings; --resume continues only a folder whose log has it.
     std::string inputsFingerprint;
+    // What the fingerprint is made of ("inputs": RunFingerprint::parts), for naming what differs.
+    nlohmann::json inputs;
 
-    std::vector<FrameTiming> frames;  // in the order they were written
+    std::vector<FrameTiming> frames;  // in the order they were written (timing.json lists them by frame)
 
     void write(const std::filesystem::path& path) const;  // atomically
 };
 
-// What --resume needs from an earlier run's timing.json: its fingerprint and its frames. Throws
-// InputError naming the file if it is not a timing log qsgi wrote.
+// What --resume needs from an earlier run's timing.json: its fingerprint, what it is made of (null
+// in a log of an older qsgi) and its frames. Throws InputError naming the file if it is not a
+// timing log qsgi wrote.
 struct EarlierRun {
     std::string inputsFingerprint;
+    nlohmann::json inputs;
     std::vector<FrameTiming> frames;
 };
 EarlierRun readTimingLog(const std::filesystem::path& path);

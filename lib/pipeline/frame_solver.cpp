@@ -46,10 +46,12 @@ constexpr double kWorthUpdatingBelow = 0.8;
 }  // namespace
 
 FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings)
-    : scene_(scene), settings_(settings), bvh_(device, scene),
-      tracer_(scene, bvh_, aimedAtEstimator(settings.trace, settings.estimator)) {
+    : scene_(scene), settings_(settings),
+      work_([this](const char* name, uint64_t done, uint64_t total) { stage(name, done, total); }),
+      bvh_(device, scene), tracer_(scene, bvh_, aimedAtEstimator(settings.trace, settings.estimator)) {
     if (needsDiscRegions(settings_.estimator)) regions_.emplace(makeDiscRegions(settings_.estimator));
-    estimator_ = Estimator::create(settings_.estimator, EstimatorContext{scene_, bvh_, device, regions(), !settings_.fullRecompute});
+    estimator_ = Estimator::create(settings_.estimator,
+                                   EstimatorContext{scene_, bvh_, device, regions(), !settings_.fullRecompute, &work_});
 }
 
 FrameSolver::~FrameSolver() = default;
@@ -121,11 +123,11 @@ std::vector<uint32_t> FrameSolver::updateRegions(const std::vector<uint32_t>* to
     std::vector<uint32_t> redecided;
     Stopwatch clock;
     if (!regionsValid_) {
-        regions_->computeAll(scene_, bvh_);
+        regions_->computeAll(scene_, bvh_, &work_);
         stats.discRegionsUpdated = scene_.vertexCount();
         regionsValid_ = true;
     } else if (touched) {
-        redecided = regions_->recompute(scene_, bvh_, *touched);
+        redecided = regions_->recompute(scene_, bvh_, *touched, &work_);
         stats.discRegionsUpdated = touched->size();
     }
     stats.discRegionsSeconds = clock.seconds();
@@ -163,7 +165,7 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     std::vector<uint32_t> touched = !firstTime && change.any ? touchedVertices(change) : std::vector<uint32_t>();
     // The estimators recompute the moved vertices and those whose disc now decides crossings
     // differently; the regions' conservative test touched more (most keep their disc).
-    stage("regions");
+    work_.start("regions", 0);
     std::vector<uint32_t> redecided = updateRegions(firstTime ? nullptr : &touched, stats);
     for (uint32_t v : touched)
         if (change.vertexMoved[v]) redecided.push_back(v);
@@ -222,7 +224,7 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
     stats.segmentsAdded = cache.segmentCount();
 
     clock.restart();
-    stage("estimating");
+    work_.start("estimating", 0);
     estimator_->solve(cache, result_, stats);
     stats.estimationSeconds = clock.seconds();
     if (!settings_.fullRecompute) lastCache_ = std::move(cache);

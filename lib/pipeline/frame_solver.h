@@ -18,6 +18,7 @@
 #include "trace/scene_bvh.h"
 #include "trace/tracked_paths.h"
 #include "util/frame_timing.h"
+#include "util/work_counter.h"
 
 namespace qsgi {
 
@@ -50,8 +51,8 @@ public:
 
     // Told what a solve is doing, for a progress display: the stage ("regions", "tracing",
     // "estimating", "tracking", "retracing", "updating") and, where known, how far it is (done of
-    // total; total 0 when unknown). Called from the solving thread, and for tracing from a
-    // reporter thread a few times a second.
+    // total; total 0 when unknown). Called from the solving thread, and from worker threads a few
+    // times a second while tracing, computing disc regions and estimating.
     using StageReporter = std::function<void(const char* stage, uint64_t done, uint64_t total)>;
     void reportStagesTo(StageReporter reporter) { reportStage_ = std::move(reporter); }
 
@@ -92,6 +93,7 @@ private:
     Scene& scene_;
     FrameSolverSettings settings_;
     StageReporter reportStage_;
+    WorkCounter work_;  // the stage in progress and how far it is, for reportStage_
     SceneBvh bvh_;
     PhotonTracer tracer_;
     std::optional<DiscRegions> regions_;

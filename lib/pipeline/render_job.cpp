@@ -31,12 +31,6 @@ namespace qsgi {
 
 namespace fs = std::filesystem;
 
-std::string frameFileName(int frame, const char* extension) {
-    char name[64];
-    std::snprintf(name, sizeof name, "frame_%04d.%s", frame, extension);
-    return name;
-}
-
 namespace {
 
 // The config's look-at camera, else --camera N, else the scene's first camera, else one that
@@ -79,12 +73,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     bool emissive = false;
     for (uint32_t t = 0; t < scene_.triangleCount() && !emissive; ++t)
         emissive = scene_.materials[scene_.triangleMaterial[t]].isEmissive() && scene_.triangleArea(t) > 0;
-    bool lit = emissive;
-    for (const PunctualLight& l : scene_.lights) lit = lit || luminance(l.intensity) > 0;
-    if (!lit)
-        throw InputError(settings_.scenePath, "",
-                         "the scene has no lights (no emissive material, no KHR_lights_punctual light); add one with "
-                         "\"lights\" in a --config file");
+    lit_ = emissive;
+    for (const PunctualLight& l : scene_.lights) lit_ = lit_ || luminance(l.intensity) > 0;
 
     // Where the animation comes from, as messages name it.
     std::string animationSource = settings_.animationPath;
@@ -113,8 +103,10 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         last_ = settings_.frames->last < 0 ? animation_.lastFrame() : settings_.frames->last;
         if (last_ > animation_.lastFrame())
             throw InputError(settings_.framesSource.empty() ? "command line" : settings_.framesSource, "frames",
-                             std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the animation's last frame " +
-                                 std::to_string(animation_.lastFrame()));
+                             std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the " +
+                                 (settings_.animationPath.empty() ? std::string("last frame, 0 (a still scene has one frame)")
+                                                                  : "animation's last frame " + std::to_string(animation_.lastFrame())) +
+                                 (unplayedAnimationsNote().empty() ? "" : " (" + unplayedAnimationsNote() + ")"));
     }
     // A camera hung from a node the animation scales to zero has no direction: refused before
     // any frame is written, naming the first such frame (a hidden node is fine, a hidden camera
@@ -150,6 +142,29 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     fingerprint_ = runFingerprint(settings_, scene_, animationBytes, camera_);
 }
 
+void RenderJob::refuseIfUnlit() const {
+    if (!lit_)
+        throw InputError(settings_.scenePath, "",
+                         "the scene has no lights (no emissive material, no KHR_lights_punctual light); add one with "
+                         "\"lights\" in a --config file");
+}
+
+std::string RenderJob::unplayedAnimationsNote() const {
+    if (scene_.animations.empty() || gltfAnimationSelector(settings_.animationPath, "").has_value()) return "";
+    const double fps = settings_.fps.value_or(kDefaultGltfFps);
+    const size_t count = scene_.animations.size();
+    std::string note = "the scene file has " + std::to_string(count) + (count == 1 ? " animation: " : " animations: ");
+    for (size_t a = 0; a < count; ++a) {
+        const KeyframeAnimation& animation = scene_.animations[a];
+        char frames[96];
+        std::snprintf(frames, sizeof frames, "%lld frames at %g fps",
+                      static_cast<long long>(Animation::lastFrameAt(animation.endTime, fps)) + 1, fps);
+        note += (a ? ", " : "") + (animation.name.empty() ? "#" + std::to_string(a) : "'" + animation.name + "'") +
+                (count > 1 ? " (gltf:" + std::to_string(a) + ")" : "") + ", " + frames;
+    }
+    return note + "; --animation gltf plays " + (count == 1 ? "it" : "them all at once");
+}
+
 Camera RenderJob::cameraAt(int frame) const {
     // A camera hung from a node follows it (channels on camera nodes move the view only).
     if (camera_.node < 0) return camera_;
@@ -159,38 +174,12 @@ Camera RenderJob::cameraAt(int frame) const {
 
 namespace {
 
-// With --resume: the frames of the earlier run in `outDir` that are complete on disk (listed in
-// its timing.json, which is written after a frame's files, and every file present). Throws
-// InputError if the folder was made from other inputs or settings.
-std::vector<FrameTiming> framesToKeep(const fs::path& outDir, const std::string& fingerprint,
-                                      const std::function<bool(int)>& filesExist) {
-    const fs::path logPath = outDir / "timing.json";
-    std::error_code ec;
-    if (!fs::exists(logPath, ec)) {
-        for (const auto& entry : fs::directory_iterator(outDir, ec))
-            if (entry.path().filename().string().rfind("frame_", 0) == 0)
-                throw InputError(outDir.string(), "--resume",
-                                 "holds frame files but no timing.json, so nothing says how they were made; render into "
-                                 "an empty folder instead");
-        return {};  // killed before its first frame: nothing to keep
-    }
-    const EarlierRun earlier = readTimingLog(logPath);
-    if (earlier.inputsFingerprint != fingerprint)
-        throw InputError(logPath.string(), "config.inputs_fingerprint",
-                         "the folder was rendered from other inputs or settings (scene, animation, photons, seed, "
-                         "estimator, radius or image options differ), so --resume would mix two renders; use the same "
-                         "ones or render into another folder");
-    std::vector<FrameTiming> kept;
-    for (const FrameTiming& f : earlier.frames)
-        if (filesExist(f.frame)) kept.push_back(f);
-    return kept;
-}
-
 }  // namespace
 
 RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame,
                           const std::function<bool()>& stopRequested,
                           const std::function<void(const StageReport&)>& onStage) {
+    refuseIfUnlit();
     std::optional<tbb::global_control> threadLimit;
     if (settings_.threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(settings_.threads));
 
@@ -209,19 +198,18 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         if (!writable) throw InputError(settings_.outDir, "--out", "the output folder is not writable");
     }
     AtomicFile::removeStaleTemporaries(outDir);
-    auto frameFilesExist = [&](int frame) {
-        std::error_code missing;
-        return fs::exists(outDir / frameFileName(frame, "ply"), missing) &&
-               (!settings_.writeExr || fs::exists(outDir / frameFileName(frame, "exr"), missing)) &&
-               (!settings_.writePng || fs::exists(outDir / frameFileName(frame, "png"), missing)) &&
-               (!settings_.writeGltf || fs::exists(outDir / frameFileName(frame, "glb"), missing));
-    };
-    // The first frame to compute: with --resume, the first of the range an earlier run of the
-    // same inputs has not completed. Its entries for earlier frames stay in the log.
+    // One folder, one run: frames of this run are kept (and with --resume not computed again),
+    // another run's are refused unless --overwrite replaces them.
+    const OutputFolderSurvey folder = surveyOutputFolder(outDir, fingerprint_, settings_);
+    if (const std::optional<InputError> refusal = outputFolderRefusal(folder, settings_)) throw *refusal;
     std::vector<FrameTiming> earlierFrames;
-    if (settings_.resume) earlierFrames = framesToKeep(outDir, fingerprint_, frameFilesExist);
+    if (folder.holds == OutputFolderSurvey::Holds::ThisRun) earlierFrames = folder.completeFrames;
+    else if (folder.holds != OutputFolderSurvey::Holds::Nothing) removeEarlierRun(folder);
+    // The first frame to compute: with --resume, the first of the range this run's earlier
+    // frames do not already hold. Earlier frames outside what is computed stay in the log.
     std::set<int> done;
-    for (const FrameTiming& f : earlierFrames) done.insert(f.frame);
+    if (settings_.resume)
+        for (const FrameTiming& f : earlierFrames) done.insert(f.frame);
     int start = first_;
     while (start <= last_ && done.count(start)) ++start;
     RunOutcome outcome;
@@ -238,10 +226,12 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     for (uint8_t d : scene_.vertexDynamic) log.dynamicVertices += d;
     log.lights = scene_.lights.size();
     log.animationDiagonal = scene_.animationBounds.extent();
-    log.inputsFingerprint = fingerprint_;
+    log.inputsFingerprint = fingerprint_.digest;
+    log.inputs = fingerprint_.parts;
     for (const FrameTiming& f : earlierFrames)
         if (f.frame < start || f.frame > last_) log.frames.push_back(f);
-    outcome.framesResumed = int(log.frames.size());
+    outcome.framesResumed = settings_.resume ? int(log.frames.size()) : 0;
+    outcome.framesKept = settings_.resume ? 0 : int(log.frames.size());
     outcome.nextFrame = start;
     if (start > last_) return outcome;  // resumed with nothing left to do: the folder stays as it is
     // Written before any frame, so the folder records its inputs' fingerprint from the start.

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "pipeline/output_folder.h"
 #include "pipeline/render_settings.h"
 #include "scene/animation.h"
 #include "scene/scene.h"
@@ -35,16 +36,17 @@ struct RunOutcome {
     bool interrupted = false;
     int nextFrame = 0;      // the first frame not written
     int framesResumed = 0;  // frames an earlier run had written (--resume)
+    int framesKept = 0;     // frames of an earlier run of the same inputs outside this run's range (no --resume)
     int framesWritten = 0;  // by this run
 };
 
 class RenderJob {
 public:
     // Loads the scene, animation and lights and checks them all; throws InputError before
-    // anything is written.
+    // anything is written. A scene without light loads (inspect reports it); run() refuses it.
     RenderJob(RenderSettings settings, Warnings& warnings);
 
-    // Creates the output folder and renders every frame (with --resume, those an earlier run of
+    // Refuses a scene without light, then creates the output folder and renders every frame (with --resume, those an earlier run of
     // the same inputs has not written). onFrame runs after each frame; when stopRequested returns
     // true after a frame, run() returns with the folder consistent (every file complete, timing.json
     // describing the frames on disk). onStage is told each stage of a frame as it starts, and
@@ -60,6 +62,17 @@ public:
     const Camera& camera() const { return camera_; }  // at frame 0
     int firstFrame() const { return first_; }
     int lastFrame() const { return last_; }
+    // Whether anything emits: an emissive triangle with area or a light of nonzero power.
+    bool hasLight() const { return lit_; }
+    // Throws InputError for a scene without light (run() does too).
+    void refuseIfUnlit() const;
+    // What the run's frame files depend on (what --resume and a folder's earlier run are compared by).
+    const RunFingerprint& fingerprint() const { return fingerprint_; }
+
+    // When the scene file carries glTF animations the run does not play (no --animation, or a
+    // transform file): "the scene file has 1 animation: 'Walk', 97 frames at 24 fps;
+    // --animation gltf plays it"; otherwise "".
+    std::string unplayedAnimationsNote() const;
 
 private:
     RenderSettings settings_;
@@ -68,10 +81,8 @@ private:
     Camera cameraAt(int frame) const;
     Animation animation_;
     int first_ = 0, last_ = 0;
-    std::string fingerprint_;  // runFingerprint of the inputs and settings
+    RunFingerprint fingerprint_;
+    bool lit_ = false;
 };
-
-// "frame_0012.ply" and the like.
-std::string frameFileName(int frame, const char* extension);
 
 }  // namespace qsgi

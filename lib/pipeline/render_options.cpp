@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "util/error.h"
+#include "util/field_count.h"
 #include "util/json_file.h"
 #include "util/nearest_name.h"
 
@@ -106,6 +107,13 @@ json getCamera(const RenderSettings& s) {
                 {"up", toJson(s.camera->up)}, {"yfov", s.camera->yfov}};
     return s.cameraIndex ? json(*s.cameraIndex) : json(nullptr);
 }
+
+// Every setting is reachable: each field of RenderSettings is set by an option below, except the
+// four that record where values came from (configPath, radiusGiven, qmcBouncesGiven,
+// framesSource). A field added without an option fails here; add its option (and count it).
+static_assert(fieldCount<RenderSettings>() == 36, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<EstimatorSettings>() == 7, "an EstimatorSettings field was added or removed: give it an option");
+static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
 
 std::vector<RenderOption> declareOptions() {
     using T = OptionType;
@@ -210,6 +218,12 @@ std::vector<RenderOption> declareOptions() {
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.blockingGrid = v; },
                  [](const RenderSettings& s) { return json(s.blockingGrid); }});
     // Photons
+    o.push_back({"aim_emission", "--no-aim", T::Boolean, 0, 0, "", {}, false, "", "true",
+                 "point, spot and directional lights emit in every direction instead of only toward what photons can "
+                 "reach (projection maps; docs/command-line.md)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.aimEmission = v; },
+                 [](const RenderSettings& s) { return json(s.aimEmission); }});
     o.push_back({"photons", "--photons", T::Integer, 1, double(kMaxPhotons), " (2^32: the path index is 32 bits)", {},
                  true, "N", "1000000", "photons traced per frame", true, true,
                  [](RenderSettings& s, const json& v, const OptionSource& src) {
@@ -267,6 +281,11 @@ std::vector<RenderOption> declareOptions() {
                  "only)",
                  false, false, [](RenderSettings& s, const json& v, const OptionSource&) { s.resume = v; },
                  [](const RenderSettings& s) { return json(s.resume); }});
+    o.push_back({nullptr, "--overwrite", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "when the output folder holds another run (other inputs or settings), unlink its frame_NNNN.* files "
+                 "and timing.json first (nothing else, never recursively); without it such a folder is refused",
+                 false, false, [](RenderSettings& s, const json& v, const OptionSource&) { s.overwrite = v; },
+                 [](const RenderSettings& s) { return json(s.overwrite); }});
     // Lights added to the scene
     o.push_back({"lights", nullptr, T::Object, 0, 0, "", {}, true, "", "none",
                  "lights added to any scene: [{\"type\": \"point\", \"position\": [x,y,z], \"intensity\": [r,g,b] (W/sr)} "

@@ -43,6 +43,7 @@ struct RenderSettings {
     bool blockingGrid = true;    // find blocked segments through the grid (false: test every tracked one)
     std::optional<FrameRange> frames;
     bool resume = false;  // continue outDir after its last complete frame (same fingerprint only)
+    bool overwrite = false;  // replace another run's frames and timing.json in outDir
     std::string framesSource;  // where frames came from (the config or "command line"), for messages
     std::vector<PunctualLight> extraLights;  // world space, from the config
 

@@ -36,41 +36,111 @@ private:
 
 }  // namespace
 
-std::string runFingerprint(const RenderSettings& s, const Scene& scene, const std::string& animationBytes,
-                           const Camera& camera) {
-    Fingerprinter f;
-    f.add(std::string(QSGI_VERSION));
+namespace {
+
+std::string hex(uint64_t value) {
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+    return text;
+}
+
+// An option's value as a message shows it: strings bare, numbers to 7 digits (a float's),
+// values the estimator does not read as "unused".
+std::string shown(const nlohmann::json& value) {
+    if (value.is_null()) return "unused";
+    if (value.is_number_float()) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.7g", value.get<double>());
+        return text;
+    }
+    return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
+}  // namespace
+
+RunFingerprint runFingerprint(const RenderSettings& s, const Scene& scene, const std::string& animationBytes,
+                              const Camera& camera) {
+    // Each part on its own (for messages), and all of them in one list, in the order the digest
+    // has always taken them (so that folders of earlier runs keep their fingerprint).
+    Fingerprinter all, content, lights, animation, view;
+    auto both = [&](Fingerprinter& part, auto&& addTo) {
+        addTo(part);
+        addTo(all);
+    };
+    all.add(std::string(QSGI_VERSION));
     // The scene as loaded (rest pose), whatever files it came from.
-    f.add(scene.positions);
-    f.add(scene.normals);
-    f.add(scene.triangles);
-    f.add(scene.triangleMaterial);
-    f.addValue(scene.worldOrigin);
-    for (const Material& m : scene.materials) {
-        f.addValue(m.albedo);
-        f.addValue(m.emission);
-    }
-    for (const PunctualLight& l : scene.lights) {
-        f.addValue(int(l.type));
-        f.addValue(l.position);
-        f.addValue(l.direction);
-        f.addValue(l.intensity);
-        f.addValue(l.cosOuterCone);
-    }
-    f.add(animationBytes);
+    both(content, [&](Fingerprinter& f) {
+        f.add(scene.positions);
+        f.add(scene.normals);
+        f.add(scene.triangles);
+        f.add(scene.triangleMaterial);
+        f.addValue(scene.worldOrigin);
+        for (const Material& m : scene.materials) {
+            f.addValue(m.albedo);
+            f.addValue(m.emission);
+        }
+    });
+    both(lights, [&](Fingerprinter& f) {
+        for (const PunctualLight& l : scene.lights) {
+            f.addValue(int(l.type));
+            f.addValue(l.position);
+            f.addValue(l.direction);
+            f.addValue(l.intensity);
+            f.addValue(l.cosOuterCone);
+        }
+    });
+    both(animation, [&](Fingerprinter& f) { f.add(animationBytes); });
     // Every option that reaches the frame files, as the option table declares them (the scene's
     // path among them: EXR metadata names it).
-    f.add(optionValues(s, OptionSelection::Fingerprinted).dump());
-    f.addValue(camera.position);
-    f.addValue(camera.forward);
-    f.addValue(camera.up);
-    f.addValue(camera.yfov);
-    f.addValue(int(camera.projection));
-    f.addValue(camera.ymag);
-    f.addValue(camera.node);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(f.result()));
-    return hex;
+    const nlohmann::json options = optionValues(s, OptionSelection::Fingerprinted);
+    all.add(options.dump());
+    both(view, [&](Fingerprinter& f) {
+        f.addValue(camera.position);
+        f.addValue(camera.forward);
+        f.addValue(camera.up);
+        f.addValue(camera.yfov);
+        f.addValue(int(camera.projection));
+        f.addValue(camera.ymag);
+        f.addValue(camera.node);
+    });
+    RunFingerprint fingerprint;
+    fingerprint.digest = hex(all.result());
+    fingerprint.parts = {{"qsgi", QSGI_VERSION},
+                         {"scene_content", hex(content.result())},
+                         {"lights", hex(lights.result())},
+                         {"animation_content", hex(animation.result())},
+                         {"camera", hex(view.result())},
+                         {"options", options}};
+    return fingerprint;
+}
+
+std::vector<std::string> fingerprintDifferences(const nlohmann::json& there, const nlohmann::json& here) {
+    std::vector<std::string> differences;
+    if (!there.is_object()) {
+        differences.push_back("the folder's timing.json does not record its settings (an older qsgi wrote it)");
+        return differences;
+    }
+    auto part = [](const nlohmann::json& parts, const char* name) {
+        return parts.contains(name) ? parts.at(name) : nlohmann::json(nullptr);
+    };
+    if (part(there, "qsgi") != part(here, "qsgi"))
+        differences.push_back("qsgi " + shown(part(there, "qsgi")) + " there, " + shown(part(here, "qsgi")) + " here");
+    // Options first, by the table's order: what a user most often changed.
+    const nlohmann::json optionsThere = part(there, "options"), optionsHere = part(here, "options");
+    for (const RenderOption& o : renderOptions()) {
+        if (!o.key || !o.fingerprinted) continue;
+        const nlohmann::json a = optionsThere.is_object() && optionsThere.contains(o.key) ? optionsThere.at(o.key) : nullptr;
+        const nlohmann::json b = optionsHere.is_object() && optionsHere.contains(o.key) ? optionsHere.at(o.key) : nullptr;
+        if (a != b) differences.push_back(std::string(o.key) + " " + shown(a) + " there, " + shown(b) + " here");
+    }
+    const std::pair<const char*, const char*> contents[] = {
+        {"scene_content", "the scene's content (geometry or materials) differs"},
+        {"lights", "the lights differ"},
+        {"animation_content", "the animation's content differs"},
+        {"camera", "the camera differs"}};
+    for (const auto& [name, what] : contents)
+        if (part(there, name) != part(here, name)) differences.push_back(what);
+    return differences;
 }
 
 }  // namespace qsgi

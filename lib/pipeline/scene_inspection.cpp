@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <set>
 
+#include "pipeline/output_folder.h"
+#include "pipeline/render_options.h"
 #include "trace/light_sampler.h"
 
 namespace qsgi {
@@ -11,6 +13,11 @@ namespace qsgi {
 namespace {
 
 nlohmann::json vec(const Vec3f& v) { return {v.x, v.y, v.z}; }
+// A position as the file and the PLY give it: the scene is held re-centred on its worldOrigin.
+nlohmann::json world(const Vec3f& p, const Scene& scene) {
+    const Vec3d w = Vec3d(p) + scene.worldOrigin;
+    return {w.x, w.y, w.z};
+}
 
 const char* lightTypeName(LightType t) {
     switch (t) {
@@ -27,6 +34,45 @@ std::string number(double x, const char* format = "%.4g") {
     return text;
 }
 
+std::string frameRange(int first, int last) { return std::to_string(first) + ":" + std::to_string(last); }
+
+// What the output folder holds and what this render would do with it; reads, never writes.
+nlohmann::json outputFolderReport(const RenderJob& job) {
+    using Holds = OutputFolderSurvey::Holds;
+    const RenderSettings& s = job.settings();
+    const OutputFolderSurvey survey = surveyOutputFolder(s.outDir, job.fingerprint(), s);
+    const std::string range = frameRange(job.firstFrame(), job.lastFrame());
+    nlohmann::json r = {{"path", s.outDir}, {"frame_files", survey.frameFiles.size()}};
+    std::string render;
+    if (survey.holds == Holds::Nothing) {
+        r["state"] = survey.exists ? "empty" : "absent";
+        render = "renders frames " + range + (survey.exists ? " into it" : ", creating it");
+    } else if (survey.holds == Holds::ThisRun) {
+        r["state"] = "this run";
+        std::set<int> complete;
+        for (const FrameTiming& f : survey.completeFrames) complete.insert(f.frame);
+        r["complete_frames"] = complete;
+        int next = job.firstFrame();
+        while (next <= job.lastFrame() && complete.count(next)) ++next;
+        if (s.resume)
+            render = next > job.lastFrame() ? "nothing: frames " + range + " are complete (--resume)"
+                                            : "resumes at frame " + std::to_string(next) + " and renders " +
+                                                  frameRange(next, job.lastFrame()) + " (--resume)";
+        else
+            render = "renders frames " + range + " again (the same bytes) and keeps the folder's other frames of this run" +
+                     (next > job.firstFrame() ? "; --resume would start at frame " + std::to_string(next) : "");
+    } else {
+        r["state"] = survey.holds == Holds::AnotherRun ? "another run" : "frame files without timing.json";
+        r["differences"] = survey.differences;
+        render = s.overwrite ? "unlinks the earlier run's " + std::to_string(survey.frameFiles.size()) +
+                                   " frame files and timing.json (--overwrite), then renders frames " + range
+                             : std::string("refuses: ") + outputFolderRefusal(survey, s)->what();
+    }
+    if (!job.hasLight()) render = "refuses: the scene has no lights";
+    r["render"] = render;
+    return r;
+}
+
 }  // namespace
 
 nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
@@ -41,7 +87,7 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
                   {"nodes", scene.nodes.size()},
                   {"triangles", scene.triangleCount()},
                   {"vertices", scene.vertexCount()},
-                  {"bounds", {{"min", vec(bounds.lower)}, {"max", vec(bounds.upper)}}},
+                  {"bounds", {{"min", world(bounds.lower, scene)}, {"max", world(bounds.upper, scene)}}},
                   {"diagonal", bounds.extent()}};
 
     // Materials as the render uses them: albedo range and emitters, over triangles that have area.
@@ -82,20 +128,22 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
         lights.push_back({{"name", l.name},
                           {"type", lightTypeName(l.type)},
                           {"from", l.node >= 0 ? "scene" : "config"},
+                          {"position", l.type == LightType::Directional ? nlohmann::json(nullptr) : world(l.position, scene)},
                           {"intensity", vec(l.intensity)},
                           {"power_w", luminance(powers[i])},
                           {"share", share(powers[i])}});
     }
     r["lights"] = lights;
+    r["lit"] = job.hasLight();
     r["emissive_surfaces"] = {{"power_w", luminance(trianglePower)}, {"share", share(trianglePower)}};
 
     const Camera& camera = job.camera();
     r["cameras"] = {{"in_scene", scene.cameras.size()},
-                    {"render", {{"from", camera.node >= 0 ? "node '" + scene.nodes[size_t(camera.node)].name + "'"
+                    {"render", {{"from", camera.node >= 0 ? (scene.nodes[size_t(camera.node)].name.empty() ? "node #" + std::to_string(camera.node) : "node '" + scene.nodes[size_t(camera.node)].name + "'")
                                          : settings.camera ? std::string("config")
                                                            : std::string("framing the scene's bounds")},
                                 {"projection", camera.projection == Projection::Perspective ? "perspective" : "orthographic"},
-                                {"position", vec(camera.position)}}}};
+                                {"position", world(camera.position, scene)}}}};
 
     nlohmann::json files = nlohmann::json::array();
     const double fps = settings.fps.value_or(kDefaultGltfFps);  // what --animation gltf would sample at
@@ -115,10 +163,31 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
                       {"morphed_nodes", morphed},
                       {"dynamic_triangles", dynamicTriangles},
                       {"dynamic_fraction", scene.triangleCount() ? double(dynamicTriangles) / scene.triangleCount() : 0.0},
-                      {"bounds", {{"min", vec(scene.animationBounds.lower)}, {"max", vec(scene.animationBounds.upper)}}},
+                      {"bounds", {{"min", world(scene.animationBounds.lower, scene)}, {"max", world(scene.animationBounds.upper, scene)}}},
                       {"diagonal", scene.animationBounds.extent()}};
     r["radius"] = {{"value", settings.estimator.radius},
                    {"from", settings.radiusGiven ? "settings" : "default: 1.5 % of the animation's diagonal"}};
+    r["animation"]["unplayed_animations"] = job.unplayedAnimationsNote();
+
+    // The options this render sets away from their defaults (the scene's path is always set).
+    // Options that only one estimator or sampler reads are compared with that estimator's or
+    // sampler's defaults, so that choosing DETP does not list its default radius as a choice.
+    RenderSettings defaults, alike;
+    alike.estimator.kind = settings.estimator.kind;
+    alike.sampling.kind = settings.sampling.kind;
+    if (!settings.radiusGiven) alike.estimator.radius = settings.estimator.radius;
+    const nlohmann::json chosen = optionValues(settings, OptionSelection::All);
+    const nlohmann::json standard = optionValues(defaults, OptionSelection::All), standardAlike = optionValues(alike, OptionSelection::All);
+    nlohmann::json changed = nlohmann::json::object();
+    for (auto it = chosen.begin(); it != chosen.end(); ++it) {
+        const nlohmann::json& base = it.key() == "estimator" || it.key() == "sampler" ? standard : standardAlike;
+        if (it.key() != "scene" && (!base.contains(it.key()) || base.at(it.key()) != it.value())) changed[it.key()] = it.value();
+    }
+    if (settings.resume) changed["resume"] = true;
+    if (settings.overwrite) changed["overwrite"] = true;
+    r["options_set"] = changed;
+
+    r["output_folder"] = outputFolderReport(job);
     r["warnings"] = warnings.messages;
     return r;
 }
@@ -141,7 +210,11 @@ std::string inspectionText(const nlohmann::json& r) {
          "; albedo " + triple(m["albedo_min"]) + " to " + triple(m["albedo_max"]) + "; " +
          std::to_string(m["emissive"].get<uint64_t>()) + " emissive (" + std::to_string(m["emissive_triangles"].get<uint64_t>()) +
          " triangles, " + number(100 * r["emissive_surfaces"]["share"].get<double>(), "%.1f") + " % of the power)");
-    line("lights     " + std::to_string(r["lights"].size()));
+    if (!r["lit"].get<bool>())
+        line("lights     none: no emissive material and no light of any power; give lights in a config (\"lights\": "
+             "point or directional, docs/inputs.md) before rendering");
+    else
+        line("lights     " + std::to_string(r["lights"].size()));
     for (const auto& l : r["lights"])
         line("  " + l["type"].get<std::string>() + " '" + l["name"].get<std::string>() + "' (" + l["from"].get<std::string>() +
              "): " + number(l["power_w"].get<double>()) + " W, " + number(100 * l["share"].get<double>(), "%.1f") +
@@ -163,7 +236,16 @@ std::string inspectionText(const nlohmann::json& r) {
          std::to_string(a["dynamic_triangles"].get<uint64_t>()) + " triangles (" +
          number(100 * a["dynamic_fraction"].get<double>(), "%.1f") + " % of the scene); bounds over the animation " +
          triple(a["bounds"]["min"]) + " to " + triple(a["bounds"]["max"]));
+    if (!a["unplayed_animations"].get<std::string>().empty()) line("  " + a["unplayed_animations"].get<std::string>());
     line("radius     " + number(r["radius"]["value"].get<double>()) + " (" + r["radius"]["from"].get<std::string>() + ")");
+    std::string options;
+    for (auto it = r["options_set"].begin(); it != r["options_set"].end(); ++it)
+        options += (options.empty() ? "" : ", ") + it.key() + " " +
+                   (it.value().is_string() ? it.value().get<std::string>() : it.value().dump());
+    line("options    " + (options.empty() ? std::string("the defaults") : options));
+    const auto& folder = r["output_folder"];
+    line("output     " + folder["path"].get<std::string>() + ": " + folder["state"].get<std::string>() + "; a render " +
+         folder["render"].get<std::string>());
     line("warnings   " + std::to_string(r["warnings"].size()));
     for (const auto& w : r["warnings"]) line("  " + w.get<std::string>());
     return out;

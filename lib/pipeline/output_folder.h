@@ -1,0 +1,59 @@
+// One output folder holds one run. Before a render writes into a folder, it looks at what the
+// folder holds: nothing of qsgi's; frames of this very run (the same fingerprint: a plain render
+// recomputes its frame range and keeps the other frames, --resume continues after the complete
+// ones); another run's frames (refused, naming each setting that differs with both values, unless
+// --overwrite); or frame files that no timing.json describes (refused unless --overwrite).
+// `qsgi inspect` reports the same survey without writing anything.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pipeline/render_settings.h"
+#include "pipeline/run_fingerprint.h"
+#include "util/error.h"
+#include "util/frame_timing.h"
+
+namespace qsgi {
+
+struct OutputFolderSurvey {
+    enum class Holds {
+        Nothing,       // missing, empty, or no frame files and no timing.json
+        ThisRun,       // a timing.json with this run's fingerprint
+        AnotherRun,    // a timing.json with another fingerprint, or one qsgi cannot read
+        UnknownFiles,  // frame files without a timing.json
+    };
+    std::filesystem::path folder;
+    bool exists = false;
+    Holds holds = Holds::Nothing;
+    // ThisRun: the frames its timing.json lists whose files are all on disk, in the log's order.
+    std::vector<FrameTiming> completeFrames;
+    // AnotherRun: what differs ("photons 20000 there, 1000000 here"), or why the log is unreadable.
+    std::vector<std::string> differences;
+    // Every frame_NNNN.* entry in the folder (what --overwrite unlinks, with timing.json).
+    std::vector<std::filesystem::path> frameFiles;
+};
+
+// "frame_0012.ply" and the like.
+std::string frameFileName(int frame, const char* extension);
+// "frame_0012.ply", "frame_12345.exr": a frame file's name as frameFileName writes it.
+bool isFrameFileName(const std::string& name);
+
+// Whether every file the settings ask for is on disk for `frame`.
+bool frameFilesComplete(const std::filesystem::path& folder, int frame, const RenderSettings& settings);
+
+// Reads the folder; writes nothing.
+OutputFolderSurvey surveyOutputFolder(const std::filesystem::path& folder, const RunFingerprint& fingerprint,
+                                      const RenderSettings& settings);
+
+// Why a run with these settings (--resume, --overwrite) may not write into the surveyed folder:
+// one message naming the folder and each differing setting, or nullopt when it may.
+std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const RenderSettings& settings);
+
+// For --overwrite: unlinks the earlier run's frame files and its timing.json, nothing else (never
+// recursively: not chunks/, not slurm/, not another file of the user's).
+void removeEarlierRun(const OutputFolderSurvey& survey);
+
+}  // namespace qsgi
