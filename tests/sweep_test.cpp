@@ -177,3 +177,28 @@ TEST(Sweep, BadConfigIsOneMessageNamingTheKeyAndExitTwo) {
         EXPECT_FALSE(fs::exists(dir / "out"));
     }
 }
+
+// On a machine without Slurm (no sbatch on PATH), submitting a render or a sweep is one line,
+// exit 2, and nothing is left behind: no chunk plan, no slurm/ folder, no output folder.
+TEST(Sweep, SlurmSubmissionWithoutSbatchIsOneLineAndWritesNothing) {
+    const fs::path dir = testScratchDir("no-sbatch");
+    const fs::path out = dir / "out";
+    // A PATH that holds no sbatch, whatever this machine has installed.
+    const std::string noSlurm = "env PATH=" + (dir / "empty-path").string() + " /usr/bin/python3 ";
+    const std::string scene = (sourceDir() / "data" / "cornell" / "cornell.gltf").string();
+    const std::string render = noSlurm + (sourceDir() / "scripts" / "slurm" / "render.py").string() + " --out " +
+                               out.string() + " --frames 0:3 --chunks 2 --qsgi " + QSGI_CLI + " -- " + scene;
+    const fs::path config = dir / "sweep.json";
+    std::ofstream(config) << R"({"scene": ")" << scene << R"(", "grid": {"photons": [1000], "estimators": ["detp"], "radius_fraction": [0.015]}})";
+    const std::string sweep = noSlurm + (sourceDir() / "scripts" / "sweep.py").string() + " " + config.string() +
+                              " --slurm --out " + out.string() + " --qsgi " + QSGI_CLI;
+    for (const std::string& command : {render, sweep}) {
+        SCOPED_TRACE(command);
+        const CommandResult r = runCommand(command);
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+        EXPECT_NE(r.output.find("sbatch is not on PATH"), std::string::npos) << r.output;
+        EXPECT_EQ(r.output.find("Traceback"), std::string::npos) << r.output;
+        EXPECT_FALSE(fs::exists(out)) << "nothing may be written";
+    }
+}

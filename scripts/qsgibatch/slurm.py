@@ -7,6 +7,7 @@ state from scratch and writes the bytes one sequential run would (the PNG exposu
 killed or failed task finishes the work without redoing any."""
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 
@@ -15,6 +16,13 @@ from .runner import finished
 
 class SlurmError(Exception):
     pass
+
+
+def require_sbatch() -> None:
+    """Raises SlurmError, before anything is written, on a machine without Slurm's sbatch."""
+    if shutil.which("sbatch") is None:
+        raise SlurmError("sbatch is not on PATH: this machine has no Slurm client. Submit from a machine of the "
+                         "cluster (its login node), or run the work here without Slurm")
 
 
 def sbatch(name, command, log_folder, options, array=None, dependency=None, cpus=1) -> str:
@@ -66,6 +74,11 @@ def python_executable():
 def submit_sweep(args, config, script) -> int:
     """A preparation job (scene probe and reference), an array of the points not yet computed, and
     a merge job that writes sweep.csv and the plots once every point has succeeded."""
+    try:
+        require_sbatch()
+    except SlurmError as e:
+        print(f"sweep: {e}", file=sys.stderr)
+        return 2
     out = os.path.abspath(args.out)
     logs = os.path.join(out, "slurm")
     os.makedirs(logs, exist_ok=True)

@@ -57,6 +57,7 @@ def parse_arguments(argv):
 
 
 def submit(args) -> int:
+    slurm.require_sbatch()  # before the plan or the log folder is written
     out = os.path.abspath(args.out)
     # Paths in the render's arguments are made absolute: tasks start in another folder.
     arguments = [os.path.abspath(a) if os.path.exists(a) else a for a in args.render_arguments]
