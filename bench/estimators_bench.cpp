@@ -220,7 +220,7 @@ void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
 }
 
 // DETP's own rate: every segment traced through the vertices' discs with the exact test, in the
-// Morton order the estimator uses (DESIGN §5). Its ceiling is BM_EmbreeAllHitsCeiling below.
+// Morton order the estimator uses (docs/design.md §5). Its ceiling is BM_EmbreeAllHitsCeiling below.
 // Third argument: 0 times the pass alone, on segments decoded and ordered before the timed loop;
 // 1 runs it as the estimator does, decoding the cache a group of blocks at a time (what reading
 // the compact cache costs the pass).

@@ -1,4 +1,4 @@
-// Fuzzes the config reader (DESIGN §8): JSON parsing as readJsonFile does it, applyConfigJson
+// Fuzzes the config reader (docs/design.md §8): JSON parsing as readJsonFile does it, applyConfigJson
 // and validateSettings. Only InputError may leave qsgi's code.
 #include <nlohmann/json.hpp>
 

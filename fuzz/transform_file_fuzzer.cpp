@@ -1,4 +1,4 @@
-// Fuzzes the transform-file reader (DESIGN §3): JSON parsing as readJsonFile does it, then
+// Fuzzes the transform-file reader (docs/design.md §3): JSON parsing as readJsonFile does it, then
 // Animation::parseTransformFile against a small scene with a mesh, a child mesh and a light, and
 // the checks RenderJob runs on the result. Only InputError may leave qsgi's code.
 #include <nlohmann/json.hpp>

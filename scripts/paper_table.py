@@ -7,7 +7,7 @@ without sorted queries; ray cache with sorted queries — plus --full-recompute,
 paper's DETP rule (--detp-boundary paper, like for like) and with the default rule (clip), and
 reads every run's timing.json: photon simulation initial / median per frame, density estimation
 initial / median per frame, and frames per second of the update (1 / median(photon_update_s +
-estimation_s)). Rendering and writing are not part of a frame (DESIGN §7).
+estimation_s)). Rendering and writing are not part of a frame (docs/design.md §7).
 
 Usage: python3 scripts/paper_table.py [--config CONFIG] [--qsgi BUILD/cli/qsgi] [--frames A:B]
                                       [--photons N] [--out DIR] [--json FILE]

@@ -98,7 +98,7 @@ def write_ply(path, positions, normals, faces, radiosity, comment):
 
 
 # ---------------------------------------------------------------------------------------------
-# Materials per vertex, in qsgi's flattening order (DESIGN §2; lib/scene/gltf_loader.cpp): scene
+# Materials per vertex, in qsgi's flattening order (docs/design.md §2; lib/scene/gltf_loader.cpp): scene
 # roots in order, depth-first pre-order, each node's mesh primitives in order.
 
 def gltf_vertex_materials(path):

@@ -47,18 +47,20 @@ git ls-files -z | tar --null -T - -cf "$work/qsgi.tar"
 mkdir "$work/ca"
 cp /usr/local/share/ca-certificates/*.crt "$work/ca/" 2>/dev/null || true
 
-# Inside the root: scripts/run.sh, as a new user would run it, on two frames of data/cornell.
+# Inside the root: scripts/run.sh, as a new user would run it, on two frames of data/cornell. Its
+# output (apt's and the compiler's) goes to a log that is copied out; its end is shown on failure.
 render=(scripts/run.sh --frames 0:1 --photons 20000 --out /root/out "$@")
-inner="cd /root/qsgi && ${render[*]@Q}"
+inner="cd /root/qsgi && start=\$(date +%s) && { ${render[*]@Q} > /root/run.log 2>&1 || { tail -n 60 /root/run.log; exit 1; }; } \
+  && echo \$(( \$(date +%s) - start )) > /root/run-seconds"
 
 start=$(date +%s)
 mmdebstrap --variant=apt --include=ca-certificates --quiet \
   --customize-hook='mkdir -p "$1/root/qsgi"' \
   --customize-hook="tar-in $work/qsgi.tar /root/qsgi" \
   --customize-hook="copy-in $work/ca /usr/local/share/ca-certificates" \
-  --customize-hook='chroot "$1" update-ca-certificates >/dev/null' \
+  --customize-hook='chroot "$1" update-ca-certificates >/dev/null 2>&1' \
   --customize-hook="chroot \"\$1\" bash -c ${inner@Q}" \
-  --customize-hook="copy-out /root/out $work" \
+  --customize-hook="copy-out /root/out /root/run.log /root/run-seconds $work" \
   bookworm /dev/null "${sources[@]}"
 seconds=$(( $(date +%s) - start ))
 
@@ -70,4 +72,10 @@ for f in frame_0000.ply frame_0001.ply frame_0000.exr frame_0001.exr frame_0000.
   fi
 done
 frames=$(grep -c '"frame":' "$out/timing.json" || true)
-echo "test-fresh-root: a fresh Debian 12 root built qsgi and rendered 2 frames in ${seconds} s (timing.json lists ${frames} frame entries)"
+if [ "$frames" != 2 ]; then
+  echo "test-fresh-root: timing.json lists $frames frames, not 2" >&2
+  exit 1
+fi
+packages=$(grep -c '^Setting up ' "$work/run.log" || true)
+echo "test-fresh-root: in a fresh Debian 12 root, scripts/run.sh installed $packages packages, built qsgi and rendered" \
+     "2 frames in $(cat "$work/run-seconds") s; the whole stage (root, install, build, render) took ${seconds} s"

@@ -1,5 +1,5 @@
 // The qsgi executable end to end: determinism of the bytes it writes, and bad input giving one
-// clear message, exit code 2 and nothing written (DESIGN §8).
+// clear message, exit code 2 and nothing written (docs/design.md §8).
 #include <gtest/gtest.h>
 
 #include <pty.h>

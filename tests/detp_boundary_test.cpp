@@ -1,4 +1,4 @@
-// Where discs meet other geometry (DESIGN §5, issue 7): no leaks through thin occluders, no light
+// Where discs meet other geometry (docs/design.md §5, issue 7): no leaks through thin occluders, no light
 // lost or gained at borders, curved surfaces, crease fallbacks, and flat interiors unchanged. Black
 // surfaces make the irradiance the direct light, which is analytic.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Own surfaces, the disc pattern and disc regions (DESIGN §5): heights on flat and curved
+// Own surfaces, the disc pattern and disc regions (docs/design.md §5): heights on flat and curved
 // surfaces, pattern moments, determinism across thread counts, and per-frame updates that equal a
 // from-scratch computation.
 #include <gtest/gtest.h>

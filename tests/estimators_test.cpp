@@ -1,4 +1,4 @@
-// Photon map and DETP (DESIGN §5): indexes equal brute force, analytic answers, the border claim
+// Photon map and DETP (docs/design.md §5): indexes equal brute force, analytic answers, the border claim
 // of the paper, geometry independence, and extreme parameters.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Golden images (DESIGN §7, §9): fresh renders compared with committed EXRs the way CI pipelines
+// Golden images (docs/design.md §7, §9): fresh renders compared with committed EXRs the way CI pipelines
 // guard renders. Thresholds (ImageTolerance defaults) and why:
 //  - The output is deterministic, so the same build reproduces a golden bit for bit (error 0).
 //  - Another compiler or CPU may round a few operations differently (FMA contraction, libm), which

@@ -135,7 +135,7 @@ TEST(HostileInput, AFolderAsATransformFileIsRefusedByName) {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
 }
 
-// A zero scale in a transform file hides the node for that frame (glTF's visibility, DESIGN
+// A zero scale in a transform file hides the node for that frame (glTF's visibility, docs/design.md
 // §3; issue 23: it was refused as "not invertible"), on every axis or on one; the frame after it
 // shows the floor lit again, exactly as frame 0 (the same pose, the same photons).
 TEST(HostileInput, AZeroScaleInATransformFileHidesTheNode) {
@@ -299,4 +299,40 @@ TEST(HostileInput, ADeepChainOfNodesAndALongTransformFileLoadAsTheySay) {
     ASSERT_EQ(a.movedNodes(), std::vector<int>{0});
     for (int f : {0, 1, 6, 7, frames / 2, frames - 1})
         EXPECT_DOUBLE_EQ(a.localsAt(f)[0].at(1, 3), 1e-3 * (f % 7)) << "frame " << f;
+}
+
+// A glTF animation without channels loads (with a warning: glTF requires one) and has frame 0
+// alone; the Animation says which animation it is and why it ends there, for the message about
+// frames beyond it. One with keys says where they end.
+TEST(HostileInput, AGltfAnimationWithoutChannelsNamesItselfAndWhyItHasOneFrame) {
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(dataDir() / "good" / "base.gltf"));
+    doc["animations"] = {{{"name", "Idle"}, {"channels", nlohmann::json::array()}, {"samplers", nlohmann::json::array()}}};
+    const fs::path dir = testScratchDir("hostile-animation-without-channels");
+    std::ofstream(dir / "idle.gltf") << doc.dump();
+    Warnings warnings;
+    Scene scene;
+    ASSERT_NO_THROW(scene = loadGltfScene((dir / "idle.gltf").string(), warnings));
+    bool warned = false;
+    for (const std::string& w : warnings.messages) warned = warned || w.find("animations[0] has no channels") != std::string::npos;
+    EXPECT_TRUE(warned);
+    for (int index : {0, -1}) {
+        const Animation idle = Animation::fromGltf(scene, index, 24, "idle.gltf (--animation gltf)");
+        EXPECT_EQ(idle.lastFrame(), 0);
+        EXPECT_TRUE(idle.hasNoChannels());
+        EXPECT_EQ(idle.name(), "glTF animation 0 'Idle'");
+        EXPECT_EQ(idle.lastFrameReason(), "glTF animation 0 'Idle' has no channels to play, so it moves nothing and has frame 0 alone");
+    }
+
+    const Scene walker = loadGltfScene((sourceDir() / "data/walker/walker.gltf").string(), warnings);
+    const Animation walk = Animation::fromGltf(walker, 0, 24, "walker.gltf (--animation gltf:0)");
+    EXPECT_FALSE(walk.hasNoChannels());
+    EXPECT_EQ(walk.name(), "glTF animation 0 'Walk'");
+    EXPECT_EQ(walk.lastFrameReason().rfind("glTF animation 0 'Walk' has keys up to ", 0), 0u) << walk.lastFrameReason();
+    EXPECT_NE(walk.lastFrameReason().find(": frames 0 to " + std::to_string(walk.lastFrame()) + " at 24 fps"), std::string::npos)
+        << walk.lastFrameReason();
+    const Animation file = Animation::fromTransformFile((dataDir() / "bad/animation/moves_the_light.json").string(),
+                                                       loadGltfScene((dataDir() / "good" / "base.gltf").string(), warnings));
+    EXPECT_EQ(file.lastFrameReason(), "transform file " + (dataDir() / "bad/animation/moves_the_light.json").string() +
+                                          " lists frames up to 1");
+    EXPECT_EQ(Animation::still(walker).lastFrameReason(), "");
 }

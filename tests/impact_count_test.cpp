@@ -1,4 +1,4 @@
-// Impact count against analytic answers (DESIGN §5), with tolerances derived from the Poisson
+// Impact count against analytic answers (docs/design.md §5), with tolerances derived from the Poisson
 // statistics of the hit counts rather than picked to pass.
 #include <gtest/gtest.h>
 
@@ -174,7 +174,7 @@ TEST(ImpactCount, ClosedBoxAbsorbsTheEmittedPower) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(absorbed[c] / emitted[c], 1.0, 0.01) << "channel " << c;
 }
 
-// A translated and scaled copy of a scene traces the same photons (DESIGN §4: epsilons scale with
+// A translated and scaled copy of a scene traces the same photons (docs/design.md §4: epsilons scale with
 // the scene and positions are re-centred).
 TEST(ImpactCount, TranslatedSceneGivesTheSameAnswer) {
     Scene a = testscenes::closedBox(8);

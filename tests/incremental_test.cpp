@@ -1,4 +1,4 @@
-// The incremental update (DESIGN §6): every frame equals a from-scratch computation of that frame,
+// The incremental update (docs/design.md §6): every frame equals a from-scratch computation of that frame,
 // bit for bit, for every estimator and DETP rule, with 1 and 2 threads, with and without the
 // envelope; nothing drifts over 10,000 frames; a frame where nothing moves changes nothing; and
 // hits do not depend on the BVH (the tie rule).
@@ -162,7 +162,7 @@ std::vector<AnimatedScene> scenes() {
         {"light far outside the scene (aimed emission)", farLight, "Cube", [](int f) { return slide(f, 0.1, -0.08); }, 4},
         {"mover lifts off and back", cubeOnFloor(false), "Cube",
          [](int f) { return Vec3d(0.0, f % 2 ? 0.02 : 0.0, 0.03 * f); }, 5},
-        // glTF's visibility (DESIGN §3): hidden by a zero scale, on every axis and on one, then
+        // glTF's visibility (docs/design.md §3): hidden by a zero scale, on every axis and on one, then
         // shown again elsewhere.
         {"mover hidden and shown again", cubeOnFloor(false), "Cube", [](int f) { return slide(f, 0.05, 0.0); }, 5,
          [](int f) { return f == 1 ? Vec3d(0.0) : f == 2 ? Vec3d(1, 0, 1) : Vec3d(1.0); }},
@@ -255,7 +255,7 @@ TEST(Incremental, FramesWhereNothingRelevantMovesChangeNothing) {
     }
 }
 
-// A zero scale hides a node for its frame (glTF's visibility, DESIGN §3): its vertices carry
+// A zero scale hides a node for its frame (glTF's visibility, docs/design.md §3): its vertices carry
 // radiosity 0 and keep their last normals, and it casts no shadow — the floor its shadow covered
 // is lit as a bare plane is, E = I h / d³, with no indirect light. The incremental frames equal
 // full recomputation on this animation with the other scenes (EveryFrameEqualsFullRecomputation…).

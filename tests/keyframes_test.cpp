@@ -343,7 +343,7 @@ TEST(Keyframes, MalformedSamplersAreRefusedNamingThePlace) {
         Warnings warnings;
         if (cases[i].message.empty()) {
             const Scene scene = loadGltfScene(file.string(), warnings);
-            // A scale animated to zero is how glTF animates visibility (DESIGN §3): the node
+            // A scale animated to zero is how glTF animates visibility (docs/design.md §3): the node
             // moves, and is hidden at frame 24.
             const Animation anim = Animation::fromGltf(scene, -1, 24, "t");
             EXPECT_EQ(anim.lastFrame(), 24);

@@ -1,4 +1,4 @@
-// The photon map follows a changing photon set (DESIGN §6.4): after update() its estimates equal,
+// The photon map follows a changing photon set (docs/design.md §6.4): after update() its estimates equal,
 // bit for bit, those of a map built from scratch over the same impacts and those of brute force;
 // and recomputing only the vertices ballsHolding() names, or those whose neighbour lists
 // editLists() edits, gives the full estimate of the new set.

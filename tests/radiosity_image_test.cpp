@@ -1,4 +1,4 @@
-// The camera and the radiosity view (DESIGN §2, §7): pixel radiance is B/π interpolated over the
+// The camera and the radiosity view (docs/design.md §2, §7): pixel radiance is B/π interpolated over the
 // hit triangle, background black.
 #include <gtest/gtest.h>
 

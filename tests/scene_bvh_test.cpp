@@ -1,4 +1,4 @@
-// Identical hits (DESIGN §6 step 0): at equal t the lowest triangle id wins, inside the static and
+// Identical hits (docs/design.md §6 step 0): at equal t the lowest triangle id wins, inside the static and
 // the dynamic BVH and between them, so no hit depends on a BVH's shape or traversal order.
 #include <gtest/gtest.h>
 

@@ -61,7 +61,7 @@ bool detpCounts(const Segment& s, const Vec3f& centre, const Vec3f& normal, cons
 namespace {
 // Fixed-point scale of the crossing coordinates in the `linear` moments.
 constexpr double kMomentScale = 1048576.0;  // 2^20
-// Above this the reachable region is too thin for a linear fit to be trusted (DESIGN §5).
+// Above this the reachable region is too thin for a linear fit to be trusted (docs/design.md §5).
 constexpr double kMaxFitCondition = 1e4;
 }  // namespace
 

@@ -1,4 +1,4 @@
-// Density estimation on the tangent plane (DESIGN §5, Lastra et al. 2002). Vertex v owns the disc
+// Density estimation on the tangent plane (docs/design.md §5, Lastra et al. 2002). Vertex v owns the disc
 // D_v = { p : (p − v)·n_v = 0, |p − v| ≤ r }. A segment s crosses it when d·n_v < 0 and its line
 // meets the plane at t* inside the disc, with
 //   clip / linear: 0 < t* ≤ t_s + min(ε_v⁺/|d·n_v|, r) — its impact lies at most ε_v⁺ (the height

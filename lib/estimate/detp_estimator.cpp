@@ -1,4 +1,4 @@
-// DETP behind the Estimator interface (DESIGN §5–§6), with its three boundary rules. Per vertex,
+// DETP behind the Estimator interface (docs/design.md §5–§6), with its three boundary rules. Per vertex,
 // fixed-point sums of the crossings' power (and first moments for `linear`), so an update is
 // "+ new − old" to the bit:
 //   - a removed segment leaves by the crossings remembered when it entered — no second trace

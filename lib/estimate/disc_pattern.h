@@ -1,4 +1,4 @@
-// The fixed cell pattern of a vertex's disc (DESIGN §5): kRings rings of equal area × kSectors
+// The fixed cell pattern of a vertex's disc (docs/design.md §5): kRings rings of equal area × kSectors
 // sectors in a tangent frame derived from n_v alone. The sector count is even, so the pattern is
 // symmetric under a half turn and its first moments vanish exactly. Coordinates here are in units
 // of the radius r: the unit disc.
@@ -32,7 +32,7 @@ int discCellOf(double x, double y);
 inline int discRingOf(int cell) { return cell / kDiscSectors; }
 void discCellCentre(int cell, double& x, double& y);
 
-// The points of the pattern that reachability tests aim at (DESIGN §5), on the unit disc: the
+// The points of the pattern that reachability tests aim at (docs/design.md §5), on the unit disc: the
 // cells' shared corners (ring boundaries × sector boundaries, ring boundary 0 being v), each
 // cell's centre, and each cell's 4×4 sub-points. Worked out once: every disc tests the same ones.
 struct DiscPatternPoints {

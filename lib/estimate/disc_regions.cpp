@@ -72,7 +72,7 @@ struct StaticShortcuts {
     bool reuse = false;  // read them from there (kept for this very start and lift)
 };
 
-// The cells of v's disc that light can reach from `startPoint` (DESIGN §5).
+// The cells of v's disc that light can reach from `startPoint` (docs/design.md §5).
 VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
                     const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage, const OwnSurface& own,
                     const StaticShortcuts& shortcuts) {

@@ -1,11 +1,11 @@
-// What each vertex's disc can receive (DESIGN §5): its own surface's height band, and which cells
+// What each vertex's disc can receive (docs/design.md §5): its own surface's height band, and which cells
 // of its fixed pattern light can reach from v's side. A cell is reachable when the segment from
 // the start point s_v = v + ε_v⁺·n_v + min(10⁻³ r, ε)·u_v to the cell's centre lifted by ε_v⁺
 // meets no geometry: cells behind an adjacent wall, under a box standing beside v or inside a
 // solid are not. A cell whose corners disagree with its centre is *mixed* (a wall runs through
 // it): a crossing or impact there is tested on its own with the same kind of segment, and the
 // cell's area counts by the reachable share of 4×4 sub-points. So light beyond a thin partition
-// never counts, however the partition cuts the pattern (DESIGN's centre-only rule lets a cell
+// never counts, however the partition cuts the pattern (deciding a cell by its centre alone would let a cell
 // that straddles the partition count the far side's light). For the photon map a cell is also *covered*: reachable, and a probe from its
 // lifted centre along −n_v first meets a surface facing n_v (within 45°) inside [−ε_v⁻, ε_v⁺]
 // — a photon map has impacts only where there is such a surface.

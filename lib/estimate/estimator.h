@@ -1,4 +1,4 @@
-// Density estimation (DESIGN §5–§6): one interface for the three estimators. Each solves a
+// Density estimation (docs/design.md §5–§6): one interface for the three estimators. Each solves a
 // frame from scratch (every vertex from every segment) and updates the previous frame's answer
 // from what a move changed (the segments retraced, the vertices and triangles moved). The
 // caller — FrameSolver, tests, benchmarks — never switches on the kind. One file per estimator:
@@ -35,7 +35,7 @@ struct EstimatorSettings {
     bool useIndex = true;     // false: brute force, the paper's "No Ray Caché" (reference for tests)
     bool sortQueries = true;  // Morton-ordered queries; false: input order
     DetpIndex detpIndex = DetpIndex::Embree;
-    // Where a disc meets other geometry (DESIGN §5): clip (default) or linear; paper is the
+    // Where a disc meets other geometry (docs/design.md §5): clip (default) or linear; paper is the
     // published rule (and the textbook photon map), for ablations.
     DetpBoundary boundary = DetpBoundary::Clip;
 };
@@ -45,7 +45,7 @@ bool needsDiscRegions(const EstimatorSettings& settings);
 DiscRegions makeDiscRegions(const EstimatorSettings& settings);
 inline const char* estimatorName(EstimatorKind kind) { return nameOf(kEstimatorNames, kind); }
 
-// What one frame changed, as an update reads it (DESIGN §6 steps 2–4). The scene, its BVH and
+// What one frame changed, as an update reads it (docs/design.md §6 steps 2–4). The scene, its BVH and
 // the disc regions already hold the new pose.
 struct FrameChange {
     const std::vector<Segment>& removed;        // old tails, as they were cached before the move

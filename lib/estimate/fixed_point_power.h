@@ -1,6 +1,6 @@
 // Fixed-point sums of photon power. Integer addition is associative, so a vertex's sum is the
 // same bits whatever order threads add in, and "+ new - old" in the incremental update is exact
-// (DESIGN §6.7; floating-point sums would depend on the order threads add in).
+// (docs/design.md §6.7; floating-point sums would depend on the order threads add in).
 #pragma once
 
 #include <cmath>

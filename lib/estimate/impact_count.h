@@ -1,6 +1,6 @@
-// Impact count (DESIGN §5): E_τ = Σ Φ / A_τ over the impacts on triangle τ; a vertex takes the
+// Impact count (docs/design.md §5): E_τ = Σ Φ / A_τ over the impacts on triangle τ; a vertex takes the
 // mean E_τ of its non-degenerate triangles. Only impacts on the side the triangle's vertex
-// normals face count, so E is the irradiance "on the side the vertex normal faces" (DESIGN §2),
+// normals face count, so E is the irradiance "on the side the vertex normal faces" (docs/design.md §2),
 // as for the other estimators.
 #pragma once
 

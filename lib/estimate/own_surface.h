@@ -1,4 +1,4 @@
-// The own surface of a vertex (DESIGN §5): the triangles reached from v across shared (welded)
+// The own surface of a vertex (docs/design.md §5): the triangles reached from v across shared (welded)
 // vertices whose front face normals lie strictly within 45° of n_v, clipped to the cylinder C_v
 // of radius r around v's normal, |height| ≤ r. Its largest heights above and below v's tangent
 // plane bound where photons that belong to v's surface can land: DETP counts a segment only if

@@ -1,15 +1,15 @@
-// Photon map (DESIGN §5): the k nearest impacts h_s to vertex v that count for v, searched within
+// Photon map (docs/design.md §5): the k nearest impacts h_s to vertex v that count for v, searched within
 // `radius`; r_k is the distance to the k-th. An impact counts when it arrives from the front
 // (d_s·n_v < 0) and — with disc regions — lies on a surface facing n_v (front face normal within
 // 45°) between ε_v⁻ below and ε_v⁺ above v's tangent plane, so a panel under a ceiling or a plate
 // over a floor lends the surface beneath none of its photons. E_v = Σ Φ_s over the k−1 impacts
 // strictly inside r_k, divided by the area of the r_k disc that such surfaces cover (DiscRegions'
-// covered cells; π r_k² where all are covered). DESIGN sums all k, which overestimates by
+// covered cells; π r_k² where all are covered). The textbook form sums all k, which overestimates by
 // k/(k−1); see estimate(). With fewer than k inside `radius`, all of them over the covered part
 // of the radius disc. Without regions (the `paper` ablation, and vertices whose own surface is
 // empty) the textbook rule: front-facing impacts over π r_k².
 //
-// The map owns a copy of its impacts and follows a changing photon set (DESIGN §6.4): update()
+// The map owns a copy of its impacts and follows a changing photon set (docs/design.md §6.4): update()
 // takes a frame's removed and added segments, and ballsHolding() names the vertices whose last
 // estimate such a change can alter, so irradianceAt() recomputes only those. Two indexes answer
 // the queries: a big kd-tree, built rarely, whose removed impacts are marked and skipped, and a

@@ -1,9 +1,9 @@
-// The photon map behind the Estimator interface (DESIGN §5, §6 step 4). Its k nearest
+// The photon map behind the Estimator interface (docs/design.md §5, §6 step 4). Its k nearest
 // neighbours cannot be folded into sums, so the map keeps every impact in a kd-tree that an
 // update edits in place (removed impacts out, added ones in), and, when frames follow, each
 // vertex's neighbour list: every counted impact within a bound at least as far as its k-th.
 // A frame's removed and added impacts edit the lists that hold them; only the vertices whose
-// list changed (DESIGN's "ball holds a changed impact": on the rim too, by the tie rule) are
+// list changed (whose ball holds a changed impact: on the rim too, by the tie rule) are
 // estimated again, from the list alone, and the trees are queried only for the vertices the
 // move touched and those whose list fell short of k. Ties are ordered by (path, bounce), so the
 // answer does not depend on what the index holds where.

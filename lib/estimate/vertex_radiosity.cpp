@@ -7,7 +7,7 @@ namespace qsgi {
 void computeRadiosity(const Scene& scene, VertexRadiosity& result) {
     result.radiosity.resize(result.irradiance.size());
     for (size_t v = 0; v < result.irradiance.size(); ++v) {
-        // A hidden vertex (zero scale, DESIGN §3) shows nothing, whatever its estimator found at
+        // A hidden vertex (zero scale, docs/design.md §3) shows nothing, whatever its estimator found at
         // the point it was collapsed to; it is recomputed when it moves back into view.
         if (scene.vertexHidden[v]) {
             result.irradiance[v] = result.radiosity[v] = Vec3f(0.0f);

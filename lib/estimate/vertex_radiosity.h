@@ -1,5 +1,5 @@
 // The per-vertex result of density estimation: irradiance E and radiosity B = ρE + πL_e
-// (DESIGN §2), both W/m^2, RGB.
+// (docs/design.md §2), both W/m^2, RGB.
 #pragma once
 
 #include <vector>

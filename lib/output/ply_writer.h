@@ -1,4 +1,4 @@
-// frame_NNNN.ply (DESIGN §7): binary little-endian; vertex x y z nx ny nz, radiosity_r/g/b
+// frame_NNNN.ply (docs/design.md §7): binary little-endian; vertex x y z nx ny nz, radiosity_r/g/b
 // (W/m^2) and a tonemapped red green blue preview; faces as vertex_indices.
 #pragma once
 

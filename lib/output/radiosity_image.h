@@ -1,4 +1,4 @@
-// A view of the per-vertex solution (DESIGN §7): primary rays from the camera through Embree,
+// A view of the per-vertex solution (docs/design.md §7): primary rays from the camera through Embree,
 // pixel radiance B/π interpolated over the hit triangle by barycentrics, black background. No
 // further bounces are traced: the image shows the view-independent solution as it is.
 #pragma once

@@ -1,4 +1,4 @@
-// timing.json (DESIGN §7): the run's configuration, per-frame timings and work counts, and the
+// timing.json (docs/design.md §7): the run's configuration, per-frame timings and work counts, and the
 // summaries that mirror the paper's table (initial frame vs. per-frame update).
 #pragma once
 

@@ -82,7 +82,7 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     change.triangleMoved.assign(scene_.triangleCount(), 0);
     for (uint32_t i : instances) {
         const MeshInstance& inst = scene_.instances[i];
-        // A vertex hidden or shown again (a zero scale, DESIGN §3) counts as moved even where it
+        // A vertex hidden or shown again (a zero scale, docs/design.md §3) counts as moved even where it
         // stays put (a vertex at its node's origin): its radiosity is 0 only while hidden.
         for (uint32_t v = inst.firstVertex; v < inst.firstVertex + inst.vertexCount; ++v)
             change.vertexMoved[v] = std::memcmp(&previousPositions_[v], &scene_.positions[v], sizeof(Vec3f)) != 0 ||

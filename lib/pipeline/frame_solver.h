@@ -1,4 +1,4 @@
-// Frame after frame of an animation (DESIGN §6): the first frame from scratch, then each next
+// Frame after frame of an animation (docs/design.md §6): the first frame from scratch, then each next
 // one either from scratch (--full-recompute, an estimator without an update, or a change so large
 // that updating would cost more) or by the incremental update: pose the scene, find and retrace
 // the paths the moved geometry affects, and hand the change to the estimator. Both give the same

@@ -101,12 +101,17 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     if (settings_.frames) {
         first_ = settings_.frames->first;
         last_ = settings_.frames->last < 0 ? animation_.lastFrame() : settings_.frames->last;
-        if (last_ > animation_.lastFrame())
+        if (last_ > animation_.lastFrame()) {
+            // Which animation ends there and why ("" for a still scene), then the file's unplayed ones.
+            std::string note = animation_.lastFrameReason();
+            const std::string unplayed = unplayedAnimationsNote();
+            if (!unplayed.empty()) note += (note.empty() ? "" : "; ") + unplayed;
             throw InputError(settings_.framesSource.empty() ? "command line" : settings_.framesSource, "frames",
                              std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the " +
                                  (settings_.animationPath.empty() ? std::string("last frame, 0 (a still scene has one frame)")
                                                                   : "animation's last frame " + std::to_string(animation_.lastFrame())) +
-                                 (unplayedAnimationsNote().empty() ? "" : " (" + unplayedAnimationsNote() + ")"));
+                                 (note.empty() ? "" : " (" + note + ")"));
+        }
     }
     // A camera hung from a node the animation scales to zero has no direction: refused before
     // any frame is written, naming the first such frame (a hidden node is fine, a hidden camera
@@ -258,12 +263,12 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     solverSettings.alwaysUpdate = settings_.alwaysUpdate;
     solverSettings.useEnvelope = settings_.useEnvelope;
     solverSettings.gridForBlocking = settings_.blockingGrid;
-    // Built in the rest pose, before any frame: every run refits the same BVHs (DESIGN §6.0).
+    // Built in the rest pose, before any frame: every run refits the same BVHs (docs/design.md §6.0).
     scene_.applyPose(scene_.restPose());
     FrameSolver solver(scene_, device, solverSettings);
     const ImageSettings imageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.seed};
 
-    // Previews are tonemapped as frame 0 of the animation is (DESIGN §6.0), so that any frame
+    // Previews are tonemapped as frame 0 of the animation is (docs/design.md §6.0), so that any frame
     // range writes the bytes one sequential run would. A run that starts later computes frame 0
     // once for it, then the state at its first frame from scratch.
     std::optional<PreviewTonemap> tonemap;
@@ -314,7 +319,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         if (settings_.writeGltf) writeVertexRadiosityGlb(outDir / frameFileName(frame, "glb"), scene_, result, *tonemap);
         timing.writeSeconds = clock.seconds();
         log.frames.push_back(timing);
-        // Rewritten after every frame, so it always describes the frames on disk (DESIGN §7).
+        // Rewritten after every frame, so it always describes the frames on disk (docs/design.md §7).
         log.write(outDir / "timing.json");
         outcome.nextFrame = frame + 1;
         ++outcome.framesWritten;

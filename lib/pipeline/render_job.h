@@ -1,5 +1,5 @@
 // One render run: load and check every input, then per frame pose the scene, trace photons,
-// estimate vertex radiosity and write the outputs (DESIGN §1). The CLI is a thin host over this.
+// estimate vertex radiosity and write the outputs (docs/design.md §1). The CLI is a thin host over this.
 #pragma once
 
 #include <functional>

@@ -1,5 +1,5 @@
 // Everything a render run needs to know, from a JSON config (configs/*.json) overridden by the
-// command line (DESIGN §8). Each option is declared once, in render_options.cpp: its key, flag,
+// command line (docs/design.md §8). Each option is declared once, in render_options.cpp: its key, flag,
 // range, default and help; the config reader here and the CLI both apply values through it.
 #pragma once
 
@@ -47,7 +47,7 @@ struct RenderSettings {
     std::string framesSource;  // where frames came from (the config or "command line"), for messages
     std::vector<PunctualLight> extraLights;  // world space, from the config
 
-    // Images (DESIGN §7)
+    // Images (docs/design.md §7)
     int width = 640, height = 480;
     int samplesPerPixel = 1;
     bool writeExr = true, exrHalf = false, writePng = false;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <unordered_map>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <set>
@@ -61,6 +62,9 @@ Transform parseNodeTransform(const json& j, const std::string& file, const std::
         if (j.size() != 1) throw InputError(file, place, "matrix cannot be combined with translation/rotation/scale");
         const std::vector<double> m = numbers(j["matrix"], 16, file, place + ".matrix");
         t = Transform::fromColumnMajor(m.data());
+        // As on a glTF node: a matrix that is no translation, rotation and scale is refused.
+        const std::string problem = trsDecompositionProblem(t);
+        if (!problem.empty()) throw InputError(file, place + ".matrix", problem);
     } else {
         Vec3d tr(0.0), sc(1.0);
         std::array<double, 4> rot{0, 0, 0, 1};
@@ -80,7 +84,7 @@ Transform parseNodeTransform(const json& j, const std::string& file, const std::
         }
         t = Transform::fromTRS(tr, rot, sc);
     }
-    // A singular transform (a zero scale) hides the node for the frame (DESIGN §3).
+    // A singular transform (a zero scale) hides the node for the frame (docs/design.md §3).
     if (!t.isFinite()) throw InputError(file, place, "transform is not finite");
     return t;
 }
@@ -153,6 +157,8 @@ Animation Animation::parseTransformFile(const std::string& path, const nlohmann:
         keys.push_back(std::move(key));
     }
     a.lastFrame_ = previousFrame;
+    a.name_ = "transform file " + path;
+    a.lastFrameReason_ = a.name_ + " lists frames up to " + std::to_string(previousFrame);
     a.indexKeys(keys);
     return a;
 }
@@ -200,6 +206,21 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
     Animation a = still(scene);
     a.fps_ = fps;
     a.lastFrame_ = int(std::max(0.0, lastFrame));
+    // Its name and why it ends where it does, for messages about frames beyond it.
+    auto named = [&](size_t i) {
+        const std::string& name = scene.animations[i].name;  // "animation i" where the file gives none
+        return "glTF animation " + std::to_string(i) + (name == "animation " + std::to_string(i) ? "" : " '" + name + "'");
+    };
+    const bool together = played.size() > 1;
+    a.name_ = together ? "the scene's " + std::to_string(played.size()) + " glTF animations, played together"
+                       : named(index < 0 ? size_t(0) : size_t(index));
+    a.noChannels_ = std::all_of(played.begin(), played.end(), [](const KeyframeAnimation* p) { return p->channels.empty(); });
+    char keys[128];
+    std::snprintf(keys, sizeof keys, " keys up to %g s: frames 0 to %d at %g fps", end, a.lastFrame_, fps);
+    a.lastFrameReason_ = a.name_ + (together ? " have" : " has") +
+                         (a.noChannels_ ? std::string(" no channels to play, so ") + (together ? "they move" : "it moves") +
+                                              " nothing and " + (together ? "have" : "has") + " frame 0 alone"
+                                        : std::string(keys));
     // Frames are sampled when asked for (poseAt), so a long animation costs no memory per frame.
     auto sampled = std::make_shared<SampledAnimations>();
     for (const KeyframeAnimation* anim : played) sampled->played.push_back(*anim);
@@ -216,7 +237,7 @@ Animation Animation::fromGltf(const Scene& scene, int index, double fps, const s
         const Pose p = a.poseAt(frame);
         for (int node : a.sampled_->animated) {
             const Transform& t = p.locals[size_t(node)];
-            // A singular one (a zero scale) hides the node for the frame (DESIGN §3).
+            // A singular one (a zero scale) hides the node for the frame (docs/design.md §3).
             if (!t.isFinite())
                 throw InputError(source, "frame " + std::to_string(frame) + " (" + std::to_string(frame / fps) +
                                              " s), node '" + scene.nodes[node].name + "'",

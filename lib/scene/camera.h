@@ -1,4 +1,4 @@
-// The view a frame is rendered from (DESIGN §2): a perspective pinhole or an orthographic camera,
+// The view a frame is rendered from (docs/design.md §2): a perspective pinhole or an orthographic camera,
 // as glTF defines them (looking down its node's −Z, +Y up).
 #pragma once
 

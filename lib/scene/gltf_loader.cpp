@@ -163,7 +163,8 @@ std::optional<NodeTrs> nodeTrs(const tinygltf::Node& n) {
     return trs;
 }
 
-// glTF 2.0 (§5.25, node): a matrix must decompose to TRS (animation targets and skins assume it): its last row 0 0 0 1 and no shear;
+// glTF 2.0 (§5.25, node): a matrix must decompose to TRS (animation targets and skins assume it): its last row 0 0 0 1 and no shear
+// (trsDecompositionProblem, which transform files use too);
 // a rotation is a unit quaternion (a zero one has no direction at all).
 Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTrs>& trs, const std::string& file,
                              int index) {
@@ -179,17 +180,8 @@ Transform nodeLocalTransform(const tinygltf::Node& n, const std::optional<NodeTr
     const Transform t = trs ? trs->matrix() : Transform::fromColumnMajor(n.matrix.data());
     if (!t.isFinite()) throw InputError(file, place, "transform holds a non-finite number");
     if (!trs) {
-        if (t.at(3, 0) != 0 || t.at(3, 1) != 0 || t.at(3, 2) != 0 || t.at(3, 3) != 1)
-            throw InputError(file, place + ".matrix", "has a last row other than 0 0 0 1, so it is no translation, rotation "
-                                                      "and scale (glTF requires that it decompose to them)");
-        for (int a = 0; a < 3; ++a)
-            for (int b = a + 1; b < 3; ++b) {
-                const Vec3d ca(t.at(0, a), t.at(1, a), t.at(2, a)), cb(t.at(0, b), t.at(1, b), t.at(2, b));
-                if (std::fabs(dot(ca, cb)) > 1e-4 * length(ca) * length(cb))
-                    throw InputError(file, place + ".matrix", "shears (its columns " + std::to_string(a) + " and " +
-                                                                  std::to_string(b) + " are not perpendicular), so it does "
-                                                                  "not decompose to translation, rotation and scale");
-            }
+        const std::string problem = trsDecompositionProblem(t);
+        if (!problem.empty()) throw InputError(file, place + ".matrix", problem);
     }
     return t;
 }
@@ -421,7 +413,8 @@ private:
             ~Tolerate() { reader.tolerateAbsentData(false); }
         } tolerate(reader_);
         // The scratch scene has skins of its own: the real scene's map of skins is set aside
-        // (and put back however this ends), as are the sets of used meshes and materials.
+        // (and put back however this ends), as are the sets of used meshes and materials; what
+        // addInfluences repairs there goes unwarned (the render does not read it).
         struct SetAside {
             SceneBuilder& builder;
             std::map<int, int> skins;
@@ -429,8 +422,10 @@ private:
             explicit SetAside(SceneBuilder& b)
                 : builder(b), skins(std::move(b.skinOf_)), meshes(b.usedMeshes_), materials(b.usedMaterials_) {
                 builder.skinOf_.clear();
+                builder.readingUnusedObjects_ = true;
             }
             ~SetAside() {
+                builder.readingUnusedObjects_ = false;
                 builder.skinOf_ = std::move(skins);
                 builder.usedMeshes_ = std::move(meshes);
                 builder.usedMaterials_ = std::move(materials);
@@ -783,12 +778,25 @@ private:
         return skinOf_[index] = int(scene.skins.size()) - 1;
     }
 
-    // JOINTS_n / WEIGHTS_n of a skinned primitive, each vertex's weights normalised to sum 1.
+    // JOINTS_n / WEIGHTS_n of a skinned primitive. glTF 2.0 (§3.7.3.3) makes these a MUST, refused
+    // always: no negative weight, no joint named twice with non-zero weights, every joint index
+    // naming a joint of the skin (also where its weight is 0), and normalized-integer weights
+    // summing to 255 or 65535 before normalization. Float weights SHOULD sum as close to 1 as
+    // reasonably possible: sums within the glTF-Validator's tolerance (2e-7 a non-zero weight) are
+    // normalised silently; others (CesiumMan's reach 0.185) are repaired as three.js's
+    // normalizeSkinWeights does, renormalised to sum 1 and a vertex whose weights are all zero
+    // given weight 1 on its first joint (the spec ignores a skinned mesh's node, so there is
+    // nothing else to follow), with one warning per accessor saying how many vertices were
+    // repaired; --strict refuses them. Accessors without data (zeros by default) have no sums to
+    // judge, as for the validator: their vertices are repaired alike, with the warning, but not
+    // refused.
     void addInfluences(const Scene& scene, MeshInstance& instance, const tinygltf::Primitive& prim,
                        const std::string& place, int skin) {
         const size_t joints = scene.skins[size_t(skin)].joints.size();
         std::vector<AccessorData> jointSets, weightSets;
+        std::vector<int> weightAccessors;
         bool weightsStated = true;  // else zeros by default: no sums to judge
+        bool floatWeights = true;   // else normalized integers somewhere, whose sums are a MUST
         for (int set = 0;; ++set) {
             auto j = prim.attributes.find("JOINTS_" + std::to_string(set));
             auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
@@ -798,7 +806,9 @@ private:
                                                                    std::to_string(set) + " without the other");
             jointSets.push_back(reader_.read(j->second, place + ".attributes." + j->first, kJointsFormat));
             weightSets.push_back(reader_.read(w->second, place + ".attributes." + w->first, kWeightsFormat));
+            weightAccessors.push_back(w->second);
             weightsStated = weightsStated && reader_.hasData(w->second) && reader_.hasData(j->second);
+            floatWeights = floatWeights && model_.accessors[size_t(w->second)].componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
         }
         if (jointSets.empty())
             throw InputError(file_, place + ".attributes",
@@ -808,6 +818,14 @@ private:
         instance.influences = int(4 * jointSets.size());
         instance.skinJoints.assign(n * size_t(instance.influences), 0);
         instance.skinWeights.assign(n * size_t(instance.influences), 0.0f);
+        // The weights as messages name them: "….attributes.WEIGHTS_0" and "accessor 5" (or every set).
+        std::string weightsPlace = place + ".attributes.WEIGHTS_0", accessorNames = "accessor ";
+        if (weightSets.size() > 1) weightsPlace += " to WEIGHTS_" + std::to_string(weightSets.size() - 1);
+        if (weightSets.size() > 1) accessorNames = "accessors ";
+        for (size_t s = 0; s < weightAccessors.size(); ++s)
+            accessorNames += (s ? ", " : "") + std::to_string(weightAccessors[s]);
+        size_t repaired = 0, allZero = 0, firstRepaired = 0;
+        float firstSum = 0, lowest = 0, highest = 0;
         std::vector<double> namedJoints;
         for (size_t v = 0; v < n; ++v) {
             double total = 0;
@@ -838,18 +856,50 @@ private:
                     instance.skinWeights[at] = float(weight);
                     total += weight;
                 }
-            // glTF 2.0 (§3.7.3.3): the weights sum to 1. CesiumMan's reach 0.185, and the
-            // validator refuses it (19 errors); sums within its tolerance are normalised here,
-            // so a vertex is never shrunk towards the origin.
-            if (weightsStated && !(std::fabs(floatTotal - 1.0f) <= tolerance))
-                throw InputError(file_, place + ".attributes.WEIGHTS_0",
-                                 "vertex " + std::to_string(v) + "'s weights sum to " + std::to_string(floatTotal) +
-                                     ", not 1 (glTF requires normalised weights)");
+            const size_t first = v * size_t(instance.influences);
+            if (!(std::fabs(floatTotal - 1.0f) <= tolerance)) {
+                if (weightsStated && !floatWeights)
+                    throw InputError(file_, weightsPlace,
+                                     "vertex " + std::to_string(v) + "'s weights sum to " + std::to_string(floatTotal) +
+                                         ", not 1 (" + accessorNames + "; glTF requires normalized-integer weights to "
+                                         "sum to 255 or 65535 before normalization)");
+                if (repaired == 0) {
+                    firstRepaired = v;
+                    firstSum = lowest = highest = floatTotal;
+                }
+                lowest = std::min(lowest, floatTotal);
+                highest = std::max(highest, floatTotal);
+                ++repaired;
+                if (total == 0) {
+                    ++allZero;
+                    instance.skinJoints[first] = uint16_t(jointSets[0](v, 0));  // within the skin: checked above
+                    instance.skinWeights[first] = 1.0f;
+                    continue;
+                }
+            }
             if (total > 0)
                 for (int k = 0; k < instance.influences; ++k)
-                    instance.skinWeights[v * size_t(instance.influences) + size_t(k)] =
-                        float(instance.skinWeights[v * size_t(instance.influences) + size_t(k)] / total);
+                    instance.skinWeights[first + size_t(k)] = float(instance.skinWeights[first + size_t(k)] / total);
         }
+        if (repaired == 0) return;
+        std::string what = std::to_string(repaired) + " of " + std::to_string(n) +
+                           (repaired == 1 ? " vertices has weights" : " vertices have weights") +
+                           " that do not sum to 1 (vertex " + std::to_string(firstRepaired) + "'s sum to " +
+                           std::to_string(firstSum);
+        if (repaired > 1) what += "; sums from " + std::to_string(lowest) + " to " + std::to_string(highest);
+        what += ")";
+        if (weightsStated && options_.strict)
+            throw InputError(file_, weightsPlace, what + " (" + accessorNames +
+                                                      "; glTF says weights should sum to 1; --strict refuses them)");
+        // One warning for the weights, however many nodes and primitives use them; none for objects
+        // the render does not read (checkUnusedObjects), which are refused above under --strict.
+        if (readingUnusedObjects_ || !warnedWeights_.insert(weightAccessors).second) return;
+        if (!weightsStated) what += "; a JOINTS_n or WEIGHTS_n accessor without data reads as zeros";
+        std::string repair = "renormalised to sum 1";
+        if (allZero == repaired) repair = "given weight 1 on their first joint, as their weights are all zero";
+        else if (allZero > 0) repair += "; " + std::to_string(allZero) + " whose weights are all zero given weight 1 on their first joint";
+        warnings_.add(file_ + ": " + weightsPlace + " (" + accessorNames + "): " + what + ": " + repair +
+                      " (glTF says weights should sum to 1; --strict refuses them)");
     }
 
     void addMorphTargets(MeshInstance& instance, const tinygltf::Primitive& prim, const std::string& place,
@@ -987,6 +1037,8 @@ private:
     AccessorReader reader_;
     std::map<int, int> skinOf_;  // glTF skin -> Scene::skins
     std::set<int> usedMeshes_, usedMaterials_;
+    std::set<std::vector<int>> warnedWeights_;  // the WEIGHTS_n accessors already warned about (addInfluences)
+    bool readingUnusedObjects_ = false;         // within checkUnusedObjects
     uint32_t defaultMaterial_ = 0;
 };
 

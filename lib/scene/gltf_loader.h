@@ -1,5 +1,5 @@
 // glTF 2.0 (.gltf with external or embedded buffers, .glb) to a render-ready Scene, through
-// tinygltf. Flattens the default scene to world space (DESIGN §2).
+// tinygltf. Flattens the default scene to world space (docs/design.md §2).
 #pragma once
 
 #include <string>

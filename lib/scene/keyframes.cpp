@@ -14,6 +14,20 @@ const char* interpolationName(Interpolation i) {
     return "?";
 }
 
+std::string trsDecompositionProblem(const Transform& t) {
+    if (t.at(3, 0) != 0 || t.at(3, 1) != 0 || t.at(3, 2) != 0 || t.at(3, 3) != 1)
+        return "has a last row other than 0 0 0 1, so it is no translation, rotation and scale (glTF requires that it "
+               "decompose to them)";
+    for (int a = 0; a < 3; ++a)
+        for (int b = a + 1; b < 3; ++b) {
+            const Vec3d ca(t.at(0, a), t.at(1, a), t.at(2, a)), cb(t.at(0, b), t.at(1, b), t.at(2, b));
+            if (std::fabs(dot(ca, cb)) > 1e-4 * length(ca) * length(cb))
+                return "shears (its columns " + std::to_string(a) + " and " + std::to_string(b) +
+                       " are not perpendicular), so it does not decompose to translation, rotation and scale";
+        }
+    return "";
+}
+
 const char* animatedPropertyName(AnimatedProperty p) {
     switch (p) {
         case AnimatedProperty::Translation: return "translation";

@@ -46,6 +46,12 @@ struct NodeTrs {
     Transform matrix() const { return Transform::fromTRS(translation, rotation, scale); }
 };
 
+// glTF 2.0 (§5.25, node.matrix): why a node's matrix does not decompose to translation, rotation
+// and scale — a last row other than 0 0 0 1, or a shear (two of its first three columns not
+// perpendicular) — or "" when it does. The glTF loader refuses such a node's matrix and a
+// transform file such a node's entry, with these words.
+std::string trsDecompositionProblem(const Transform& matrix);
+
 struct KeyframeAnimation {
     std::string name;
     std::vector<AnimationChannel> channels;

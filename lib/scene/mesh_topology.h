@@ -1,5 +1,5 @@
 // Which triangles meet at each vertex, with vertices welded by exact position, so that a UV or
-// normal seam (two vertices at one place) does not cut a surface in two (DESIGN §5, own surface).
+// normal seam (two vertices at one place) does not cut a surface in two (docs/design.md §5, own surface).
 // Built from plain arrays, so the scene and a PLY read back (qsgi compare) use the same rules.
 #pragma once
 

@@ -156,7 +156,9 @@ void Scene::placeInstance(size_t instanceIndex, const Transform& world, const st
             for (int e = 0; e < 16; ++e) blend.m[size_t(e)] += w * j.m[size_t(e)];
             total += w;
         }
-        return total > 0 ? blend : world;  // a vertex no joint holds stays with its node
+        // A vertex no joint holds stays with its node: only in scenes built in code, since the
+        // loader gives a vertex whose weights are all zero weight 1 on its first joint.
+        return total > 0 ? blend : world;
     };
     const bool transformNormals = !objectNormal.empty();
     const bool rigidHidden = !skinned && !world.isInvertible();

@@ -1,5 +1,5 @@
 // The render-ready scene: world-space triangles with materials, lights, the node hierarchy that
-// animation moves, and which vertices are dynamic (DESIGN §2). Built by the glTF loader; the
+// animation moves, and which vertices are dynamic (docs/design.md §2). Built by the glTF loader; the
 // tracer and estimators read it and never see file syntax.
 #pragma once
 
@@ -32,7 +32,7 @@ Vec3f frontFaceNormal(const std::vector<Vec3f>& positions, const std::vector<Vec
 
 enum class LightType { Point, Spot, Directional };
 
-// A punctual light, static by definition (DESIGN §2). intensity is W/sr for point and spot
+// A punctual light, static by definition (docs/design.md §2). intensity is W/sr for point and spot
 // lights; for directional lights it is the irradiance (W/m^2) on a plane facing the light.
 struct PunctualLight {
     std::string name;
@@ -127,7 +127,7 @@ struct Scene {
     std::vector<Skin> skins;
 
     // World space, current pose, relative to worldOrigin: re-centring keeps float positions
-    // precise for scenes far from the origin (DESIGN §4), so a scene translated by 1e5 m traces
+    // precise for scenes far from the origin (docs/design.md §4), so a scene translated by 1e5 m traces
     // exactly as at the origin. Add worldOrigin back when writing positions out.
     Vec3d worldOrigin{0.0};
     std::vector<Vec3f> positions;
@@ -136,13 +136,13 @@ struct Scene {
     std::vector<Triangle> triangles;
     std::vector<uint32_t> triangleMaterial;
     // A vertex is hidden while its transform is singular — a zero scale, on any axis, is how glTF
-    // animates visibility (DESIGN §3). A hidden rigid instance is collapsed to its node's origin,
+    // animates visibility (docs/design.md §3). A hidden rigid instance is collapsed to its node's origin,
     // so its zero-area triangles block and receive nothing; a skinned vertex goes where its
     // singular blend puts it. Hidden vertices keep their last finite normal and carry radiosity 0
     // (computeRadiosity).
     std::vector<uint8_t> vertexHidden;
 
-    // Dynamic = under a node the animation moves (DESIGN §2). Filled by markDynamic.
+    // Dynamic = under a node the animation moves (docs/design.md §2). Filled by markDynamic.
     std::vector<uint8_t> vertexDynamic;
     std::vector<uint8_t> triangleDynamic;
 
@@ -150,15 +150,15 @@ struct Scene {
     size_t triangleCount() const { return triangles.size(); }
 
     // Bounds of the current pose. Anything that must not change with the pose uses
-    // animationBounds instead (DESIGN §6 step 0).
+    // animationBounds instead (docs/design.md §6 step 0).
     Bounds3f bounds() const;
     // Union of the bounds of every pose the run can show: the rest pose after finalize(), every
     // frame once the animation is known (sweepAnimationBounds).
     Bounds3f animationBounds;
     // Per instance: the union of its bounds over every frame of the animation, for instances the
-    // animation moves (empty for the others). The incremental update's envelope (DESIGN §6.5).
+    // animation moves (empty for the others). The incremental update's envelope (docs/design.md §6.5).
     std::vector<Bounds3f> sweptInstanceBounds;
-    // 10^-6 of animationBounds' diagonal: the tolerance of the estimators' geometric tests (DESIGN §5).
+    // 10^-6 of animationBounds' diagonal: the tolerance of the estimators' geometric tests (docs/design.md §5).
     float sceneEpsilon() const { return 1e-6f * std::max(animationBounds.extent(), 1e-6f); }
 
     Vec3f geometricNormal(uint32_t tri) const;  // unit, from the CCW winding (front side)
@@ -180,7 +180,7 @@ struct Scene {
     Bounds3f instanceBounds(size_t instanceIndex) const;
 
     // Makes `locals` the rest pose: the run's first frame, so that static geometry is placed once
-    // in the pose every frame shows (DESIGN §6 step 0). Re-places instances, and the lights and
+    // in the pose every frame shows (docs/design.md §6 step 0). Re-places instances, and the lights and
     // cameras hung from nodes.
     void setRestPose(const Pose& pose);
 

@@ -1,4 +1,4 @@
-// Counter-based random numbers (DESIGN §4): the numbers of photon i, bounce k, dimension d are a
+// Counter-based random numbers (docs/design.md §4): the numbers of photon i, bounce k, dimension d are a
 // pure function of (seed, i, k, d). Retracing a path repeats its choices exactly, and results do
 // not depend on thread count or scheduling.
 #pragma once

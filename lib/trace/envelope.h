@@ -1,4 +1,4 @@
-// The envelope of the moving geometry (DESIGN §6 step 5): the boxes each moving instance sweeps
+// The envelope of the moving geometry (docs/design.md §6 step 5): the boxes each moving instance sweeps
 // over the whole animation, dilated by a margin. A light path can change only from a segment that
 // meets it: a moving triangle is hit or blocks inside it, and every disc an update recomputes lies
 // inside it. Paths that never meet it are folded into the estimators' sums once and never searched
@@ -36,7 +36,7 @@ private:
 // a vertex can be that the update recomputes: what the envelope's margin must cover.
 // DETP: a crossing counts up to r past the impact, on a disc within r of a vertex, and a vertex
 // is recomputed when its test region (r√2 around it, DiscRegions::touchedBy) meets a mover, so
-// the margin is (1 + √2) r plus the regions' own slack (DESIGN's 2r misses a corner of that).
+// the margin is (1 + √2) r plus the regions' own slack (a margin of 2r would miss a corner of that).
 // Impact count: nothing beyond the impact itself.
 float envelopeMargin(bool discs, float radius, float sceneEpsilon);
 

@@ -1,4 +1,4 @@
-// Chooses where photons start (DESIGN §4): every emitter — punctual lights and each emissive
+// Chooses where photons start (docs/design.md §4): every emitter — punctual lights and each emissive
 // triangle — in proportion to the power it sends toward the scene. With aiming on, point, spot
 // and directional lights emit only where their projection map (projection_map.h) says photons
 // may reach geometry, each photon carrying the power of the part actually sampled.

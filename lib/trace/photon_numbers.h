@@ -1,4 +1,4 @@
-// The uniform numbers one photon path draws (DESIGN §4, issue 20). Every number is a pure function
+// The uniform numbers one photon path draws (docs/design.md §4, issue 20). Every number is a pure function
 // of (seed, photon, bounce, dimension), so retracing a path repeats its choices exactly and
 // results do not depend on threads, frame ranges or Slurm chunks. Two samplers:
 //  - random: every number hashed (counter_rng.h), independent of every other;

@@ -1,4 +1,4 @@
-// Photon tracing (DESIGN §4): emits photons from the lights, follows them through diffuse
+// Photon tracing (docs/design.md §4): emits photons from the lights, follows them through diffuse
 // bounces with Russian roulette and stores every segment in the ray cache.
 #pragma once
 

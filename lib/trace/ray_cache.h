@@ -1,4 +1,4 @@
-// The ray cache (DESIGN §4): every segment of every photon path, in (path, bounce) order, stored
+// The ray cache (docs/design.md §4): every segment of every photon path, in (path, bounce) order, stored
 // in about 23 bytes a segment instead of the 52 of a Segment, and decoded to exactly the segments
 // the tracer followed.
 //

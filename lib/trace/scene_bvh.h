@@ -1,4 +1,4 @@
-// The scene's triangles in Embree (DESIGN §6 steps 0–1): static triangles in one Embree scene
+// The scene's triangles in Embree (docs/design.md §6 steps 0–1): static triangles in one Embree scene
 // built once per run and never rebuilt, dynamic triangles in another that is refitted when the
 // animation moves them. A ray's closest hit is the nearer of the two scenes' hits; at equal t the
 // lower scene triangle id wins, inside each scene too (an intersection filter), so which triangle

@@ -1,6 +1,6 @@
 // A counter-based, Owen-scrambled Sobol sequence (issue 20): point i of dimension d is computed
 // from i alone (no sequential state), so a photon's numbers are a pure function of its index,
-// as the hashed ones are (DESIGN §4). Direction numbers are Joe and Kuo's (sobol_table.h); the
+// as the hashed ones are (docs/design.md §4). Direction numbers are Joe and Kuo's (sobol_table.h); the
 // scrambling is Burley's hash-based Owen scrambling ("Practical Hash-based Owen Scrambling",
 // JCGT 9(4), 2020), which keeps every (t, m, s)-net a net with the same t.
 #pragma once

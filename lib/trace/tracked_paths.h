@@ -1,4 +1,4 @@
-// The part of the ray cache that frames search (DESIGN §6 steps 2–3 and 5): every path that meets
+// The part of the ray cache that frames search (docs/design.md §6 steps 2–3 and 5): every path that meets
 // the envelope, from its first segment that does. Finds the paths a move affects — from the first
 // segment that hit a triangle that moved, or that a moved triangle now blocks before its impact —
 // retraces them from there with the same random numbers, and swaps the new tails in.

@@ -1,5 +1,5 @@
 // Errors a user can act on. An InputError names the file, the place in it and the problem; the
-// CLI turns it into one line on stderr and exit code 2 (DESIGN §8).
+// CLI turns it into one line on stderr and exit code 2 (docs/design.md §8).
 #pragma once
 
 #include <stdexcept>

@@ -1,4 +1,4 @@
-// One frame's record in timing.json (DESIGN §7): what computing it cost and changed. Every stage
+// One frame's record in timing.json (docs/design.md §7): what computing it cost and changed. Every stage
 // writes its own counters here directly (tracing, finding affected paths, the estimator's update,
 // disc regions, rendering); forEachTimingField is the one list that writing and reading (for
 // --resume) share, so a new counter is one member and one line.
@@ -12,9 +12,10 @@ namespace qsgi {
 struct FrameTiming {
     int frame = 0;
     bool fromScratch = true;  // computed from scratch, or by the incremental update
-    // Why a frame after the first was computed from scratch: "" (it was not), "full-recompute",
-    // "first-frame", "estimator" (the estimator has no update, e.g. --detp-index flann) or
-    // "change-too-large" (updating would cost more than recomputing, judged from counts).
+    // Why a frame after a run's first was computed from scratch: "full-recompute", "estimator"
+    // (the estimator has no update, e.g. --detp-index flann) or "change-too-large" (updating would
+    // cost more than recomputing, judged from counts). "" for a frame updated incrementally and for
+    // the run's first frame, which is always from scratch (fromScratch says so).
     std::string fromScratchReason;
     double findAffectedSeconds = 0, retraceSeconds = 0;  // the parts of an update's photon time
     double photonSimulationSeconds = 0;  // tracing (or finding and retracing) photons
@@ -25,7 +26,7 @@ struct FrameTiming {
     uint64_t segments = 0;               // segments in the ray cache after this frame
     uint64_t photonsMissingScene = 0;    // photons whose first segment hit nothing
     uint64_t pathsRetraced = 0;
-    uint64_t pathsAffectedByImpact = 0, pathsAffectedByBlocking = 0;  // DESIGN §6 step 2 (a), (b)
+    uint64_t pathsAffectedByImpact = 0, pathsAffectedByBlocking = 0;  // docs/design.md §6 step 2 (a), (b)
     uint64_t impactCandidates = 0;    // (a): tracked segments listed on the moved triangles
     uint64_t blockingCandidates = 0;  // (b): tracked segments the grid handed to the exact test
     uint64_t trackedPaths = 0, trackedSegments = 0, trackedBytes = 0;  // what frames search (§6.5)
@@ -36,7 +37,7 @@ struct FrameTiming {
     uint64_t verticesRecomputed = 0;
     uint64_t recomputeCandidates = 0;  // segments gathered for those recomputations
     uint64_t crossingsForgotten = 0;   // DETP: removed crossings subtracted as remembered, untraced
-    // Disc regions (DESIGN §5): time, vertices (re)computed this frame, and the vertices with an
+    // Disc regions (docs/design.md §5): time, vertices (re)computed this frame, and the vertices with an
     // empty own surface (paper fallback) or no reachable cell (buried: E = 0).
     double discRegionsSeconds = 0;
     uint64_t discRegionsUpdated = 0;

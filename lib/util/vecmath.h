@@ -58,7 +58,7 @@ template <typename T> constexpr Vec3<T> max(const Vec3<T>& a, const Vec3<T>& b) 
 template <typename T> bool isFinite(const Vec3<T>& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
-// Rec. 709 luminance: the weight lights are chosen by (DESIGN §4).
+// Rec. 709 luminance: the weight lights are chosen by (docs/design.md §4).
 template <typename T> constexpr T luminance(const Vec3<T>& c) {
     return T(0.2126) * c.x + T(0.7152) * c.y + T(0.0722) * c.z;
 }
@@ -97,7 +97,7 @@ struct Bounds3f {
                b.lower.y <= upper.y && lower.z <= b.upper.z && b.lower.z <= upper.z;
     }
     // Distance along the ray o + t·d (d ≠ 0) to where it leaves the box; 0 if it starts outside
-    // and never enters or the box is empty. Escaping photons end there (DESIGN §4, §5).
+    // and never enters or the box is empty. Escaping photons end there (docs/design.md §4, §5).
     float exitDistance(const Vec3f& o, const Vec3f& d) const;
     // Clips the part [t0, t1] of the ray o + t·d to the box (in double precision, closed box);
     // false if it misses. t1 may be infinite.

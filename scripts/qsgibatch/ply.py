@@ -1,4 +1,4 @@
-"""Reads and writes the vertex-radiosity PLY files qsgi writes (binary little-endian; DESIGN §7).
+"""Reads and writes the vertex-radiosity PLY files qsgi writes (binary little-endian; docs/design.md §7).
 
 Only what sweeps need: the vertex table as a numpy record array, and a copy of a file with other
 radiosity values (the averaged reference). The header and the face list are kept as bytes, so a

@@ -433,6 +433,13 @@ bad("animation", "node_unknown.json", anim([{"frame": 0, "nodes": {"Flor": {"tra
 bad("animation", "matrix_and_translation.json",
     anim([{"frame": 0, "nodes": {"Floor": {"matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1],
                                            "translation": [0, 1, 0]}}}]), "cannot be combined")
+# A matrix that is no translation, rotation and scale, refused as on a glTF node (node_matrix_*.gltf).
+bad("animation", "matrix_projective.json",
+    anim([{"frame": 0}, {"frame": 3, "nodes": {"Floor": {"matrix": [1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]}}}]),
+    "frame 3, node 'Floor'.matrix: has a last row other than 0 0 0 1")
+bad("animation", "matrix_sheared.json",
+    anim([{"frame": 0}, {"frame": 3, "nodes": {"Floor": {"matrix": [1, 0, 0, 0, 0.5, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]}}}]),
+    "frame 3, node 'Floor'.matrix: shears")
 bad("animation", "moves_the_light.json", anim([{"frame": 0}, {"frame": 1, "nodes": {"Lamp": {"translation": [0, 2, 0]}}}]),
     "lights must be static")
 bad("animation", "translation_overflows_float.json",
