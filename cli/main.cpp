@@ -100,36 +100,47 @@ qsgi::RenderSettings settingsFrom(const BoundOptions& bound) {
 // One line for a command line CLI11 cannot parse. A flag the subcommand does not know is named
 // with the nearest one it does (as a config's unknown key is); anything else keeps CLI11's words.
 std::string commandLineError(const CLI::App& app, int argc, char** argv, const CLI::ParseError& error) {
+    const auto all = [](const CLI::App*) { return true; };
     std::vector<std::string> subcommands;
+    for (const CLI::App* sub : app.get_subcommands(all)) subcommands.push_back(sub->get_name());
     const CLI::App* command = nullptr;
-    int first = 1;
-    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) subcommands.push_back(sub->get_name());
-    for (; first < argc && !command; ++first)
-        for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
-            if (sub->get_name() == argv[first]) command = sub;
+    for (int i = 1; i < argc && !command; ++i)
+        for (const CLI::App* sub : app.get_subcommands(all))
+            if (sub->get_name() == argv[i]) command = sub;
+    std::string list;
+    for (const std::string& name : subcommands) list += (list.empty() ? "" : ", ") + name;
     if (!command) {
         // No subcommand: the first word that is not a flag is a mistyped one.
         for (int i = 1; i < argc; ++i)
             if (argv[i][0] != '-')
                 return "unknown subcommand '" + std::string(argv[i]) + "'" + qsgi::didYouMean(argv[i], subcommands) +
-                       " (subcommands: render, inspect, compare, options; see qsgi --help)";
-        return std::string(error.what()) + " (see qsgi --help)";
+                       " (subcommands: " + list + "; see qsgi --help)";
+        return std::string(error.what()) + " (subcommands: " + list + "; see qsgi --help)";
     }
-    std::vector<std::string> known{"--help", "-h"};
+    std::vector<std::string> flags;  // the subcommand's own, the candidates for "nearest"
     for (const CLI::Option* option : command->get_options()) {
-        for (const std::string& name : option->get_lnames()) known.push_back("--" + name);
-        for (const std::string& name : option->get_snames()) known.push_back("-" + name);
+        for (const std::string& name : option->get_lnames())
+            if (name != "help") flags.push_back("--" + name);
+        for (const std::string& name : option->get_snames())
+            if (name != "h") flags.push_back("-" + name);
     }
     const std::string help = "qsgi " + command->get_name() + " --help";
-    for (int i = first; i < argc; ++i) {
+    for (int i = 1; i < argc; ++i) {
         const std::string word = argv[i];
         if (word == "--") break;
         // A flag: "--name" or "-x" (not a negative number, which is a value).
         if (word.size() < 2 || word[0] != '-' || !(std::isalpha(static_cast<unsigned char>(word[1])) || word[1] == '-')) continue;
         const std::string name = word.substr(0, word.find('='));
-        if (std::find(known.begin(), known.end(), name) == known.end())
-            return "unknown flag " + name + " for qsgi " + command->get_name() + qsgi::didYouMean(name, known) + " (" + help +
-                   " lists them)";
+        if (name == "--help" || name == "-h" || std::find(flags.begin(), flags.end(), name) != flags.end()) continue;
+        // The nearest known flag, always named: a close one as a question, else as the nearest.
+        std::string nearest = qsgi::didYouMean(name, flags);
+        if (nearest.empty() && !flags.empty()) {
+            const auto closest = std::min_element(flags.begin(), flags.end(), [&](const std::string& x, const std::string& y) {
+                return qsgi::editDistance(name, x) < qsgi::editDistance(name, y);
+            });
+            nearest = " (the nearest is " + *closest + ")";
+        }
+        return "unknown flag " + name + " for qsgi " + command->get_name() + nearest + "; " + help + " lists them";
     }
     return std::string(error.what()) + " (see " + help + ")";
 }
@@ -266,6 +277,9 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "qsgi: every frame is already complete in %s\n", out.c_str());
         else if (!o.quiet)
             std::fprintf(stderr, "qsgi: %s\n", display.summary(out, outcome).c_str());
+        if (!o.quiet && outcome.filesReplaced > 0)
+            std::fprintf(stderr, "qsgi: --overwrite: unlinked %d files of another run from %s before rendering\n",
+                         outcome.filesReplaced, out.c_str());
         if (!o.quiet && !job.unplayedAnimationsNote().empty())
             std::fprintf(stderr, "qsgi: note: %s: %s\n", o.scenePath.c_str(), job.unplayedAnimationsNote().c_str());
         return 0;

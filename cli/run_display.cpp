@@ -45,8 +45,9 @@ std::string RunDisplay::status(int index, int count) const {
     // for each frame not done, less what the current one has already taken.
     if (!frameSeconds_.empty()) {
         const std::vector<double> updates(frameSeconds_.begin() + (frameSeconds_.size() > 1 ? 1 : 0), frameSeconds_.end());
-        const double left = median(updates) * double(count - index) - frameClock_.seconds();
-        text += ", ~" + qsgi::formatDuration(std::max(left, 0.0)) + " left";
+        const double perFrame = median(updates);
+        const double left = perFrame * double(count - index - 1) + std::max(perFrame - frameClock_.seconds(), 0.0);
+        text += ", ~" + qsgi::formatDuration(left) + " left";
     }
     return text;
 }

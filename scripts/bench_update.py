@@ -25,6 +25,9 @@ import statistics
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from qsgibatch.qsgi import clear_run  # noqa: E402
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 SCENES = os.path.join(ROOT, "out", "bench", "scenes")
 
@@ -53,6 +56,7 @@ def cases(quick):
 
 
 def run(qsgi, args, out):
+    clear_run(out)
     cmd = ["/usr/bin/time", "-f", "%M", qsgi, "render"] + args + ["--no-exr", "--quiet", "--out", out]
     done = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     if done.returncode != 0:

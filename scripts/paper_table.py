@@ -19,6 +19,9 @@ import statistics
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from qsgibatch.qsgi import clear_run  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
@@ -32,6 +35,7 @@ RULES = [("paper", ["--detp-boundary", "paper"]), ("clip (default)", ["--detp-bo
 
 
 def run(qsgi, config, extra, out):
+    clear_run(out)
     cmd = [qsgi, "render", "--config", config, "--out", out, "--no-exr", "--quiet"] + extra
     subprocess.run(cmd, check=True)
     with open(os.path.join(out, "timing.json")) as f:

@@ -28,6 +28,7 @@ import numpy as np
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 from qsgibatch import ply  # noqa: E402
+from qsgibatch.qsgi import clear_run  # noqa: E402
 
 SCENES = [("cornell", "data/cornell/cornell.gltf", "tests/reference/cornell_f0000.ply"),
           ("ceiling_panel", "tests/scenes/ceiling_panel/ceiling_panel.gltf", "tests/reference/ceiling_panel_f0000.ply"),
@@ -41,6 +42,7 @@ RADIUS = "0.05"
 
 
 def render(qsgi, scene, photons, seed, sampler_args, out):
+    clear_run(out)
     subprocess.run([qsgi, "render", os.path.join(ROOT, scene), "--photons", str(photons), "--seed", str(seed),
                     "--estimator", "detp", "--radius", RADIUS, "--no-exr", "--quiet", "--out", out] + sampler_args,
                    check=True)

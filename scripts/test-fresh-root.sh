@@ -10,11 +10,10 @@
 # host's apt sources for Debian 12 (the host's mirror, not mmdebstrap's default) and the host's
 # locally added CA certificates (for a mirror or proxy over TLS).
 #
-# Usage: scripts/test-fresh-root.sh [extra arguments for qsgi render]
+# Usage: scripts/test-fresh-root.sh
 # Needs root (mmdebstrap's root mode) and installs mmdebstrap when it is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-repo="$(pwd)"
 
 if [ "$(id -u)" -ne 0 ]; then
   echo "test-fresh-root: needs root (mmdebstrap's root mode mounts /dev and /proc in the root)" >&2
@@ -26,13 +25,17 @@ if ! command -v mmdebstrap >/dev/null 2>&1; then
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends mmdebstrap >/dev/null
 fi
 
-# The host's enabled sources that serve Debian 12 (bookworm, -updates, -security), each file as one
-# mirror argument (mmdebstrap takes a file's contents, one-line or deb822). Third-party sources stay
-# out: their keyrings are not in the root.
+# The host's enabled sources of Debian 12 itself (bookworm, -updates, -security, signed by Debian's
+# keyring), each file as one mirror argument (mmdebstrap takes a file's contents, one-line or deb822).
+# Third-party sources that also name bookworm (Docker's, NodeSource's) stay out: their keyrings are
+# not in the root, and apt-get update there would fail on them.
 sources=()
 for f in /etc/apt/sources.list /etc/apt/sources.list.d/*.list /etc/apt/sources.list.d/*.sources; do
   [ -f "$f" ] || continue
-  grep -v '^\s*#' "$f" | grep -q 'bookworm' || continue
+  active="$(grep -v '^\s*#' "$f")"
+  grep -q 'bookworm' <<<"$active" || continue
+  grep -qiE '^Enabled:\s*no' <<<"$active" && continue
+  grep -E '^(deb|URIs:)' <<<"$active" | grep -vE 'deb\.debian\.org|security\.debian\.org|snapshot\.debian\.org|ftp\.[a-z.]*debian\.org' | grep -q . && continue
   sources+=("$f")
 done
 if [ ${#sources[@]} -eq 0 ]; then
@@ -41,15 +44,17 @@ fi
 
 # Scratch space of this script's own: the checkout's tracked files as a tarball, and the frames
 # copied out of the root for checking. No mount is ever under it.
-work="$(mktemp -d)"
+work="$(mktemp -d /tmp/qsgi-fresh-root.XXXXXX)"  # no spaces: the hooks below name it unquoted
 trap 'rm -rf -- "$work"' EXIT
-git ls-files -z | tar --null -T - -cf "$work/qsgi.tar"
+# The tracked files as they stand in the checkout (uncommitted edits included; a tracked file deleted
+# in the work tree is left out).
+git ls-files -z | tar --null --ignore-failed-read -T - -cf "$work/qsgi.tar" 2>/dev/null
 mkdir "$work/ca"
 cp /usr/local/share/ca-certificates/*.crt "$work/ca/" 2>/dev/null || true
 
 # Inside the root: scripts/run.sh, as a new user would run it, on two frames of data/cornell. Its
 # output (apt's and the compiler's) goes to a log that is copied out; its end is shown on failure.
-render=(scripts/run.sh --frames 0:1 --photons 20000 --out /root/out "$@")
+render=(scripts/run.sh --frames 0:1 --photons 20000 --out /root/out)
 inner="cd /root/qsgi && start=\$(date +%s) && { ${render[*]@Q} > /root/run.log 2>&1 || { tail -n 60 /root/run.log; exit 1; }; } \
   && echo \$(( \$(date +%s) - start )) > /root/run-seconds"
 

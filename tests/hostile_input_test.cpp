@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "output/ply_reader.h"
+#include "pipeline/output_folder.h"
 #include "pipeline/render_job.h"
 #include "scene/animation.h"
 #include "scene/gltf_loader.h"

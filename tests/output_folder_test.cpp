@@ -51,7 +51,7 @@ TEST(OutputFolder, FrameFileNamesAreRecognisedExactly) {
     for (const char* name : {"frame_0000.ply", "frame_0012.exr", "frame_12345.png", "frame_9999.glb", "frame_0001.x"})
         EXPECT_TRUE(qsgi::isFrameFileName(name)) << name;
     for (const char* name : {"frame_000.ply", "frame_0001", "frame_0001.", "frames_0001.ply", "frame_00a1.ply", "timing.json",
-                             "my_frame_0001.ply", "frame_.ply"})
+                             "my_frame_0001.ply", "frame_.ply", "frame_0001.qsgi-tmp.ply", "frame_0001.ply.qsgi-merge-tmp"})
         EXPECT_FALSE(qsgi::isFrameFileName(name)) << name;
     EXPECT_EQ(qsgi::frameFileName(7, "ply"), "frame_0007.ply");
     EXPECT_TRUE(qsgi::isFrameFileName(qsgi::frameFileName(123456, "exr")));
@@ -124,5 +124,33 @@ TEST(OutputFolder, FrameFilesWithoutALogAreRefusedUnlessOverwritten) {
     EXPECT_EQ(readFileBytes(out / "frame_0000.ply"), "not ours");
     ASSERT_EQ(runQsgi(cornellRender("0:0", options + " --overwrite")).exitCode, 0);
     EXPECT_NE(readFileBytes(out / "frame_0000.ply"), "not ours");
+    EXPECT_EQ(loggedFrames(out), (std::vector<int>{0}));
+}
+
+// What cannot hold a run is refused before anything is written: a file standing where the folder
+// should be, a timing.json that cannot be read (nothing says which run it holds); --overwrite
+// replaces the latter and says so, also together with --resume.
+TEST(OutputFolder, AFileOrAnUnreadableLogIsRefusedAndOverwriteSaysWhatItUnlinked) {
+    const fs::path dir = testScratchDir("folder-odd");
+    const fs::path file = dir / "a-file";
+    std::ofstream(file) << "mine";
+    const CommandResult onFile = runQsgi(cornellRender("0:0", "--photons 2000 --no-exr --out " + file.string()));
+    EXPECT_EQ(onFile.exitCode, 2) << onFile.output;
+    EXPECT_NE(onFile.output.find("is not a folder"), std::string::npos) << onFile.output;
+    EXPECT_EQ(readFileBytes(file), "mine");
+
+    const fs::path out = dir / "out";
+    fs::create_directories(out);
+    std::ofstream(out / "timing.json") << "{ not json";
+    std::ofstream(out / "frame_0000.ply") << "?";
+    const auto before = contents(out);
+    const std::string options = "--photons 2000 --no-exr --out " + out.string();
+    const CommandResult refused = runQsgi(cornellRender("0:0", options));
+    EXPECT_EQ(refused.exitCode, 2) << refused.output;
+    EXPECT_NE(refused.output.find("timing.json cannot be read"), std::string::npos) << refused.output;
+    EXPECT_EQ(contents(out), before);
+    const CommandResult replaced = runQsgi(cornellRender("0:0", options + " --resume --overwrite", false));
+    ASSERT_EQ(replaced.exitCode, 0) << replaced.output;
+    EXPECT_NE(replaced.output.find("--overwrite: unlinked 2 files of another run"), std::string::npos) << replaced.output;
     EXPECT_EQ(loggedFrames(out), (std::vector<int>{0}));
 }

@@ -21,7 +21,8 @@ bool isFrameFileName(const std::string& name) {
     if (name.rfind("frame_", 0) != 0) return false;
     size_t digits = 0;
     while (kPrefix + digits < name.size() && std::isdigit(static_cast<unsigned char>(name[kPrefix + digits]))) ++digits;
-    return digits >= 4 && kPrefix + digits + 1 < name.size() && name[kPrefix + digits] == '.';
+    return digits >= 4 && kPrefix + digits + 1 < name.size() && name[kPrefix + digits] == '.' &&
+           name.find(".qsgi-") == std::string::npos;
 }
 
 bool frameFilesComplete(const fs::path& folder, int frame, const RenderSettings& s) {
@@ -38,9 +39,14 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
     survey.folder = folder;
     std::error_code ec;
     survey.exists = fs::is_directory(folder, ec);
+    survey.notAFolder = !survey.exists && fs::exists(folder, ec);
     if (!survey.exists) return survey;
-    for (const auto& entry : fs::directory_iterator(folder, ec))
-        if (isFrameFileName(entry.path().filename().string())) survey.frameFiles.push_back(entry.path());
+    try {
+        for (const auto& entry : fs::directory_iterator(folder))
+            if (isFrameFileName(entry.path().filename().string())) survey.frameFiles.push_back(entry.path());
+    } catch (const fs::filesystem_error& e) {
+        throw InputError(folder.string(), "--out", std::string("cannot read the output folder: ") + e.code().message());
+    }
     std::sort(survey.frameFiles.begin(), survey.frameFiles.end());
 
     const fs::path logPath = folder / "timing.json";
@@ -53,7 +59,7 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
         earlier = readTimingLog(logPath);
     } catch (const InputError& e) {
         survey.holds = OutputFolderSurvey::Holds::AnotherRun;
-        survey.differences.push_back(std::string("its timing.json ") + e.problem());
+        survey.differences.push_back("its timing.json cannot be read, so nothing says which run it holds: " + e.problem());
         return survey;
     }
     if (earlier.inputsFingerprint != fingerprint.digest) {
@@ -71,8 +77,9 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
 
 std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const RenderSettings& settings) {
     using Holds = OutputFolderSurvey::Holds;
-    if (settings.overwrite || survey.holds == Holds::Nothing || survey.holds == Holds::ThisRun) return std::nullopt;
     const std::string place = settings.resume ? "--resume" : "--out";
+    if (survey.notAFolder) return InputError(survey.folder.string(), "--out", "is not a folder");
+    if (settings.overwrite || survey.holds == Holds::Nothing || survey.holds == Holds::ThisRun) return std::nullopt;
     if (survey.holds == Holds::UnknownFiles)
         return InputError(survey.folder.string(), place,
                           "holds frame files but no timing.json, so nothing says how they were made; render into an "
@@ -86,17 +93,23 @@ std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, 
                           "to replace its frames and timing.json");
 }
 
-void removeEarlierRun(const OutputFolderSurvey& survey) {
+size_t removeEarlierRun(const OutputFolderSurvey& survey) {
     std::error_code ec;
+    size_t removed = 0;
     for (const fs::path& file : survey.frameFiles) {
         // A folder named like a frame file is not a frame file: left alone.
         if (fs::is_directory(fs::symlink_status(file, ec))) continue;
         if (!fs::remove(file, ec) && ec)
             throw InputError(file.string(), "--overwrite", "cannot remove the earlier run's file: " + ec.message());
+        ++removed;
     }
     const fs::path log = survey.folder / "timing.json";
-    if (fs::exists(fs::symlink_status(log, ec)) && !fs::remove(log, ec) && ec)
-        throw InputError(log.string(), "--overwrite", "cannot remove the earlier run's timing.json: " + ec.message());
+    if (fs::exists(fs::symlink_status(log, ec))) {
+        if (!fs::remove(log, ec) && ec)
+            throw InputError(log.string(), "--overwrite", "cannot remove the earlier run's timing.json: " + ec.message());
+        ++removed;
+    }
+    return removed;
 }
 
 }  // namespace qsgi

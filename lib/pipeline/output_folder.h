@@ -26,7 +26,8 @@ struct OutputFolderSurvey {
         UnknownFiles,  // frame files without a timing.json
     };
     std::filesystem::path folder;
-    bool exists = false;
+    bool exists = false;     // as a folder
+    bool notAFolder = false;  // something else stands under the name (a file): refused
     Holds holds = Holds::Nothing;
     // ThisRun: the frames its timing.json lists whose files are all on disk, in the log's order.
     std::vector<FrameTiming> completeFrames;
@@ -38,7 +39,8 @@ struct OutputFolderSurvey {
 
 // "frame_0012.ply" and the like.
 std::string frameFileName(int frame, const char* extension);
-// "frame_0012.ply", "frame_12345.exr": a frame file's name as frameFileName writes it.
+// "frame_0012.ply", "frame_12345.exr": a frame file's name as frameFileName writes it (not a
+// temporary of AtomicFile's or the Slurm merge's, whose names hold ".qsgi-").
 bool isFrameFileName(const std::string& name);
 
 // Whether every file the settings ask for is on disk for `frame`.
@@ -53,7 +55,7 @@ OutputFolderSurvey surveyOutputFolder(const std::filesystem::path& folder, const
 std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const RenderSettings& settings);
 
 // For --overwrite: unlinks the earlier run's frame files and its timing.json, nothing else (never
-// recursively: not chunks/, not slurm/, not another file of the user's).
-void removeEarlierRun(const OutputFolderSurvey& survey);
+// recursively: not chunks/, not slurm/, not another file of the user's). Returns how many.
+size_t removeEarlierRun(const OutputFolderSurvey& survey);
 
 }  // namespace qsgi

@@ -22,6 +22,7 @@
 #include "output/atomic_file.h"
 #include "pipeline/render_options.h"
 #include "pipeline/frame_solver.h"
+#include "pipeline/output_folder.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
 #include "trace/photon_tracer.h"
@@ -177,10 +178,6 @@ Camera RenderJob::cameraAt(int frame) const {
                        scene_.worldOrigin);
 }
 
-namespace {
-
-}  // namespace
-
 RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame,
                           const std::function<bool()>& stopRequested,
                           const std::function<void(const StageReport&)>& onStage) {
@@ -189,6 +186,11 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     if (settings_.threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(settings_.threads));
 
     const fs::path outDir(settings_.outDir);
+    // One folder, one run: frames of this run are kept (and with --resume not computed again),
+    // another run's are refused unless --overwrite replaces them. Judged before anything is
+    // created, probed or cleaned, so a refused render leaves the folder exactly as it was.
+    const OutputFolderSurvey folder = surveyOutputFolder(outDir, fingerprint_, settings_);
+    if (const std::optional<InputError> refusal = outputFolderRefusal(folder, settings_)) throw *refusal;
     std::error_code ec;
     fs::create_directories(outDir, ec);
     if (ec || !fs::is_directory(outDir))
@@ -203,13 +205,12 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         if (!writable) throw InputError(settings_.outDir, "--out", "the output folder is not writable");
     }
     AtomicFile::removeStaleTemporaries(outDir);
-    // One folder, one run: frames of this run are kept (and with --resume not computed again),
-    // another run's are refused unless --overwrite replaces them.
-    const OutputFolderSurvey folder = surveyOutputFolder(outDir, fingerprint_, settings_);
-    if (const std::optional<InputError> refusal = outputFolderRefusal(folder, settings_)) throw *refusal;
     std::vector<FrameTiming> earlierFrames;
+    RunOutcome outcome;
     if (folder.holds == OutputFolderSurvey::Holds::ThisRun) earlierFrames = folder.completeFrames;
-    else if (folder.holds != OutputFolderSurvey::Holds::Nothing) removeEarlierRun(folder);
+    else if (folder.holds != OutputFolderSurvey::Holds::Nothing) {
+        outcome.filesReplaced = int(removeEarlierRun(folder));
+    }
     // The first frame to compute: with --resume, the first of the range this run's earlier
     // frames do not already hold. Earlier frames outside what is computed stay in the log.
     std::set<int> done;
@@ -217,7 +218,6 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
         for (const FrameTiming& f : earlierFrames) done.insert(f.frame);
     int start = first_;
     while (start <= last_ && done.count(start)) ++start;
-    RunOutcome outcome;
 
     TimingLog log;
     log.config = optionValues(settings_, OptionSelection::Logged);

@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "pipeline/output_folder.h"
+#include "pipeline/run_fingerprint.h"
 #include "pipeline/render_settings.h"
 #include "scene/animation.h"
 #include "scene/scene.h"
@@ -36,7 +36,8 @@ struct RunOutcome {
     bool interrupted = false;
     int nextFrame = 0;      // the first frame not written
     int framesResumed = 0;  // frames an earlier run had written (--resume)
-    int framesKept = 0;     // frames of an earlier run of the same inputs outside this run's range (no --resume)
+    int framesKept = 0;
+    int filesReplaced = 0;  // of another run, unlinked by --overwrite (frame files and timing.json)     // frames of an earlier run of the same inputs outside this run's range (no --resume)
     int framesWritten = 0;  // by this run
 };
 

@@ -61,7 +61,8 @@ std::string shown(const nlohmann::json& value) {
 RunFingerprint runFingerprint(const RenderSettings& s, const Scene& scene, const std::string& animationBytes,
                               const Camera& camera) {
     // Each part on its own (for messages), and all of them in one list, in the order the digest
-    // has always taken them (so that folders of earlier runs keep their fingerprint).
+    // has always taken them. (The digest changes whenever a fingerprinted option is added: aim_emission,
+    // back with issue 31, made every earlier folder another run's.)
     Fingerprinter all, content, lights, animation, view;
     auto both = [&](Fingerprinter& part, auto&& addTo) {
         addTo(part);
@@ -117,7 +118,7 @@ RunFingerprint runFingerprint(const RenderSettings& s, const Scene& scene, const
 std::vector<std::string> fingerprintDifferences(const nlohmann::json& there, const nlohmann::json& here) {
     std::vector<std::string> differences;
     if (!there.is_object()) {
-        differences.push_back("the folder's timing.json does not record its settings (an older qsgi wrote it)");
+        differences.push_back("its timing.json, written by an older qsgi, does not record which settings it was made with");
         return differences;
     }
     auto part = [](const nlohmann::json& parts, const char* name) {

@@ -183,6 +183,9 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
         const nlohmann::json& base = it.key() == "estimator" || it.key() == "sampler" ? standard : standardAlike;
         if (it.key() != "scene" && (!base.contains(it.key()) || base.at(it.key()) != it.value())) changed[it.key()] = it.value();
     }
+    // A radius the user gave is a choice even where it equals the default (or the estimator
+    // does not read it).
+    if (settings.radiusGiven) changed["radius"] = settings.estimator.radius;
     if (settings.resume) changed["resume"] = true;
     if (settings.overwrite) changed["overwrite"] = true;
     r["options_set"] = changed;
@@ -241,7 +244,9 @@ std::string inspectionText(const nlohmann::json& r) {
     std::string options;
     for (auto it = r["options_set"].begin(); it != r["options_set"].end(); ++it)
         options += (options.empty() ? "" : ", ") + it.key() + " " +
-                   (it.value().is_string() ? it.value().get<std::string>() : it.value().dump());
+                   (it.value().is_string()         ? it.value().get<std::string>()
+                    : it.value().is_number_float() ? number(it.value().get<double>(), "%.7g")
+                                                   : it.value().dump());
     line("options    " + (options.empty() ? std::string("the defaults") : options));
     const auto& folder = r["output_folder"];
     line("output     " + folder["path"].get<std::string>() + ": " + folder["state"].get<std::string>() + "; a render " +

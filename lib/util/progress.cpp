@@ -1,5 +1,6 @@
 #include "util/progress.h"
 
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -17,8 +18,14 @@ void ProgressLine::show(const std::string& text, bool force) {
     if (!force && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     drawn_ = true;
+    // Clipped to the terminal's width: a line that wraps is not redrawn in place but leaves a
+    // stray line at every redraw.
+    std::string shown = text;
+    winsize size{};
+    if (ioctl(STDERR_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 1 && shown.size() >= size.ws_col)
+        shown.resize(size_t(size.ws_col) - 1);
     // Carriage return, the text, then erase whatever a longer previous line left.
-    std::fprintf(stderr, "\r%s\033[K", text.c_str());
+    std::fprintf(stderr, "\r%s\033[K", shown.c_str());
     std::fflush(stderr);
 }
 

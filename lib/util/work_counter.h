@@ -42,7 +42,9 @@ public:
         if (!report_) return;
         const auto now = std::chrono::steady_clock::now();
         std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
-        if (!lock.owns_lock() || now - lastReport_ < std::chrono::milliseconds(100)) return;
+        // The last item always reports (the bar ends full); the others at most every 100 ms.
+        if (done < total_ && (!lock.owns_lock() || now - lastReport_ < std::chrono::milliseconds(100))) return;
+        if (!lock.owns_lock()) lock.lock();
         lastReport_ = now;
         report_(stage_, done, total_);
     }

@@ -9,6 +9,19 @@ class QsgiError(Exception):
     pass
 
 
+def clear_run(out: str) -> None:
+    """Unlinks the run a script left in its own folder `out` (frame_NNNN.* and timing.json, nothing
+    else, never recursively), for scripts that render one setting after another into one folder
+    and read back that render's frames alone: qsgi keeps the frames of the same run outside a new
+    range and refuses another run's folder."""
+    if not os.path.isdir(out):
+        return
+    for name in os.listdir(out):
+        path = os.path.join(out, name)
+        if (name == "timing.json" or (name.startswith("frame_") and "." in name)) and not os.path.isdir(path):
+            os.remove(path)
+
+
 class Qsgi:
     def __init__(self, executable: str, scene: str, animation: str):
         self.executable, self.scene, self.animation = executable, scene, animation
