@@ -15,22 +15,28 @@ namespace field_count_detail {
 // (std::optional's), so that such a field still counts once.
 struct AnyField {
     template <class T>
-    constexpr operator T() const&& noexcept;
+    operator T() const&&;
 };
 
-template <class T, class... Fields>
-constexpr auto initialisableWith(int) -> decltype(T{std::declval<Fields>()...}, true) {
+// Whether T{AnyField × N} compiles. N is tried from kMostFields down, so the first that compiles
+// initialises every field (trying 1, 2, … would name aggregates with fields left out, which
+// clang's -Wmissing-field-initializers reports even here).
+template <class T, size_t... I>
+constexpr auto initialisableWith(std::index_sequence<I...>, int) -> decltype(T{(void(I), std::declval<AnyField>())...}, true) {
     return true;
 }
-template <class T, class... Fields>
-constexpr bool initialisableWith(long) {
+template <class T, size_t... I>
+constexpr bool initialisableWith(std::index_sequence<I...>, long) {
     return false;
 }
 
-template <class T, class... Fields>
-constexpr size_t fieldCount() {
-    if constexpr (initialisableWith<T, Fields..., AnyField>(0)) return fieldCount<T, Fields..., AnyField>();
-    else return sizeof...(Fields);
+constexpr size_t kMostFields = 64;
+
+template <class T, size_t N>
+constexpr size_t fieldCountFrom() {
+    if constexpr (N == 0) return 0;
+    else if constexpr (initialisableWith<T>(std::make_index_sequence<N>{}, 0)) return N;
+    else return fieldCountFrom<T, N - 1>();
 }
 
 }  // namespace field_count_detail
@@ -38,7 +44,9 @@ constexpr size_t fieldCount() {
 // T must be an aggregate without base classes, C arrays or fields of reference type.
 template <class T>
 constexpr size_t fieldCount() {
-    return field_count_detail::fieldCount<T>();
+    constexpr size_t count = field_count_detail::fieldCountFrom<T, field_count_detail::kMostFields>();
+    static_assert(count < field_count_detail::kMostFields, "more fields than fieldCount can count");
+    return count;
 }
 
 }  // namespace qsgi
