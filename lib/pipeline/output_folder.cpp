@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <set>
 
 #include "output/timing_log.h"
 
@@ -73,6 +74,14 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
     for (const FrameTiming& f : earlier.frames)
         if (frameFilesComplete(folder, f.frame, settings)) survey.completeFrames.push_back(f);
     return survey;
+}
+
+int firstIncompleteFrame(const OutputFolderSurvey& survey, int first, int last) {
+    std::set<int> complete;
+    for (const FrameTiming& f : survey.completeFrames) complete.insert(f.frame);
+    int next = first;
+    while (next <= last && complete.count(next)) ++next;
+    return next;
 }
 
 std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const RenderSettings& settings) {

@@ -50,6 +50,10 @@ bool frameFilesComplete(const std::filesystem::path& folder, int frame, const Re
 OutputFolderSurvey surveyOutputFolder(const std::filesystem::path& folder, const RunFingerprint& fingerprint,
                                       const RenderSettings& settings);
 
+// The first frame of first..last that the survey's complete frames of this run do not hold
+// (last + 1 when they hold them all): where --resume starts.
+int firstIncompleteFrame(const OutputFolderSurvey& survey, int first, int last);
+
 // Why a run with these settings (--resume, --overwrite) may not write into the surveyed folder:
 // one message naming the folder and each differing setting, or nullopt when it may.
 std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const RenderSettings& settings);

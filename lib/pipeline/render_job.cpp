@@ -213,11 +213,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     }
     // The first frame to compute: with --resume, the first of the range this run's earlier
     // frames do not already hold. Earlier frames outside what is computed stay in the log.
-    std::set<int> done;
-    if (settings_.resume)
-        for (const FrameTiming& f : earlierFrames) done.insert(f.frame);
-    int start = first_;
-    while (start <= last_ && done.count(start)) ++start;
+    const int start = settings_.resume ? firstIncompleteFrame(folder, first_, last_) : first_;
 
     TimingLog log;
     log.config = optionValues(settings_, OptionSelection::Logged);

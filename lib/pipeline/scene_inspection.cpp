@@ -52,8 +52,7 @@ nlohmann::json outputFolderReport(const RenderJob& job) {
         std::set<int> complete;
         for (const FrameTiming& f : survey.completeFrames) complete.insert(f.frame);
         r["complete_frames"] = complete;
-        int next = job.firstFrame();
-        while (next <= job.lastFrame() && complete.count(next)) ++next;
+        const int next = firstIncompleteFrame(survey, job.firstFrame(), job.lastFrame());
         if (s.resume)
             render = next > job.lastFrame() ? "nothing: frames " + range + " are complete (--resume)"
                                             : "resumes at frame " + std::to_string(next) + " and renders " +
