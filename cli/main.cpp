@@ -44,8 +44,11 @@ void installStopHandlers() {
 
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternal = 1;
+constexpr int kExitEnvironment = 74;  // sysexits' EX_IOERR: the disk failed (full, I/O error)
+constexpr int kExitBusy = 75;         // sysexits' EX_TEMPFAIL: another run holds the folder; retry later
 
-// Runs a subcommand's work; bad input becomes one line and exit 2, anything else exit 1.
+// Runs a subcommand's work; bad input becomes one line and exit 2, a failing disk 74, a folder
+// another run holds 75, anything else exit 1.
 template <typename Work>
 int exitCodeOf(Work&& work) {
     try {
@@ -53,6 +56,12 @@ int exitCodeOf(Work&& work) {
     } catch (const qsgi::InputError& e) {
         std::fprintf(stderr, "qsgi: error: %s\n", e.what());
         return kExitBadInput;
+    } catch (const qsgi::EnvironmentError& e) {
+        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
+        return kExitEnvironment;
+    } catch (const qsgi::FolderBusyError& e) {
+        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
+        return kExitBusy;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "qsgi: internal error: %s\n", e.what());
         return kExitInternal;
@@ -235,7 +244,10 @@ int main(int argc, char** argv) {
             qsgi::Warnings warnings;
             const qsgi::RenderJob job(settingsFrom(inspectOptions), warnings);
             const nlohmann::json report = qsgi::inspectRender(job, warnings);
-            std::fputs(inspectJson ? (report.dump(2) + "\n").c_str() : qsgi::inspectionText(report).c_str(), stdout);
+            // Names are UTF-8 or pathJson's objects; bytes a message quotes are shown as U+FFFD.
+            const std::string text =
+                inspectJson ? report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : qsgi::inspectionText(report);
+            std::fputs(text.c_str(), stdout);
             return 0;
         });
 
@@ -249,22 +261,27 @@ int main(int argc, char** argv) {
         if (!o.quiet)
             for (const auto& w : warnings.messages) std::fprintf(stderr, "qsgi: warning: %s\n", w.c_str());
         RunDisplay display(!o.quiet && qsgi::stderrIsTerminal());
-        const qsgi::RunOutcome outcome = job.run(
-            [&](const qsgi::FrameReport& r) {
-                // Lights far from the geometry waste photons; say so once, with the number.
-                char text[256];
-                if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet) {
-                    std::snprintf(text, sizeof text, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate "
-                                  "rests on the rest (move lights closer or add photons)", 100 * r.missedFraction);
-                    display.message(text);
-                }
-                if (o.verbose) {
-                    std::snprintf(text, sizeof text, "qsgi: frame %d (%d/%d) %.3f s", r.frame, r.index + 1, r.count, r.seconds);
-                    display.message(text);
-                }
-                display.frameDone(r);
-            },
-            [] { return gStopSignal != 0; }, [&](const qsgi::StageReport& r) { display.stage(r); });
+        qsgi::RunObserver observer;
+        observer.onWarning = [&](const std::string& w) {
+            if (!o.quiet) display.message("qsgi: warning: " + w);
+        };
+        observer.stopRequested = [] { return gStopSignal != 0; };
+        observer.onStage = [&](const qsgi::StageReport& r) { display.stage(r); };
+        observer.onFrame = [&](const qsgi::FrameReport& r) {
+            // Lights far from the geometry waste photons; say so once, with the number.
+            char text[256];
+            if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet) {
+                std::snprintf(text, sizeof text, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate "
+                              "rests on the rest (move lights closer or add photons)", 100 * r.missedFraction);
+                display.message(text);
+            }
+            if (o.verbose) {
+                std::snprintf(text, sizeof text, "qsgi: frame %d (%d/%d) %.3f s", r.frame, r.index + 1, r.count, r.seconds);
+                display.message(text);
+            }
+            display.frameDone(r);
+        };
+        const qsgi::RunOutcome outcome = job.run(observer);
         display.finish();
         const std::string& out = job.outputFolder();
         if (outcome.interrupted) {

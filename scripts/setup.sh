@@ -13,14 +13,17 @@ run_packages=(
   libembree-dev
   libopenimageio-dev        # found through its pkg-config file (CMakeLists.txt says why)
   libopenexr-dev
+  libpng-dev                # PNG textures (lib/scene/texture_colour.cpp)
   libtinygltf-dev libstb-dev
   libflann-dev liblz4-dev
+  libxxhash-dev             # checksums of the frame files (timing.json, --resume)
   libtbb-dev
   nlohmann-json3-dev
   libcli11-dev
 )
 test_packages=(
   python3 python3-numpy python3-matplotlib   # scripts/sweep.py, tests/data/make_inputs.py, reference checks
+  python3-xxhash            # the Slurm merge verifies chunk files (scripts/qsgibatch/chunks.py)
   openimageio-tools
   libgtest-dev libgmock-dev
   libbenchmark-dev

@@ -6,6 +6,7 @@
 #include "estimate/accuracy.h"
 #include "estimate/impact_count.h"
 #include "output/ply_reader.h"
+#include "output/output_directory.h"
 #include "output/ply_writer.h"
 #include "test_support.h"
 
@@ -66,8 +67,8 @@ TEST(Accuracy, CompareCommandReadsPlysAndRejectsMismatches) {
     VertexRadiosity a, b;
     a.radiosity.assign(scene.vertexCount(), Vec3f(1.0f));
     b.radiosity.assign(scene.vertexCount(), Vec3f(1.1f));
-    writeVertexRadiosityPly(dir / "a.ply", scene, a, PreviewTonemap{});
-    writeVertexRadiosityPly(dir / "b.ply", scene, b, PreviewTonemap{});
+    writeFileAtomically(dir / "a.ply", encodeVertexRadiosityPly(scene, a, PreviewTonemap{}));
+    writeFileAtomically(dir / "b.ply", encodeVertexRadiosityPly(scene, b, PreviewTonemap{}));
     const VertexRadiosityPly back = readVertexRadiosityPly((dir / "b.ply").string());
     ASSERT_EQ(back.radiosity.size(), scene.vertexCount());
     EXPECT_EQ(back.radiosity[5], Vec3f(1.1f));
@@ -80,7 +81,7 @@ TEST(Accuracy, CompareCommandReadsPlysAndRejectsMismatches) {
     Scene other = testscenes::plane(1.0f, 4, Vec3f(0.5f));
     VertexRadiosity c;
     c.radiosity.assign(other.vertexCount(), Vec3f(1.0f));
-    writeVertexRadiosityPly(dir / "c.ply", other, c, PreviewTonemap{});
+    writeFileAtomically(dir / "c.ply", encodeVertexRadiosityPly(other, c, PreviewTonemap{}));
     const CommandResult mismatch = runQsgi("compare " + (dir / "c.ply").string() + " " + (dir / "a.ply").string());
     EXPECT_EQ(mismatch.exitCode, 2);
     EXPECT_NE(mismatch.output.find("not the same scene"), std::string::npos) << mismatch.output;

@@ -102,7 +102,9 @@ TEST(OutputFolder, AnotherRunsFolderIsRefusedNamingEachDifferenceAndOverwriteLea
 
     const CommandResult replaced = runQsgi(cornellRender("0:1", other + " --overwrite"));
     ASSERT_EQ(replaced.exitCode, 0) << replaced.output;
-    EXPECT_EQ(namesIn(out), (std::set<std::string>{"chunks", "notes.txt", "frame_0000.ply", "frame_0001.ply", "timing.json"}));
+    // Theirs, the new run's, and the folder's lock (which stays, naming its last holder).
+    EXPECT_EQ(namesIn(out), (std::set<std::string>{"chunks", "notes.txt", "frame_0000.ply", "frame_0001.ply", "timing.json",
+                                                   ".qsgi-lock"}));
     EXPECT_EQ(loggedFrames(out), (std::vector<int>{0, 1}));
     EXPECT_EQ(readFileBytes(out / "notes.txt"), "mine");
     EXPECT_EQ(readFileBytes(out / "chunks" / "c0" / "frame_0000.ply"), "a chunk's frame");

@@ -8,7 +8,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "output/atomic_file.h"
 
 namespace qsgi {
 namespace {
@@ -64,8 +63,7 @@ int addIndexAccessor(tinygltf::Model& model, const std::vector<Triangle>& triang
 
 }  // namespace
 
-void writeVertexRadiosityGlb(const std::filesystem::path& path, const Scene& scene, const VertexRadiosity& result,
-                             const PreviewTonemap& tonemap) {
+std::string encodeVertexRadiosityGlb(const Scene& scene, const VertexRadiosity& result, const PreviewTonemap& tonemap) {
     tinygltf::Model model;
     model.asset.version = "2.0";
     model.asset.generator = std::string("qsgi ") + QSGI_VERSION;
@@ -122,10 +120,8 @@ void writeVertexRadiosityGlb(const std::filesystem::path& path, const Scene& sce
     std::ostringstream bytes;
     tinygltf::TinyGLTF writer;
     if (!writer.WriteGltfSceneToStream(&model, bytes, false, true))
-        throw std::runtime_error("tinygltf could not write " + path.string());
-    AtomicFile out(path);
-    out.stream() << bytes.str();
-    out.commit();
+        throw std::runtime_error("tinygltf could not encode a frame's GLB");
+    return bytes.str();
 }
 
 }  // namespace qsgi

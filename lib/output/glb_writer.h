@@ -7,10 +7,10 @@
 // exposure, the one the PLY colours use (fixed at frame 0, so frames do not flicker), recorded in
 // the mesh's extras as qsgi.exposure. Positions are stored relative to the scene's worldOrigin,
 // which the root node's translation adds back (float positions stay precise far from the
-// origin). Written with tinygltf, atomically.
+// origin). Encoded with tinygltf.
 #pragma once
 
-#include <filesystem>
+#include <string>
 
 #include "estimate/vertex_radiosity.h"
 #include "output/ply_writer.h"
@@ -18,7 +18,7 @@
 
 namespace qsgi {
 
-void writeVertexRadiosityGlb(const std::filesystem::path& path, const Scene& scene, const VertexRadiosity& result,
-                             const PreviewTonemap& tonemap);
+// The file's bytes (OutputDirectory::write puts them on disk).
+std::string encodeVertexRadiosityGlb(const Scene& scene, const VertexRadiosity& result, const PreviewTonemap& tonemap);
 
 }  // namespace qsgi

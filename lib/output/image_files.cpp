@@ -1,30 +1,31 @@
 #include "output/image_files.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include "output/atomic_file.h"
 #include "output/srgb.h"
 
 namespace qsgi {
 
 namespace {
-void writeWithOiio(const std::filesystem::path& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc pixelType,
-                   const void* pixels) {
-    AtomicFile file(path);
-    const std::string temp = file.temporaryPath().string();
-    auto out = OIIO::ImageOutput::create(temp);
-    if (!out) throw std::runtime_error("OpenImageIO cannot write " + temp + ": " + OIIO::geterror());
-    if (!out->open(temp, spec) || !out->write_image(pixelType, pixels) || !out->close())
-        throw std::runtime_error("writing " + temp + " failed: " + out->geterror());
-    file.commit();
+// `format` is a file name whose extension picks OpenImageIO's writer; nothing is opened by it.
+std::string encodeWithOiio(const char* format, const OIIO::ImageSpec& spec, OIIO::TypeDesc pixelType, const void* pixels) {
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput memory(bytes);
+    auto out = OIIO::ImageOutput::create(format, &memory);
+    if (!out || !out->supports("ioproxy"))
+        throw std::runtime_error(std::string("OpenImageIO cannot encode ") + format + " in memory: " + OIIO::geterror());
+    if (!out->set_ioproxy(&memory) || !out->open(format, spec) || !out->write_image(pixelType, pixels) || !out->close())
+        throw std::runtime_error(std::string("encoding ") + format + " failed: " + out->geterror());
+    return std::string(bytes.begin(), bytes.end());
 }
 }  // namespace
 
-void writeExr(const std::filesystem::path& path, const RgbImage& image, const ImageMetadata& metadata, bool half) {
+std::string encodeExr(const RgbImage& image, const ImageMetadata& metadata, bool half) {
     OIIO::ImageSpec spec(image.width, image.height, 3, half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");
     // OpenImageIO stamps the wall-clock time unless told otherwise; a fixed stamp keeps the same
@@ -33,7 +34,7 @@ void writeExr(const std::filesystem::path& path, const RgbImage& image, const Im
     for (const auto& [k, v] : metadata.strings) spec.attribute(k, v);
     for (const auto& [k, v] : metadata.ints) spec.attribute(k, v);
     for (const auto& [k, v] : metadata.floats) spec.attribute(k, v);
-    writeWithOiio(path, spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
+    return encodeWithOiio("frame.exr", spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
 }
 
 float automaticExposure(const RgbImage& image, double percentile) {
@@ -48,13 +49,13 @@ float automaticExposure(const RgbImage& image, double percentile) {
     return 0.8f / lum[k];
 }
 
-void writePngPreview(const std::filesystem::path& path, const RgbImage& image, float exposure) {
+std::string encodePngPreview(const RgbImage& image, float exposure) {
     std::vector<uint8_t> bytes(image.pixels.size());
     for (size_t i = 0; i < bytes.size(); ++i) {
         bytes[i] = encodeSrgb8(image.pixels[i] * exposure);
     }
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-    writeWithOiio(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
+    return encodeWithOiio("frame.png", spec, OIIO::TypeDesc::UINT8, bytes.data());
 }
 
 }  // namespace qsgi

@@ -1,8 +1,8 @@
-// Writing renders: linear EXR through OpenImageIO with the run's metadata, and an 8-bit sRGB PNG
-// preview. Both atomically (temporary file in the same folder, then rename).
+// Encoding renders: linear EXR through OpenImageIO with the run's metadata, and an 8-bit sRGB PNG
+// preview. Encoded in memory (an OpenImageIO IOProxy): OpenImageIO opens files by name and would
+// follow a link planted in the output folder, so the bytes go to disk through OutputDirectory.
 #pragma once
 
-#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,10 +17,11 @@ struct ImageMetadata {
     std::vector<std::pair<std::string, float>> floats;
 };
 
-void writeExr(const std::filesystem::path& path, const RgbImage& image, const ImageMetadata& metadata, bool half);
+// The EXR file's bytes.
+std::string encodeExr(const RgbImage& image, const ImageMetadata& metadata, bool half);
 
-// exposure multiplies the linear radiance before sRGB encoding and clamping.
-void writePngPreview(const std::filesystem::path& path, const RgbImage& image, float exposure);
+// The PNG file's bytes. exposure multiplies the linear radiance before sRGB encoding and clamping.
+std::string encodePngPreview(const RgbImage& image, float exposure);
 
 // Exposure that maps the given percentile of the pixels' luminance (background excluded) to 0.8.
 float automaticExposure(const RgbImage& image, double percentile = 0.99);

@@ -5,7 +5,6 @@
 #include <cstring>
 #include <sstream>
 
-#include "output/atomic_file.h"
 #include "output/srgb.h"
 
 namespace qsgi {
@@ -36,8 +35,7 @@ void put(std::string& buf, T v) {
 }
 }  // namespace
 
-void writeVertexRadiosityPly(const std::filesystem::path& path, const Scene& scene, const VertexRadiosity& result,
-                             const PreviewTonemap& tonemap) {
+std::string encodeVertexRadiosityPly(const Scene& scene, const VertexRadiosity& result, const PreviewTonemap& tonemap) {
     std::ostringstream header;
     header << "ply\nformat binary_little_endian 1.0\ncomment qsgi " << QSGI_VERSION
            << " vertex radiosity (W/m^2)\nelement vertex " << scene.vertexCount()
@@ -58,9 +56,7 @@ void writeVertexRadiosityPly(const std::filesystem::path& path, const Scene& sce
         put(buf, uint8_t(3));
         for (uint32_t v : t.v) put(buf, int32_t(v));
     }
-    AtomicFile file(path);
-    file.stream().write(buf.data(), std::streamsize(buf.size()));
-    file.commit();
+    return buf;
 }
 
 }  // namespace qsgi

@@ -2,7 +2,7 @@
 // (W/m^2) and a tonemapped red green blue preview; faces as vertex_indices.
 #pragma once
 
-#include <filesystem>
+#include <string>
 
 #include "estimate/vertex_radiosity.h"
 #include "scene/scene.h"
@@ -18,7 +18,7 @@ struct PreviewTonemap {
     uint8_t encode(float value) const;
 };
 
-void writeVertexRadiosityPly(const std::filesystem::path& path, const Scene& scene, const VertexRadiosity& result,
-                             const PreviewTonemap& tonemap);
+// The file's bytes (OutputDirectory::write puts them on disk).
+std::string encodeVertexRadiosityPly(const Scene& scene, const VertexRadiosity& result, const PreviewTonemap& tonemap);
 
 }  // namespace qsgi

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 
-#include "output/atomic_file.h"
 #include "util/error.h"
 #include "util/json_file.h"
 
@@ -22,14 +21,14 @@ nlohmann::json summary(std::vector<double> v) {
 }
 }  // namespace
 
-void TimingLog::write(const std::filesystem::path& path) const {
+std::string TimingLog::text() const {
     using nlohmann::json;
     json j;
     j["version"] = QSGI_VERSION;
     j["config"] = config;
     j["config"]["inputs_fingerprint"] = inputsFingerprint;
     j["inputs"] = inputs;
-    j["scene"] = {{"file", scene}, {"vertices", vertices}, {"triangles", triangles},
+    j["scene"] = {{"file", pathJson(scene)}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
                   {"degenerate_triangles", degenerateTriangles}, {"animation_diagonal", animationDiagonal}};
     // Aimed emission's effect (issue 12), from the run's first frame: the share of the lights'
@@ -56,12 +55,15 @@ void TimingLog::write(const std::filesystem::path& path) const {
         const FrameTiming& f = *frame;
         json entry;
         forEachTimingField(f, [&](const char* name, const auto& value) { entry[name] = value; });
+        json files = json::array();
+        for (const FileRecord& file : f.files) files.push_back({{"name", file.name}, {"bytes", file.bytes}, {"xxh3", file.xxh3}});
+        entry["files"] = files;
         list.push_back(entry);
     }
     j["frames"] = list;
-    AtomicFile file(path);
-    file.stream() << j.dump(2) << "\n";
-    file.commit();
+    // Every name in it is UTF-8 (pathJson), but a string the log only shows (an option's text)
+    // must not stop a render: such bytes are shown as U+FFFD.
+    return j.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
 }
 
 EarlierRun readTimingLog(const std::filesystem::path& path) {
@@ -73,6 +75,10 @@ EarlierRun readTimingLog(const std::filesystem::path& path) {
         for (const nlohmann::json& entry : j.at("frames")) {
             FrameTiming f;
             forEachTimingField(f, [&](const char* name, auto& value) { entry.at(name).get_to(value); });
+            if (entry.contains("files"))
+                for (const nlohmann::json& file : entry.at("files"))
+                    f.files.push_back(FileRecord{file.at("name").get<std::string>(), file.at("bytes").get<uint64_t>(),
+                                                 file.at("xxh3").get<std::string>()});
             run.frames.push_back(f);
         }
     } catch (const nlohmann::json::exception& e) {

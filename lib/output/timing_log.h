@@ -33,7 +33,8 @@ struct TimingLog {
 
     std::vector<FrameTiming> frames;  // in the order they were written (timing.json lists them by frame)
 
-    void write(const std::filesystem::path& path) const;  // atomically
+    // The file's text (OutputDirectory::write puts it on disk).
+    std::string text() const;
 };
 
 // What --resume needs from an earlier run's timing.json: its fingerprint, what it is made of (null
@@ -42,7 +43,7 @@ struct TimingLog {
 struct EarlierRun {
     std::string inputsFingerprint;
     nlohmann::json inputs;
-    std::vector<FrameTiming> frames;
+    std::vector<FrameTiming> frames;  // with the files each records (none in an older qsgi's log)
 };
 EarlierRun readTimingLog(const std::filesystem::path& path);
 

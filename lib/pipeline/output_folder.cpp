@@ -1,10 +1,16 @@
 #include "pipeline/output_folder.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <set>
 
+#include "output/file_checksum.h"
 #include "output/timing_log.h"
 
 namespace qsgi {
@@ -26,12 +32,26 @@ bool isFrameFileName(const std::string& name) {
            name.find(".qsgi-") == std::string::npos;
 }
 
-bool frameFilesComplete(const fs::path& folder, int frame, const RenderSettings& s) {
-    std::error_code missing;
-    return fs::exists(folder / frameFileName(frame, "ply"), missing) &&
-           (!s.writeExr || fs::exists(folder / frameFileName(frame, "exr"), missing)) &&
-           (!s.writePng || fs::exists(folder / frameFileName(frame, "png"), missing)) &&
-           (!s.writeGltf || fs::exists(folder / frameFileName(frame, "glb"), missing));
+std::vector<std::string> frameFileNames(int frame) {
+    return {frameFileName(frame, "ply"), frameFileName(frame, "exr"), frameFileName(frame, "png"), frameFileName(frame, "glb")};
+}
+
+std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& s) {
+    if (record.files.empty()) return std::string("timing.json (an older qsgi's) records no checksums to verify its files by");
+    std::vector<std::string> wanted = {frameFileName(record.frame, "ply")};
+    if (s.writeExr) wanted.push_back(frameFileName(record.frame, "exr"));
+    if (s.writePng) wanted.push_back(frameFileName(record.frame, "png"));
+    if (s.writeGltf) wanted.push_back(frameFileName(record.frame, "glb"));
+    for (const std::string& name : wanted) {
+        const bool listed = std::any_of(record.files.begin(), record.files.end(), [&](const FileRecord& f) { return f.name == name; });
+        if (!listed) return name + " is not among the files timing.json lists for it";
+    }
+    for (const FileRecord& file : record.files) {
+        if (!isFrameFileName(file.name) || file.name.rfind(frameFileName(record.frame, ""), 0) != 0)
+            return "timing.json lists '" + file.name + "', not a file of this frame";
+        if (const std::optional<std::string> mismatch = fileMismatch(folderFd, file)) return file.name + " " + *mismatch;
+    }
+    return std::nullopt;
 }
 
 OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerprint& fingerprint,
@@ -51,11 +71,18 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
     std::sort(survey.frameFiles.begin(), survey.frameFiles.end());
 
     const fs::path logPath = folder / "timing.json";
-    if (!fs::exists(logPath, ec)) {
+    const fs::file_status logStatus = fs::symlink_status(logPath, ec);
+    if (!fs::exists(logStatus)) {
         survey.holds = survey.frameFiles.empty() ? OutputFolderSurvey::Holds::Nothing : OutputFolderSurvey::Holds::UnknownFiles;
         return survey;
     }
     EarlierRun earlier;
+    if (!fs::is_regular_file(logStatus)) {
+        survey.holds = OutputFolderSurvey::Holds::AnotherRun;
+        survey.differences.push_back(std::string("its timing.json is ") +
+                                     (fs::is_symlink(logStatus) ? "a symbolic link" : "not a regular file") + ", not a log qsgi wrote");
+        return survey;
+    }
     try {
         earlier = readTimingLog(logPath);
     } catch (const InputError& e) {
@@ -71,8 +98,15 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
         return survey;
     }
     survey.holds = OutputFolderSurvey::Holds::ThisRun;
-    for (const FrameTiming& f : earlier.frames)
-        if (frameFilesComplete(folder, f.frame, settings)) survey.completeFrames.push_back(f);
+    const int folderFd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (folderFd < 0)
+        throw InputError(folder.string(), "--out", std::string("cannot read the output folder: ") + std::strerror(errno));
+    for (const FrameTiming& f : earlier.frames) {
+        if (const std::optional<std::string> problem = frameFilesProblem(folderFd, f, settings))
+            survey.failedFrames.push_back({f.frame, *problem});
+        else survey.completeFrames.push_back(f);
+    }
+    ::close(folderFd);
     return survey;
 }
 

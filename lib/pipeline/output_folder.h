@@ -29,8 +29,16 @@ struct OutputFolderSurvey {
     bool exists = false;     // as a folder
     bool notAFolder = false;  // something else stands under the name (a file): refused
     Holds holds = Holds::Nothing;
-    // ThisRun: the frames its timing.json lists whose files are all on disk, in the log's order.
+    // ThisRun: the frames its timing.json lists whose files are all on disk as it records them
+    // (verified: regular files, not links, of the recorded size and checksum), in the log's order.
     std::vector<FrameTiming> completeFrames;
+    // ThisRun: the frames it lists that fail that check, and why ("frame_0002.ply has 1234 bytes,
+    // timing.json says 2468"). A render computes them again or, outside its frames, removes them.
+    struct FailedFrame {
+        int frame;
+        std::string reason;
+    };
+    std::vector<FailedFrame> failedFrames;
     // AnotherRun: what differs ("photons 20000 there, 1000000 here"), or why the log is unreadable.
     std::vector<std::string> differences;
     // Every frame_NNNN.* entry in the folder (what --overwrite unlinks, with timing.json).
@@ -43,10 +51,14 @@ std::string frameFileName(int frame, const char* extension);
 // temporary of AtomicFile's or the Slurm merge's, whose names hold ".qsgi-").
 bool isFrameFileName(const std::string& name);
 
-// Whether every file the settings ask for is on disk for `frame`.
-bool frameFilesComplete(const std::filesystem::path& folder, int frame, const RenderSettings& settings);
+// Why `frame`'s files in the folder open as `folderFd` are not as `record` lists them (every file
+// the settings ask for listed; every listed file verified by fileMismatch), or nullopt when they are.
+std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& settings);
 
-// Reads the folder; writes nothing.
+// The names of a frame's files, whichever the settings write: what a failed frame's removal unlinks.
+std::vector<std::string> frameFileNames(int frame);
+
+// Reads the folder (every frame file of this run's is read whole, to verify it); writes nothing.
 OutputFolderSurvey surveyOutputFolder(const std::filesystem::path& folder, const RunFingerprint& fingerprint,
                                       const RenderSettings& settings);
 

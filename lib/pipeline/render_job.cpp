@@ -19,7 +19,8 @@
 #include "output/ply_writer.h"
 #include "output/radiosity_image.h"
 #include "output/timing_log.h"
-#include "output/atomic_file.h"
+#include "output/folder_lock.h"
+#include "output/output_directory.h"
 #include "pipeline/render_options.h"
 #include "pipeline/frame_solver.h"
 #include "pipeline/output_folder.h"
@@ -178,33 +179,30 @@ Camera RenderJob::cameraAt(int frame) const {
                        scene_.worldOrigin);
 }
 
-RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame,
-                          const std::function<bool()>& stopRequested,
-                          const std::function<void(const StageReport&)>& onStage) {
+RunOutcome RenderJob::run(const RunObserver& observer) {
     refuseIfUnlit();
     std::optional<tbb::global_control> threadLimit;
     if (settings_.threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, size_t(settings_.threads));
+    auto warn = [&](const std::string& message) {
+        if (observer.onWarning) observer.onWarning(message);
+    };
 
-    const fs::path outDir(settings_.outDir);
     // One folder, one run: frames of this run are kept (and with --resume not computed again),
-    // another run's are refused unless --overwrite replaces them. Judged before anything is
-    // created, probed or cleaned, so a refused render leaves the folder exactly as it was.
-    const OutputFolderSurvey folder = surveyOutputFolder(outDir, fingerprint_, settings_);
+    // another run's are refused unless --overwrite replaces them. Judged first without touching
+    // anything, so that a refused render leaves the folder exactly as it was; then again under
+    // the folder's lock, which decides.
+    if (const std::optional<InputError> refusal =
+            outputFolderRefusal(surveyOutputFolder(settings_.outDir, fingerprint_, settings_), settings_))
+        throw *refusal;
+    OutputDirectory out(settings_.outDir);
+    const FolderLock lock(out, "qsgi render");
+    if (!lock.held()) warn(lock.unguardedReason());
+    const OutputFolderSurvey folder = surveyOutputFolder(settings_.outDir, fingerprint_, settings_);
     if (const std::optional<InputError> refusal = outputFolderRefusal(folder, settings_)) throw *refusal;
-    std::error_code ec;
-    fs::create_directories(outDir, ec);
-    if (ec || !fs::is_directory(outDir))
-        throw InputError(settings_.outDir, "--out", "cannot create the output folder" + (ec ? ": " + ec.message() : ""));
-    {
-        // Find out now, not after the first frame's work, whether files can be written here.
-        const fs::path probe = outDir / ".qsgi-write-test";
-        std::ofstream test(probe);
-        const bool writable = bool(test << "ok");
-        test.close();
-        fs::remove(probe, ec);
-        if (!writable) throw InputError(settings_.outDir, "--out", "the output folder is not writable");
-    }
-    AtomicFile::removeStaleTemporaries(outDir);
+    // Find out now, not after the first frame's work, whether files can be written here.
+    out.probeWritable();
+    // Another live run's temporaries would go too: only under the lock.
+    if (lock.held()) out.removeStaleTemporaries();
     std::vector<FrameTiming> earlierFrames;
     RunOutcome outcome;
     if (folder.holds == OutputFolderSurvey::Holds::ThisRun) earlierFrames = folder.completeFrames;
@@ -214,6 +212,20 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     // The first frame to compute: with --resume, the first of the range this run's earlier
     // frames do not already hold. Earlier frames outside what is computed stay in the log.
     const int start = settings_.resume ? firstIncompleteFrame(folder, first_, last_) : first_;
+    // Frames the log lists whose files are not as it records them (cut short, overwritten,
+    // replaced by a link): computed again when this run's frames hold them; outside them, their
+    // files are unlinked and the log forgets them, so that it lists exactly what is whole.
+    for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames) {
+        const bool recomputed = failed.frame >= start && failed.frame <= last_;
+        if (!recomputed)
+            for (const std::string& name : frameFileNames(failed.frame)) out.remove(name);
+        if (!recomputed || settings_.resume)
+            warn("frame " + std::to_string(failed.frame) + " in " + settings_.outDir + " is not as timing.json records it (" +
+                 failed.reason + "): " +
+                 (recomputed ? "computing it again"
+                             : "outside --frames, so its files are removed; render it again with --frames " +
+                                   std::to_string(failed.frame) + ":" + std::to_string(failed.frame) + " --resume"));
+    }
 
     TimingLog log;
     log.config = optionValues(settings_, OptionSelection::Logged);
@@ -234,9 +246,14 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     outcome.framesResumed = settings_.resume ? int(log.frames.size()) : 0;
     outcome.framesKept = settings_.resume ? 0 : int(log.frames.size());
     outcome.nextFrame = start;
-    if (start > last_) return outcome;  // resumed with nothing left to do: the folder stays as it is
+    if (start > last_) {
+        // Resumed with nothing left to do: the folder stays as it is, but for the log forgetting
+        // frames whose files were removed above.
+        if (!folder.failedFrames.empty()) out.write("timing.json", log.text());
+        return outcome;
+    }
     // Written before any frame, so the folder records its inputs' fingerprint from the start.
-    log.write(outDir / "timing.json");
+    out.write("timing.json", log.text());
 
     EmbreeDevice device;
     auto imageMetadata = [&](int frame) {
@@ -283,7 +300,7 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
     const int count = last_ - start + 1;
     int current = start;  // the frame being solved, for the stage reports
     auto stage = [&](const char* name, uint64_t done, uint64_t total) {
-        if (onStage) onStage(StageReport{current, current - start, count, name, done, total});
+        if (observer.onStage) observer.onStage(StageReport{current, current - start, count, name, done, total});
     };
     solver.reportStagesTo(stage);
     for (int frame = start; frame <= last_; ++frame) {
@@ -309,20 +326,39 @@ RunOutcome RenderJob::run(const std::function<void(const FrameReport&)>& onFrame
 
         clock.restart();
         stage("writing", 0, 0);
-        writeVertexRadiosityPly(outDir / frameFileName(frame, "ply"), scene_, result, *tonemap);
-        if (settings_.writeExr) writeExr(outDir / frameFileName(frame, "exr"), *image, imageMetadata(frame), settings_.exrHalf);
-        if (settings_.writePng) writePngPreview(outDir / frameFileName(frame, "png"), *image, *exposure);
-        if (settings_.writeGltf) writeVertexRadiosityGlb(outDir / frameFileName(frame, "glb"), scene_, result, *tonemap);
-        timing.writeSeconds = clock.seconds();
-        log.frames.push_back(timing);
-        // Rewritten after every frame, so it always describes the frames on disk (docs/design.md §7).
-        log.write(outDir / "timing.json");
+        // A frame is on disk whole or not at all: every file, then timing.json listing them. A
+        // failure (a full disk) removes the files already placed, so the folder holds exactly
+        // the frames the log lists, and --resume continues from this one.
+        const std::vector<std::string> names = frameFileNames(frame);
+        try {
+            timing.files.push_back(out.write(names[0], encodeVertexRadiosityPly(scene_, result, *tonemap)));
+            if (settings_.writeExr) timing.files.push_back(out.write(names[1], encodeExr(*image, imageMetadata(frame), settings_.exrHalf)));
+            if (settings_.writePng) timing.files.push_back(out.write(names[2], encodePngPreview(*image, *exposure)));
+            if (settings_.writeGltf) timing.files.push_back(out.write(names[3], encodeVertexRadiosityGlb(scene_, result, *tonemap)));
+            timing.writeSeconds = clock.seconds();
+            log.frames.push_back(timing);
+            // Rewritten after every frame, so it always describes the frames on disk (docs/design.md §7).
+            out.write("timing.json", log.text());
+        } catch (const EnvironmentError& e) {
+            if (!log.frames.empty() && log.frames.back().frame == frame) log.frames.pop_back();
+            std::string problem = "writing frame " + std::to_string(frame) + " failed: " + e.problem() + ". ";
+            try {
+                for (const std::string& name : names) out.remove(name);
+                problem += "Its files were removed; ";
+            } catch (const EnvironmentError& removal) {
+                problem += "Removing its files failed too (" + removal.problem() + "); ";
+            }
+            if (frame > start)
+                problem += "frames " + std::to_string(start) + "-" + std::to_string(frame - 1) + " are complete; ";
+            throw EnvironmentError(settings_.outDir, problem + "once the cause is fixed, add --resume to continue from frame " +
+                                                         std::to_string(frame));
+        }
         outcome.nextFrame = frame + 1;
         ++outcome.framesWritten;
-        if (onFrame)
-            onFrame(FrameReport{frame, frame - start, count, frameClock.seconds(),
+        if (observer.onFrame)
+            observer.onFrame(FrameReport{frame, frame - start, count, frameClock.seconds(),
                                 double(log.photonsMissingScene) / double(std::max<uint64_t>(settings_.photons, 1))});
-        if (frame < last_ && stopRequested && stopRequested()) {
+        if (frame < last_ && observer.stopRequested && observer.stopRequested()) {
             outcome.interrupted = true;
             return outcome;
         }

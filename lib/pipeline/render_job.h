@@ -36,9 +36,21 @@ struct RunOutcome {
     bool interrupted = false;
     int nextFrame = 0;      // the first frame not written
     int framesResumed = 0;  // frames an earlier run had written (--resume)
-    int framesKept = 0;
-    int filesReplaced = 0;  // of another run, unlinked by --overwrite (frame files and timing.json)     // frames of an earlier run of the same inputs outside this run's range (no --resume)
+    int framesKept = 0;     // frames of an earlier run of the same inputs outside this run's range (no --resume)
+    int filesReplaced = 0;  // of another run, unlinked by --overwrite (frame files and timing.json)
     int framesWritten = 0;  // by this run
+};
+
+// What a run tells its host, all optional: onFrame after each frame; stopRequested, asked after
+// each frame, ends the run early with the folder consistent; onStage each stage of a frame as it
+// starts, and how far tracing is a few times a second (from another thread); onWarning what the
+// user should know about the folder (a file system that cannot lock, frames of an earlier run
+// computed again because their files were damaged).
+struct RunObserver {
+    std::function<void(const FrameReport&)> onFrame;
+    std::function<bool()> stopRequested;
+    std::function<void(const StageReport&)> onStage;
+    std::function<void(const std::string&)> onWarning;
 };
 
 class RenderJob {
@@ -47,14 +59,12 @@ public:
     // anything is written. A scene without light loads (inspect reports it); run() refuses it.
     RenderJob(RenderSettings settings, Warnings& warnings);
 
-    // Refuses a scene without light, then creates the output folder and renders every frame (with --resume, those an earlier run of
-    // the same inputs has not written). onFrame runs after each frame; when stopRequested returns
-    // true after a frame, run() returns with the folder consistent (every file complete, timing.json
-    // describing the frames on disk). onStage is told each stage of a frame as it starts, and
-    // how far tracing is a few times a second (from another thread).
-    RunOutcome run(const std::function<void(const FrameReport&)>& onFrame = {},
-                   const std::function<bool()>& stopRequested = {},
-                   const std::function<void(const StageReport&)>& onStage = {});
+    // Refuses a scene without light, then creates the output folder, takes its lock and renders
+    // every frame (with --resume, those an earlier run of the same inputs has not written whole).
+    // The folder is consistent whenever run() returns or throws: every file complete, timing.json
+    // listing exactly the frames on disk. Throws InputError for a folder it may not use,
+    // FolderBusyError when another run holds it, EnvironmentError when the disk fails.
+    RunOutcome run(const RunObserver& observer = {});
 
     const Scene& scene() const { return scene_; }
     const std::string& outputFolder() const { return settings_.outDir; }

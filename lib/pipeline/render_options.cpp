@@ -445,7 +445,9 @@ json optionValues(const RenderSettings& s, OptionSelection selection) {
         if (!o.key || !o.get) continue;
         if (selection == OptionSelection::Fingerprinted && !o.fingerprinted) continue;
         if (selection == OptionSelection::Logged && !o.logged) continue;
-        values[o.key] = o.get(s);
+        const json value = o.get(s);
+        // Recorded (timing.json, the fingerprint): a path that is not UTF-8 as pathJson records it.
+        values[o.key] = value.is_string() && selection != OptionSelection::All ? pathJson(value.get<std::string>()) : value;
     }
     return values;
 }

@@ -66,7 +66,8 @@ void applyOption(const RenderOption& option, const nlohmann::json& value, const 
 void applyCommandLineOption(const RenderOption& option, const std::string& text, RenderSettings& settings);
 
 // Every option's value in force, by config key (options without a key are left out); only those
-// that reach the frame files, or only those timing.json records, when asked.
+// that reach the frame files, or only those timing.json records, when asked. Those two are for
+// recording: a text that is not UTF-8 (a path) is given as pathJson gives it.
 enum class OptionSelection { All, Fingerprinted, Logged };
 nlohmann::json optionValues(const RenderSettings& settings, OptionSelection selection);
 

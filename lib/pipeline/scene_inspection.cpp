@@ -5,12 +5,18 @@
 #include <set>
 
 #include "pipeline/output_folder.h"
+#include "util/json_file.h"
 #include "pipeline/render_options.h"
 #include "trace/light_sampler.h"
 
 namespace qsgi {
 
 namespace {
+
+// A path as pathJson records it, for the text report.
+std::string shownPath(const nlohmann::json& path) {
+    return path.is_string() ? path.get<std::string>() : path.at("text").get<std::string>();
+}
 
 nlohmann::json vec(const Vec3f& v) { return {v.x, v.y, v.z}; }
 // A position as the file and the PLY give it: the scene is held re-centred on its worldOrigin.
@@ -42,7 +48,7 @@ nlohmann::json outputFolderReport(const RenderJob& job) {
     const RenderSettings& s = job.settings();
     const OutputFolderSurvey survey = surveyOutputFolder(s.outDir, job.fingerprint(), s);
     const std::string range = frameRange(job.firstFrame(), job.lastFrame());
-    nlohmann::json r = {{"path", s.outDir}, {"frame_files", survey.frameFiles.size()}};
+    nlohmann::json r = {{"path", pathJson(s.outDir)}, {"frame_files", survey.frameFiles.size()}};
     std::string render;
     if (survey.holds == Holds::Nothing) {
         r["state"] = survey.exists ? "empty" : "absent";
@@ -52,6 +58,10 @@ nlohmann::json outputFolderReport(const RenderJob& job) {
         std::set<int> complete;
         for (const FrameTiming& f : survey.completeFrames) complete.insert(f.frame);
         r["complete_frames"] = complete;
+        nlohmann::json failing = nlohmann::json::array();
+        for (const OutputFolderSurvey::FailedFrame& f : survey.failedFrames)
+            failing.push_back({{"frame", f.frame}, {"problem", f.reason}});
+        r["failing_frames"] = failing;
         const int next = firstIncompleteFrame(survey, job.firstFrame(), job.lastFrame());
         if (s.resume)
             render = next > job.lastFrame() ? "nothing: frames " + range + " are complete (--resume)"
@@ -67,6 +77,10 @@ nlohmann::json outputFolderReport(const RenderJob& job) {
                                    " frame files and timing.json (--overwrite), then renders frames " + range
                              : std::string("refuses: ") + outputFolderRefusal(survey, s)->what();
     }
+    if (!survey.failedFrames.empty() && survey.holds == Holds::ThisRun)
+        render += "; " + std::to_string(survey.failedFrames.size()) +
+                  " frames it lists are not as its timing.json records them: computed again within the frames "
+                  "rendered, removed outside them";
     if (!job.hasLight()) render = "refuses: the scene has no lights";
     r["render"] = render;
     return r;
@@ -81,7 +95,7 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
     nlohmann::json r;
 
     const Bounds3f bounds = scene.bounds();
-    r["scene"] = {{"file", settings.scenePath},
+    r["scene"] = {{"file", pathJson(settings.scenePath)},
                   {"mesh_instances", scene.instances.size()},
                   {"nodes", scene.nodes.size()},
                   {"triangles", scene.triangleCount()},
@@ -153,7 +167,7 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
     nlohmann::json moved = nlohmann::json::array(), morphed = nlohmann::json::array();
     for (int n : animation.movedNodes()) moved.push_back(scene.nodes[size_t(n)].name);
     for (int n : animation.morphedNodes()) morphed.push_back(scene.nodes[size_t(n)].name);
-    r["animation"] = {{"source", settings.animationPath.empty() ? "none (one still frame)" : settings.animationPath},
+    r["animation"] = {{"source", settings.animationPath.empty() ? nlohmann::json("none (one still frame)") : pathJson(settings.animationPath)},
                       {"fps", animation.fps()},
                       {"frames", animation.lastFrame() + 1},
                       {"render_frames", {job.firstFrame(), job.lastFrame()}},
@@ -201,7 +215,7 @@ std::string inspectionText(const nlohmann::json& r) {
         return number(v[0].get<double>()) + " " + number(v[1].get<double>()) + " " + number(v[2].get<double>());
     };
     const auto& s = r["scene"];
-    line("scene      " + s["file"].get<std::string>());
+    line("scene      " + shownPath(s["file"]));
     line("  " + std::to_string(s["mesh_instances"].get<uint64_t>()) + " mesh instances, " +
          std::to_string(s["nodes"].get<uint64_t>()) + " nodes, " + std::to_string(s["triangles"].get<uint64_t>()) +
          " triangles, " + std::to_string(s["vertices"].get<uint64_t>()) + " vertices; bounds " +
@@ -225,7 +239,7 @@ std::string inspectionText(const nlohmann::json& r) {
     line("camera     " + c["render"]["projection"].get<std::string>() + ", from " + c["render"]["from"].get<std::string>() +
          " (" + std::to_string(c["in_scene"].get<uint64_t>()) + " in the scene)");
     const auto& a = r["animation"];
-    line("animation  " + a["source"].get<std::string>() + ": " + std::to_string(a["frames"].get<int64_t>()) + " frames at " +
+    line("animation  " + shownPath(a["source"]) + ": " + std::to_string(a["frames"].get<int64_t>()) + " frames at " +
          number(a["fps"].get<double>()) + " fps (rendering " + std::to_string(a["render_frames"][0].get<int>()) + ":" +
          std::to_string(a["render_frames"][1].get<int>()) + ")");
     for (const auto& g : a["gltf_animations"])
@@ -248,7 +262,7 @@ std::string inspectionText(const nlohmann::json& r) {
                                                    : it.value().dump());
     line("options    " + (options.empty() ? std::string("the defaults") : options));
     const auto& folder = r["output_folder"];
-    line("output     " + folder["path"].get<std::string>() + ": " + folder["state"].get<std::string>() + "; a render " +
+    line("output     " + shownPath(folder["path"]) + ": " + folder["state"].get<std::string>() + "; a render " +
          folder["render"].get<std::string>());
     line("warnings   " + std::to_string(r["warnings"].size()));
     for (const auto& w : r["warnings"]) line("  " + w.get<std::string>());

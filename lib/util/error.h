@@ -29,6 +29,27 @@ private:
     std::string file_, place_, problem_;
 };
 
+// The machine, not the input, stopped the run: a full disk, an I/O error, a read-only file system.
+// `folder` is where it happened; the CLI prints the message and exits 74 (sysexits' EX_IOERR), so
+// a batch system can tell "free space and --resume" from "fix the input" (docs/design.md §8).
+class EnvironmentError : public std::runtime_error {
+public:
+    EnvironmentError(std::string folder, std::string problem)
+        : std::runtime_error(folder + ": " + problem), folder_(std::move(folder)), problem_(std::move(problem)) {}
+    const std::string& folder() const { return folder_; }
+    const std::string& problem() const { return problem_; }
+
+private:
+    std::string folder_, problem_;
+};
+
+// Another run holds the output folder's lock: the CLI prints the message (the folder and the
+// holder) and exits 75 (sysexits' EX_TEMPFAIL: try again later).
+class FolderBusyError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 // Non-fatal findings while reading inputs, reported once each by the caller.
 struct Warnings {
     std::vector<std::string> messages;

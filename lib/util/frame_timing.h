@@ -6,6 +6,9 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include "util/file_record.h"
 
 namespace qsgi {
 
@@ -42,6 +45,9 @@ struct FrameTiming {
     double discRegionsSeconds = 0;
     uint64_t discRegionsUpdated = 0;
     uint64_t ownSurfaceFallbacks = 0, buriedVertices = 0;
+    // The frame's files as written, which --resume verifies before it trusts them ("files" in
+    // timing.json; not a timing, so not in forEachTimingField's list).
+    std::vector<FileRecord> files;
 };
 
 template <class Timing, class Visit>

@@ -103,4 +103,23 @@ void refuseUnknownKeys(const nlohmann::json& j, const std::vector<std::string>& 
     }
 }
 
+nlohmann::json pathJson(const std::string& name) {
+    using nlohmann::json;
+    // nlohmann's serializer is the UTF-8 check: strict, it throws on the first invalid byte;
+    // with `replace`, it writes U+FFFD for it.
+    try {
+        (void)json(name).dump();
+        return name;
+    } catch (const json::type_error&) {
+    }
+    static constexpr char kDigits[] = "0123456789abcdef";
+    std::string hex;
+    for (unsigned char c : name) {
+        hex += kDigits[c >> 4];
+        hex += kDigits[c & 15];
+    }
+    const std::string quoted = json(name).dump(-1, ' ', false, json::error_handler_t::replace);
+    return {{"text", json::parse(quoted).get<std::string>()}, {"hex", hex}};
+}
+
 }  // namespace qsgi

@@ -26,4 +26,10 @@ void refuseDeepNesting(const std::string& text, const std::string& path, size_t 
 void refuseUnknownKeys(const nlohmann::json& j, const std::vector<std::string>& known, const std::string& file,
                        const std::string& place);
 
+// A file name as JSON records it. Names are bytes on Linux and JSON text is UTF-8: a name that
+// is UTF-8 is a string; any other is {"text": the name with U+FFFD for each byte that does not
+// decode, for people, "hex": its exact bytes in hex, for programs} (docs/design.md §7), so
+// timing.json and inspect record every name losslessly.
+nlohmann::json pathJson(const std::string& name);
+
 }  // namespace qsgi

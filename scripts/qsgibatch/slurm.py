@@ -6,11 +6,13 @@ state from scratch and writes the bytes one sequential run would (the PNG exposu
 0, is computed for it). Each submission covers only what is missing, so submitting again after a
 killed or failed task finishes the work without redoing any."""
 import os
+import re
 import shlex
 import shutil
 import subprocess
 import sys
 
+from .chunks import write_file
 from .runner import finished
 
 
@@ -43,15 +45,24 @@ def sbatch(name, command, log_folder, options, array=None, dependency=None, cpus
 def replace_merge_job(record: str, new_job: str) -> None:
     """Cancels the merge job an earlier submission left (recorded in `record`) and records the new
     one. A merge whose array had a failed or killed task waits forever on a dependency that can
-    never be met, unless the cluster sets kill_invalid_depend; the resubmission supersedes it."""
-    if os.path.exists(record):
-        with open(record) as f:
-            old = f.read().strip()
-        if old and old != new_job:
+    never be met, unless the cluster sets kill_invalid_depend; the resubmission supersedes it. The
+    record is read and written without following a link planted at its name, and only a job id
+    read from it reaches scancel."""
+    folder_fd = os.open(os.path.dirname(record) or ".", os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+    try:
+        name = os.path.basename(record)
+        old = ""
+        try:
+            fd = os.open(name, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK, dir_fd=folder_fd)
+            with os.fdopen(fd, "rb") as f:
+                old = f.read(64).decode("ascii", "replace").strip()
+        except OSError:  # none yet, or not a file this script wrote
+            pass
+        if re.fullmatch(r"[0-9]+", old) and old != new_job:
             subprocess.run(["scancel", "--state=PENDING", old], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    with open(record + ".tmp", "w") as f:
-        f.write(new_job + "\n")
-    os.replace(record + ".tmp", record)
+        write_file(folder_fd, name, (new_job + "\n").encode())
+    finally:
+        os.close(folder_fd)
 
 
 def array_spec(indices) -> str:

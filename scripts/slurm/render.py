@@ -7,7 +7,10 @@
 Everything after `--` is passed to `qsgi render` (not --out, --frames, --resume, --threads: this
 script sets them). OUT must be on a file system every node sees. Submitting the same command
 again submits only the chunks that are not finished (a killed chunk resumes from its last
-complete frame) and the merge. `--task I` and `--merge` are what the jobs run."""
+complete frame, and a chunk whose files no longer match its timing.json runs again) and the merge.
+`--task I` and `--merge` are what the jobs run. Exit codes: 0 done, 2 refused (one line naming the
+folder, and for an unfinished or damaged chunk the chunk, frame, file and problem), 75 another
+run or merge holds OUT/.qsgi-lock (try again later), 74 the machine failed (no space, I/O error)."""
 import argparse
 import os
 import shlex
@@ -66,8 +69,7 @@ def submit(args) -> int:
     wanted["chunks"] = [list(c) for c in wanted["chunks"]]
     chunks.save_plan(out, wanted)
     missing = [i for i, (a, b) in enumerate(wanted["chunks"]) if not chunks.complete(out, i, a, b)]
-    logs = os.path.join(out, "slurm")
-    os.makedirs(logs, exist_ok=True)
+    logs = chunks.subfolder(out, "slurm")  # a real folder: Slurm writes the jobs' logs in it
     me = [slurm.python_executable(), os.path.abspath(__file__), "--out", out]
     dependency = None
     if missing:
@@ -97,9 +99,15 @@ def main(argv):
             print(f"render: merged {chunks.merge(out)} frames into {out}")
             return 0
         return submit(args)
-    except (chunks.ChunkError, slurm.SlurmError) as e:
+    except chunks.ChunkError as e:  # 2 a refusal, 75 another run holds the folder, 74 the machine failed
+        print(f"render: {e}", file=sys.stderr)
+        return e.exit_code
+    except slurm.SlurmError as e:
         print(f"render: {e}", file=sys.stderr)
         return 2
+    except OSError as e:
+        print(f"render: {out}: {e}", file=sys.stderr)
+        return 74
 
 
 if __name__ == "__main__":

@@ -1,0 +1,62 @@
+#include "output/file_checksum.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <xxhash.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+namespace qsgi {
+
+namespace {
+std::string hex(uint64_t value) {
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+    return text;
+}
+
+struct StateFree {
+    void operator()(XXH3_state_t* state) const { XXH3_freeState(state); }
+};
+}  // namespace
+
+std::string xxh3Hex(std::string_view bytes) { return hex(XXH3_64bits(bytes.data(), bytes.size())); }
+
+std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record) {
+    struct stat link {};
+    if (::fstatat(folderFd, record.name.c_str(), &link, AT_SYMLINK_NOFOLLOW) != 0)
+        return errno == ENOENT ? "missing" : std::string("cannot be read: ") + std::strerror(errno);
+    if (S_ISLNK(link.st_mode)) return "is a symbolic link, not a file qsgi wrote";
+    if (!S_ISREG(link.st_mode)) return "is not a regular file";
+    if (uint64_t(link.st_size) != record.bytes)
+        return "has " + std::to_string(link.st_size) + " bytes, timing.json says " + std::to_string(record.bytes);
+    const int fd = ::openat(folderFd, record.name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) return std::string("cannot be read: ") + std::strerror(errno);
+    std::unique_ptr<XXH3_state_t, StateFree> state(XXH3_createState());
+    XXH3_64bits_reset(state.get());
+    std::vector<char> buffer(1 << 20);
+    uint64_t total = 0;
+    for (;;) {
+        const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) {
+            const int error = errno;
+            ::close(fd);
+            return std::string("cannot be read: ") + std::strerror(error);
+        }
+        if (n == 0) break;
+        XXH3_64bits_update(state.get(), buffer.data(), size_t(n));
+        total += uint64_t(n);
+    }
+    ::close(fd);
+    if (total != record.bytes) return "changed while being checked";
+    if (hex(XXH3_64bits_digest(state.get())) != record.xxh3) return "has other bytes than qsgi wrote (checksum differs)";
+    return std::nullopt;
+}
+
+}  // namespace qsgi

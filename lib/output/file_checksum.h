@@ -1,0 +1,24 @@
+// Checksums of what qsgi writes, and the check that a file in the output folder is still what
+// timing.json says it wrote. XXH3 (Debian's libxxhash) reads at memory speed; it catches a
+// truncated, overwritten or replaced file, not a writer who also edits timing.json (it is a
+// checksum, not a signature).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "util/file_record.h"
+
+namespace qsgi {
+
+// XXH3 64-bit of `bytes` as 16 lowercase hex digits.
+std::string xxh3Hex(std::string_view bytes);
+
+// Why the file `record.name` in the folder open as `folderFd` is not the one recorded: missing, a
+// symbolic link, not a regular file, another size, another checksum, unreadable. nullopt when it
+// matches. Never follows a link at the name.
+std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record);
+
+}  // namespace qsgi
