@@ -23,7 +23,7 @@ run_packages=(
 )
 test_packages=(
   python3 python3-numpy python3-matplotlib   # scripts/sweep.py, tests/data/make_inputs.py, reference checks
-  python3-xxhash            # the Slurm merge verifies chunk files (scripts/qsgibatch/chunks.py)
+  python3-xxhash            # the Slurm merge verifies chunk files (scripts/qsgibatch/output_folder.py)
   openimageio-tools
   libgtest-dev libgmock-dev
   libbenchmark-dev

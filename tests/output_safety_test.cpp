@@ -280,6 +280,18 @@ TEST(OutputSafety, OneRunPerFolderAtATime) {
     EXPECT_EQ(after.exitCode, 0) << after.output;
     EXPECT_EQ(readFileBytes(out / ".qsgi-lock").find("pid 4242"), std::string::npos);
 
+    // A hard link to someone's file planted as the lock file: locked, but never truncated or
+    // written (it is that other file too).
+    const fs::path linked = dir / "linked", victim = dir / "victim.txt";
+    fs::create_directories(linked);
+    {
+        std::ofstream(victim) << "not a lock file\n";
+    }
+    fs::create_hard_link(victim, linked / ".qsgi-lock");
+    const CommandResult throughLink = runQsgi(renderArguments("0:0") + " --quiet --out " + quoted(linked));
+    EXPECT_EQ(throughLink.exitCode, 0) << throughLink.output;
+    EXPECT_EQ(readFileBytes(victim), "not a lock file\n");
+
     // Two renders started together into one folder: one renders, the other (if they overlapped)
     // stops with 75; the folder holds one whole run either way.
     const fs::path together = dir / "together";

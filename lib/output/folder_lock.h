@@ -3,7 +3,7 @@
 // could be a live run's), held for the whole run and released by the kernel when the process
 // ends however it ends, so a killed run (a requeued Slurm task) never blocks the next one. The
 // file stays, holding the last holder's line ("pid 1234 on host node07 since …"). The Slurm merge
-// (scripts/qsgibatch/chunks.py) takes the same lock the same way.
+// (scripts/qsgibatch/output_folder.py) takes the same lock the same way.
 #pragma once
 
 #include <string>

@@ -12,7 +12,7 @@ import shutil
 import subprocess
 import sys
 
-from .chunks import write_file
+from .output_folder import write_file
 from .runner import finished
 
 

@@ -18,7 +18,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from qsgibatch import chunks, slurm  # noqa: E402
+from qsgibatch import chunks, output_folder, slurm  # noqa: E402
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SET_HERE = ("--out", "--frames", "--resume", "--threads")
@@ -69,7 +69,7 @@ def submit(args) -> int:
     wanted["chunks"] = [list(c) for c in wanted["chunks"]]
     chunks.save_plan(out, wanted)
     missing = [i for i, (a, b) in enumerate(wanted["chunks"]) if not chunks.complete(out, i, a, b)]
-    logs = chunks.subfolder(out, "slurm")  # a real folder: Slurm writes the jobs' logs in it
+    logs = output_folder.make_subfolder(out, "slurm")  # a real folder: Slurm writes the jobs' logs in it
     me = [slurm.python_executable(), os.path.abspath(__file__), "--out", out]
     dependency = None
     if missing:
@@ -99,7 +99,7 @@ def main(argv):
             print(f"render: merged {chunks.merge(out)} frames into {out}")
             return 0
         return submit(args)
-    except chunks.ChunkError as e:  # 2 a refusal, 75 another run holds the folder, 74 the machine failed
+    except output_folder.FolderError as e:  # 2 a refusal, 75 another run holds the folder, 74 the machine failed
         print(f"render: {e}", file=sys.stderr)
         return e.exit_code
     except slurm.SlurmError as e:

@@ -1,10 +1,12 @@
 #!/usr/bin/python3
 """The Slurm merge of frame chunks (scripts/qsgibatch/chunks.py) trusts nothing in the folder and
-writes through no link planted there. Fake chunk folders hold small frame files and timing.json
-logs recording each file's size and XXH3, as qsgi render writes them; no Slurm and no qsgi needed.
+writes through no link planted there (scripts/qsgibatch/output_folder.py). Fake chunk folders hold
+small frame files and timing.json logs recording each file's size and XXH3, as qsgi render writes
+them; no Slurm and no qsgi needed.
 
     python3 tests/python/test_chunks.py        (a second or so)"""
 import contextlib
+import errno
 import fcntl
 import importlib.util
 import io
@@ -26,7 +28,7 @@ except ImportError:  # another python3 first on PATH (pyenv); Debian's has pytho
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPOSITORY, "scripts"))
 
-from qsgibatch import chunks  # noqa: E402
+from qsgibatch import chunks, output_folder  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("render", os.path.join(REPOSITORY, "scripts", "slurm", "render.py"))
 render = importlib.util.module_from_spec(_spec)
@@ -72,7 +74,7 @@ def read(path: str) -> bytes:
 
 def temporary(name: str) -> str:
     """The first temporary name the merge uses for `name` in this process."""
-    return f".{name}{chunks.TEMPORARY_MARKER}.{os.getpid()}"
+    return f".{name}{output_folder.TEMPORARY_MARKER}.{os.getpid()}"
 
 
 class MergeTest(unittest.TestCase):
@@ -114,7 +116,7 @@ class MergeTest(unittest.TestCase):
                 self.assertEqual(r, record(r["name"], data))
                 self.assertEqual(data, frame_bytes(entry["frame"], r["name"].rsplit(".")[1]))
         self.assertFalse(os.path.islink(os.path.join(self.out, "timing.json")))
-        self.assertEqual([n for n in os.listdir(self.out) if chunks.TEMPORARY_MARKER in n], [])
+        self.assertEqual([n for n in os.listdir(self.out) if output_folder.TEMPORARY_MARKER in n], [])
 
     def refusal(self, index: int) -> str:
         """The merge's refusal while chunk `index` is damaged; it placed nothing and complete()
@@ -133,16 +135,16 @@ class MergeTest(unittest.TestCase):
         self.assertTrue(all(chunks.complete(self.out, i, a, b) for i, (a, b) in enumerate(CHUNKS)))
         self.assertEqual(chunks.merge(self.out), 6)
         self.assertMergedCorrectly()
-        with open(os.path.join(self.out, chunks.LOCK)) as f:
+        with open(os.path.join(self.out, output_folder.LOCK)) as f:
             self.assertRegex(f.read(), rf"^pid {os.getpid()} on host \S+ since \d{{4}}-\d\d-\d\dT\d\d:\d\d:\d\dZ \(qsgi merge\)\n$")
         self.assertEqual(chunks.merge(self.out), 6)  # again: the same folder
         self.assertMergedCorrectly()
 
     def test_links_planted_at_every_name_written_are_replaced_not_followed(self):
-        names = ["timing.json", "frame_0001.ply", "frame_0004.png", chunks.LOCK,
+        names = ["timing.json", "frame_0001.ply", "frame_0004.png", output_folder.LOCK,
                  temporary("timing.json"), temporary("frame_0001.ply"), temporary("frame_0004.png")]
         victims = {name: self.victim(f"victim-{i}") for i, name in enumerate(names)}
-        os.unlink(os.path.join(self.out, chunks.LOCK))  # save_plan's
+        os.unlink(os.path.join(self.out, output_folder.LOCK))  # save_plan's
         for name, target in victims.items():
             self.plant(name, target)
         dangling = os.path.join(self.outside, "never-made")  # O_CREAT through the link would make it
@@ -151,13 +153,13 @@ class MergeTest(unittest.TestCase):
         for target in victims.values():
             self.assertEqual(read(target), b"not qsgi's to touch\n", target)
         self.assertFalse(os.path.exists(dangling))
-        self.assertFalse(os.path.islink(os.path.join(self.out, chunks.LOCK)))
+        self.assertFalse(os.path.islink(os.path.join(self.out, output_folder.LOCK)))
         self.assertMergedCorrectly()
 
     def test_a_lock_file_hard_linked_to_a_file_elsewhere_is_not_written(self):
         victim = self.victim("lock-victim")
-        os.unlink(os.path.join(self.out, chunks.LOCK))
-        os.link(victim, os.path.join(self.out, chunks.LOCK))
+        os.unlink(os.path.join(self.out, output_folder.LOCK))
+        os.link(victim, os.path.join(self.out, output_folder.LOCK))
         self.assertEqual(chunks.merge(self.out), 6)
         self.assertEqual(read(victim), b"not qsgi's to touch\n")
 
@@ -188,7 +190,7 @@ class MergeTest(unittest.TestCase):
         self.plant(temporary("notes.txt") + ".1", second)
         fd = os.open(self.out, os.O_RDONLY | os.O_DIRECTORY)
         try:
-            chunks.write_file(fd, "notes.txt", b"written\n")
+            output_folder.write_file(fd, "notes.txt", b"written\n")
         finally:
             os.close(fd)
         self.assertEqual(read(first), b"not qsgi's to touch\n")
@@ -263,11 +265,11 @@ class MergeTest(unittest.TestCase):
         with open(stale, "w"):
             pass
         holder = "pid 4242 on host node07 since 2026-12-03T07:00:00Z (qsgi render)"
-        fd = os.open(os.path.join(self.out, chunks.LOCK), os.O_RDWR | os.O_CREAT, 0o644)
+        fd = os.open(os.path.join(self.out, output_folder.LOCK), os.O_RDWR | os.O_CREAT, 0o644)
         try:
             os.write(fd, (holder + "\n").encode())
             fcntl.flock(fd, fcntl.LOCK_EX)  # another open file description: the merge's flock conflicts
-            with self.assertRaises(chunks.FolderBusy) as refused:
+            with self.assertRaises(output_folder.FolderBusy) as refused:
                 chunks.merge(self.out)
             self.assertIn(holder, str(refused.exception))
             self.assertIn(self.out, str(refused.exception))
@@ -275,7 +277,7 @@ class MergeTest(unittest.TestCase):
             with contextlib.redirect_stderr(stderr):
                 self.assertEqual(render.main(["--out", self.out, "--merge"]), 75)
             self.assertIn(holder, stderr.getvalue())
-            with self.assertRaises(chunks.FolderBusy):
+            with self.assertRaises(output_folder.FolderBusy):
                 chunks.save_plan(self.out, PLAN)
         finally:
             os.close(fd)
@@ -289,11 +291,11 @@ class MergeTest(unittest.TestCase):
         holder = subprocess.Popen(
             [sys.executable, "-c", "import fcntl, os, sys; fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT, 0o644); "
              "fcntl.flock(fd, fcntl.LOCK_EX); os.write(fd, b'pid %d on host elsewhere since then (qsgi render)\\n' "
-             "% os.getpid()); print('held', flush=True); sys.stdin.read()", os.path.join(self.out, chunks.LOCK)],
+             "% os.getpid()); print('held', flush=True); sys.stdin.read()", os.path.join(self.out, output_folder.LOCK)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         try:
             self.assertEqual(holder.stdout.readline(), "held\n")
-            with self.assertRaisesRegex(chunks.FolderBusy, rf"pid {holder.pid} on host elsewhere"):
+            with self.assertRaisesRegex(output_folder.FolderBusy, rf"pid {holder.pid} on host elsewhere"):
                 chunks.merge(self.out)
         finally:
             holder.communicate()  # closes its stdin: it ends
@@ -302,11 +304,11 @@ class MergeTest(unittest.TestCase):
     def test_a_lock_file_left_by_a_dead_process_does_not_block(self):
         dead = subprocess.Popen([sys.executable, "-c", "pass"])
         dead.wait()
-        with open(os.path.join(self.out, chunks.LOCK), "w") as f:
+        with open(os.path.join(self.out, output_folder.LOCK), "w") as f:
             f.write(f"pid {dead.pid} on host {os.uname().nodename} since 2026-12-03T07:00:00Z (qsgi merge)\n")
         self.assertEqual(chunks.merge(self.out), 6)
         self.assertMergedCorrectly()
-        with open(os.path.join(self.out, chunks.LOCK)) as f:
+        with open(os.path.join(self.out, output_folder.LOCK)) as f:
             self.assertTrue(f.read().startswith(f"pid {os.getpid()} "))
 
     def test_a_file_system_that_cannot_lock_warns_and_leaves_temporaries(self):
@@ -314,7 +316,7 @@ class MergeTest(unittest.TestCase):
         with open(stale, "w"):
             pass
         stderr = io.StringIO()
-        with mock.patch.object(chunks.fcntl, "flock", side_effect=OSError(chunks.errno.ENOLCK, "No locks available")), \
+        with mock.patch.object(output_folder.fcntl, "flock", side_effect=OSError(errno.ENOLCK, "No locks available")), \
                 contextlib.redirect_stderr(stderr):
             self.assertEqual(chunks.merge(self.out), 6)
         self.assertIn("not guarding against concurrent runs", stderr.getvalue())
@@ -324,9 +326,9 @@ class MergeTest(unittest.TestCase):
         moved = os.path.join(self.outside, "001")
         os.rename(chunks.folder(self.out, 1), moved)
         os.symlink(moved, chunks.folder(self.out, 1))
-        with self.assertRaisesRegex(chunks.ChunkError, "chunks/001: is not a folder"):
+        with self.assertRaisesRegex(output_folder.FolderError, "chunks/001: is not a folder"):
             chunks.merge(self.out)
-        with self.assertRaisesRegex(chunks.ChunkError, "chunks/001: is not a folder"):
+        with self.assertRaisesRegex(output_folder.FolderError, "chunks/001: is not a folder"):
             chunks.task_command(self.out, 1, 1)
 
 
