@@ -12,6 +12,8 @@
 #include <set>
 #include <sstream>
 
+#include <sys/stat.h>
+
 #include "output/ply_reader.h"
 #include "pipeline/output_folder.h"
 #include "pipeline/render_job.h"
@@ -25,7 +27,7 @@ namespace fs = std::filesystem;
 namespace {
 
 struct HostileFile {
-    std::string kind;   // gltf, animation or config
+    std::string kind;   // gltf, animation, config or ply
     std::string file;   // relative to tests/data
     std::string words;  // the message must contain these
     std::string names;  // and name this file
@@ -81,12 +83,13 @@ TEST(HostileInput, EveryBadFileIsRefusedWithOneLineNamingItExitTwoAndNothingWrit
         if (row.kind == "gltf") args = "render " + file + " --photons 1000";
         else if (row.kind == "animation") args = "render " + base + " --animation " + file + " --photons 1000";
         else if (row.kind == "config") args = "render --config " + file;  // the config's own photon count
+        else if (row.kind == "ply") args = "compare " + file + " " + (dataDir() / "good" / "frame.ply").string();
         else {
             ADD_FAILURE() << row.file << ": unknown kind " << row.kind;
             continue;
         }
         fs::remove_all(out);
-        const CommandResult r = runQsgi(args + " --out " + out.string());
+        const CommandResult r = runQsgi(args + (row.kind == "ply" ? "" : " --out " + out.string()));
         SCOPED_TRACE(row.file + "\n" + r.output);
         EXPECT_EQ(r.exitCode, 2);
         EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line expected";
@@ -104,7 +107,8 @@ TEST(HostileInput, ValidEdgeCasesLoadWithTheGeometryTheyHold) {
                              "buffer_without_uri_unused.gltf", "quantized.gltf", "glb_with_unused_second_buffer.glb",
                              "texture_embedded.gltf", "texture_data_uri.gltf", "texture_unreadable.gltf",
                              "integer_written_as_float.gltf", "data_uri_percent_encoded.gltf", "glb_trailing_bytes.glb",
-                             "primitive_without_position.gltf"}) {
+                             "primitive_without_position.gltf", "light_range_and_texture_transform.gltf",
+                             "texture_png_hostile.gltf", "texture_png_variants.gltf"}) {
         SCOPED_TRACE(name);
         Warnings warnings;
         Scene scene;
@@ -336,4 +340,158 @@ TEST(HostileInput, AGltfAnimationWithoutChannelsNamesItselfAndWhyItHasOneFrame) 
     EXPECT_EQ(file.lastFrameReason(), "transform file " + (dataDir() / "bad/animation/moves_the_light.json").string() +
                                           " lists frames up to 1");
     EXPECT_EQ(Animation::still(walker).lastFrameReason(), "");
+}
+
+namespace {
+
+// Every line a run printed is qsgi's own ("qsgi: …"): no library wrote to the terminal.
+void expectOnlyQsgisLines(const std::string& output) {
+    std::istringstream lines(output);
+    for (std::string line; std::getline(lines, line);)
+        EXPECT_EQ(line.rfind("qsgi: ", 0), 0u) << "a line qsgi did not write: " << line;
+}
+
+// Whether some warning names `place` and says `words`.
+bool warned(const Warnings& warnings, const std::string& place, const std::string& words) {
+    for (const std::string& w : warnings.messages)
+        if (w.find(place) != std::string::npos && w.find(words) != std::string::npos) return true;
+    return false;
+}
+
+}  // namespace
+
+// `qsgi compare` reads two PLYs it did not write: a header's counts are checked against the file's
+// size before anything is allocated for them (both arguments), and what is no file is named so.
+TEST(HostileInput, ComparedPlysThatAreNoFilesOrClaimMoreThanTheyHoldAreRefusedByName) {
+    const std::string good = (dataDir() / "good" / "frame.ply").string();
+    const fs::path dir = testScratchDir("hostile-ply");
+    const fs::path pipe = dir / "pipe.ply";
+    fs::remove(pipe);
+    ASSERT_EQ(mkfifo(pipe.c_str(), 0600), 0);
+    const std::string huge = (dataDir() / "bad/ply/vertex_count_huge.ply").string();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {good + " " + huge, huge + ": header, element vertex (line 3): declares 200000000 vertices"},
+        {dir.string() + " " + good, dir.string() + ": is a directory, not a PLY file"},
+        {good + " " + pipe.string(), pipe.string() + ": is not a regular file (a device, pipe or socket)"},
+    };
+    for (const auto& [args, message] : cases) {
+        // Under 1 GiB of address space: a count believed would fail to allocate, not exit 2.
+        const CommandResult r = runCommand((kSanitized ? std::string() : "ulimit -v 1048576 && ") + QSGI_CLI +
+                                           " compare " + args);
+        SCOPED_TRACE(args + "\n" + r.output);
+        EXPECT_EQ(r.exitCode, 2);
+        EXPECT_EQ(r.output.rfind("qsgi: error: " + message, 0), 0u);
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1);
+    }
+}
+
+// A texture whose uri names no readable file (a directory, a pipe, a device, a file past 2 GiB,
+// nothing) leaves its material's factor with one warning naming the image and the uri; tinygltf
+// never opens such a path (a pipe would block it, a directory made it allocate 2^63 bytes). An
+// image nothing decodes is an unused object: a warning, refused under --strict.
+TEST(HostileInput, TextureUrisNamingNoReadableFileLeaveTheFactorWithAWarningNamingTheUri) {
+    const fs::path dir = testScratchDir("hostile-texture-uri");
+    fs::create_directories(dir / "folder.png");
+    fs::remove(dir / "pipe.png");
+    ASSERT_EQ(mkfifo((dir / "pipe.png").c_str(), 0600), 0);
+    { std::ofstream(dir / "huge.png") << "x"; }
+    fs::resize_file(dir / "huge.png", uint64_t(3) << 30);  // sparse: nothing is written, or read
+    std::string device = "dev/null";
+    for (int up = 0; up < 64; ++up) device = "../" + device;  // past the root stays at the root
+    const std::vector<std::pair<std::string, std::string>> images = {
+        {"folder.png", "names a directory, not a file"},
+        {"pipe.png", "names a device, pipe or socket, not a regular file"},
+        {device, "names a device, pipe or socket, not a regular file"},
+        {"huge.png", "names a file of 3221225472 bytes, beyond the 2 GiB qsgi reads for an image"},
+        {"missing.png", "names no file (looked beside the glTF file)"},
+        {"folder.png", "names a directory, not a file"},  // images[5]: no material decodes it
+    };
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(dataDir() / "good" / "texture_data_uri.gltf"));
+    doc["images"] = nlohmann::json::array();
+    doc["textures"] = nlohmann::json::array();
+    doc["materials"] = nlohmann::json::array();
+    for (size_t i = 0; i < images.size(); ++i) {
+        doc["images"].push_back({{"uri", images[i].first}});
+        doc["textures"].push_back({{"source", i}});
+        if (i + 1 < images.size())
+            doc["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", i}}}, {"baseColorFactor", {0.5, 0.25, 1, 1}}}}});
+    }
+    const fs::path file = dir / "scene.gltf";
+    std::ofstream(file) << doc.dump();
+
+    Warnings warnings;
+    Scene scene;
+    ASSERT_NO_THROW(scene = loadGltfScene(file.string(), warnings));
+    for (size_t i = 0; i + 1 < images.size(); ++i) {
+        SCOPED_TRACE(images[i].first);
+        EXPECT_EQ(scene.materials[i].albedo, Vec3f(0.5f, 0.25f, 1.0f));
+        const std::string image = "images[" + std::to_string(i) + "].uri '" + images[i].first + "' ";
+        EXPECT_TRUE(warned(warnings, "materials[" + std::to_string(i) + "].pbrMetallicRoughness.baseColorTexture: " + image,
+                           images[i].second + "; using baseColorFactor alone"));
+    }
+    EXPECT_TRUE(warned(warnings, "images[5].uri: 'folder.png' names a directory, not a file",
+                       "(images[5] is not in the rendered scene, so it is ignored)"));
+    for (const std::string& w : warnings.messages) EXPECT_EQ(w.find("File read error"), std::string::npos) << w;
+
+    const CommandResult quiet = runQsgi("render " + file.string() + " --photons 1000 --quiet --out " + (dir / "out").string());
+    EXPECT_EQ(quiet.exitCode, 0) << quiet.output;
+    EXPECT_EQ(quiet.output, "") << "--quiet prints errors only";
+    const CommandResult strict = runQsgi("inspect --strict " + file.string());
+    EXPECT_EQ(strict.exitCode, 2) << strict.output;
+    EXPECT_NE(strict.output.find("images[5].uri: 'folder.png' names a directory, not a file"), std::string::npos) << strict.output;
+    EXPECT_EQ(std::count(strict.output.begin(), strict.output.end(), '\n'), 1) << strict.output;
+}
+
+// PNGs libpng refuses (tests/data/good/texture_png_hostile.gltf: a header PNG forbids, a CRC,
+// zlib or filter error, data that ends early) leave each material's factor with a warning in
+// qsgi's words, and no library prints a line, with --quiet or without.
+TEST(HostileInput, HostilePngTexturesWarnInQsgisWordsAndNoLibraryPrints) {
+    const fs::path file = dataDir() / "good" / "texture_png_hostile.gltf";
+    Warnings warnings;
+    Scene scene;
+    ASSERT_NO_THROW(scene = loadGltfScene(file.string(), warnings));
+    size_t rows = 0;
+    std::ifstream table(dataDir() / "good" / "texture_png_hostile.tsv");
+    for (std::string line; std::getline(table, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        const int m = std::stoi(line.substr(0, line.find('\t')));
+        const std::string words = line.substr(line.find('\t') + 1);
+        SCOPED_TRACE("materials[" + std::to_string(m) + "]: " + words);
+        EXPECT_EQ(scene.materials[size_t(m)].albedo, Vec3f(0.5f, 0.25f, 1.0f));
+        EXPECT_TRUE(warned(warnings, "materials[" + std::to_string(m) + "].pbrMetallicRoughness.baseColorTexture: images[" +
+                                         std::to_string(m) + "] ",
+                           words));
+        ++rows;
+    }
+    EXPECT_GE(rows, 12u);
+
+    const fs::path dir = testScratchDir("hostile-png");
+    const CommandResult quiet = runQsgi("render " + file.string() + " --photons 1000 --quiet --out " + (dir / "quiet").string());
+    EXPECT_EQ(quiet.exitCode, 0) << quiet.output;
+    EXPECT_EQ(quiet.output, "") << "--quiet prints errors only";
+    const CommandResult loud = runQsgi("render " + file.string() + " --photons 1000 --out " + (dir / "loud").string());
+    EXPECT_EQ(loud.exitCode, 0) << loud.output;
+    EXPECT_NE(loud.output.find("qsgi: warning: "), std::string::npos) << loud.output;
+    expectOnlyQsgisLines(loud.output);
+}
+
+// KHR_lights_punctual's range is positive where given: refused in a light the render uses
+// (bad/gltf/light_range_*.gltf), a warning in one no node of the scene uses, refused by --strict.
+TEST(HostileInput, ALightRangeNotPositiveInALightNothingUsesWarnsAndStrictRefusesIt) {
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(dataDir() / "good" / "base.gltf"));
+    doc["extensions"]["KHR_lights_punctual"]["lights"].push_back({{"type", "point"}, {"intensity", 1}, {"range", 0}});
+    const fs::path file = fs::path(testScratchDir("hostile-light-range")) / "unused.gltf";
+    std::ofstream(file) << doc.dump();
+    Warnings warnings;
+    ASSERT_NO_THROW(loadGltfScene(file.string(), warnings));
+    EXPECT_TRUE(warned(warnings, "KHR_lights_punctual.lights[1].range: is 0",
+                       "(KHR_lights_punctual.lights[1] is not in the rendered scene, so it is ignored)"));
+    GltfReadOptions strict;
+    strict.strict = true;
+    try {
+        loadGltfScene(file.string(), warnings, strict);
+        ADD_FAILURE() << "--strict should refuse it";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.place(), "KHR_lights_punctual.lights[1].range");
+    }
 }

@@ -12,10 +12,12 @@
 #include <set>
 
 #include "pipeline/render_options.h"
+#include "pipeline/render_settings.h"
 #include "pipeline/run_fingerprint.h"
 #include "test_support.h"
 #include "util/error.h"
 #include "util/field_count.h"
+#include "util/nearest_name.h"
 
 using namespace qsgi;
 namespace fs = std::filesystem;
@@ -286,4 +288,31 @@ TEST(RenderOptions, EverySettingIsReachableAndTheFieldCountItRestsOnIsExact) {
                                     " --no-aim --photons 2000 --no-exr --quiet --out " +
                                     (fs::path(testScratchDir("no-aim")) / "out").string());
     EXPECT_EQ(r.exitCode, 0) << r.output;
+}
+
+// An unknown config key names the nearest known key, whether it is misspelt or put in other
+// words (docs/command-line.md: "names the nearest known key"); a word that shares nothing with
+// any key gets no guess.
+TEST(RenderOptions, AnUnknownKeyNamesTheNearestKnownKeyMisspeltOrInOtherWords) {
+    std::vector<std::string> keys;
+    for (const RenderOption& o : renderOptions())
+        if (o.key) keys.push_back(o.key);
+    const std::vector<std::pair<std::string, std::string>> typos = {
+        {"photon", "photons"},          {"photon_count", "photons"},   {"num_photons", "photons"},
+        {"photonCount", "photons"},     {"totalphotons", "photons"},   {"num_threads", "threads"},
+        {"thread_count", "threads"},    {"maxBounces", "max_bounces"}, {"max_bounce", "max_bounces"},
+        {"bounces_max", "max_bounces"}, {"image_width", "width"},      {"output_dir", "out"},
+        {"outdir", "out"},              {"exr-half", "exr_half"},      {"seed_value", "seed"},
+        {"estimater", "estimator"},     {"gltf_output", "gltf_out"},   {"detp_boundry", "detp_boundary"}};
+    for (const auto& [typo, key] : typos)
+        EXPECT_EQ(didYouMean(typo, keys), " (did you mean \"" + key + "\"?)") << typo;
+    for (const char* unrelated : {"resolution", "quality", "colour_space"}) EXPECT_EQ(didYouMean(unrelated, keys), "") << unrelated;
+    // The same rule for flags, choices and node names.
+    EXPECT_EQ(didYouMean("--photon-count", {"--photons", "--out", "--threads"}), " (did you mean \"--photons\"?)");
+    EXPECT_EQ(didYouMean("photon_mapping", {"impact-count", "photon-map", "detp"}), " (did you mean \"photon-map\"?)");
+    EXPECT_EQ(didYouMean("Floor_2", {"Lamp", "Floor"}), " (did you mean \"Floor\"?)");
+
+    RenderSettings s;
+    const InputError e = refusal([&] { applyConfigJson("my.json", json{{"photon_count", 1000}}, s); });
+    EXPECT_EQ(std::string(e.what()), "my.json: photon_count: unknown key (did you mean \"photons\"?)");
 }

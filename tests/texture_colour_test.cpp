@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -34,6 +36,18 @@ std::string encoded(const std::string& name, int width, int height, int channels
     EXPECT_TRUE(out->write_image(sizeof(T) == 1 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16, pixels.data()));
     out->close();
     return readFileBytes(path);
+}
+
+std::string base64(const std::string& bytes) {
+    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        uint32_t group = uint32_t(uint8_t(bytes[i])) << 16;
+        if (i + 1 < bytes.size()) group |= uint32_t(uint8_t(bytes[i + 1])) << 8;
+        if (i + 2 < bytes.size()) group |= uint8_t(bytes[i + 2]);
+        for (size_t k = 0; k < 4; ++k) out += i + k <= bytes.size() ? digits[(group >> (18 - 6 * k)) & 63] : '=';
+    }
+    return out;
 }
 
 TextureColour meanOf(const std::string& bytes) {
@@ -123,4 +137,60 @@ TEST(TextureColour, AFlatJpegGivesItsColourWithinOneQuantisationStep) {
     const TextureColour cut = meanOf(bytes.substr(0, bytes.size() / 3));
     EXPECT_FALSE(cut.mean);
     EXPECT_FALSE(cut.problem.empty());
+}
+
+// Valid PNGs a decoder may get wrong (tests/data/good/texture_png_variants.gltf): an Adam7-
+// interlaced one, read pass by pass, every pixel once; and a row of 1,100,000 pixels, wider than
+// libpng's default limit of 10^6 (OpenImageIO refused it, printing "libpng error").
+TEST(TextureColour, InterlacedAndVeryWidePngsGiveTheirMean) {
+    Warnings warnings;
+    const Scene scene = loadGltfScene((sourceDir() / "tests/data/good/texture_png_variants.gltf").string(), warnings);
+    for (const auto& w : warnings.messages) EXPECT_EQ(w.find("materials["), std::string::npos) << w;
+    double sum[3] = {0, 0, 0};
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 5; ++x)
+            for (int c = 0; c < 3; ++c) sum[c] += srgbToLinear(((x * 37 + y * 11 + c * 50) % 256) / 255.0);
+    ASSERT_GE(scene.materials.size(), 2u);
+    EXPECT_FLOAT_EQ(scene.materials[0].albedo.x, float(sum[0] / 15));
+    EXPECT_FLOAT_EQ(scene.materials[0].albedo.y, float(sum[1] / 15));
+    EXPECT_FLOAT_EQ(scene.materials[0].albedo.z, float(sum[2] / 15));
+    EXPECT_FLOAT_EQ(scene.materials[1].albedo.x, float(srgbToLinear(128 / 255.0)));
+    EXPECT_FLOAT_EQ(scene.materials[1].albedo.z, float(srgbToLinear(128 / 255.0)));
+}
+
+// Broken JPEGs go through OpenImageIO, which takes over libjpeg's error and message routines: a
+// file cut short, one with its entropy-coded data scrambled and one whose frame header says 0
+// rows are reported or read, and nothing but qsgi prints, with --quiet or without.
+TEST(TextureColour, BrokenJpegsPrintNothingButQsgisWords) {
+    std::vector<uint8_t> pixels;
+    for (int p = 0; p < 16 * 16; ++p) pixels.insert(pixels.end(), {uint8_t(p), uint8_t(255 - p), 90});
+    const std::string jpeg = encoded("broken.jpg", 16, 16, 3, pixels, 90);
+    std::string scrambled = jpeg;
+    const size_t scan = scrambled.find("\xFF\xDA");
+    ASSERT_NE(scan, std::string::npos);
+    for (size_t i = scan + 20; i + 2 < scrambled.size(); i += 7) scrambled[i] = char(scrambled[i] ^ 0x5A);
+    std::string noRows = jpeg;
+    const size_t frame = noRows.find("\xFF\xC0");
+    ASSERT_NE(frame, std::string::npos);
+    noRows[frame + 5] = 0;  // the frame header's height
+    noRows[frame + 6] = 0;
+    const std::vector<std::string> broken = {jpeg.substr(0, jpeg.size() / 2), scrambled, noRows};
+
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(sourceDir() / "tests/data/good/texture_data_uri.gltf"));
+    doc["images"] = doc["textures"] = doc["materials"] = nlohmann::json::array();
+    for (size_t i = 0; i < broken.size(); ++i) {
+        doc["images"].push_back({{"uri", "data:image/jpeg;base64," + base64(broken[i])}});
+        doc["textures"].push_back({{"source", i}});
+        doc["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", i}}}}}});
+    }
+    const fs::path dir = testScratchDir("texture_colour_jpeg");
+    std::ofstream(dir / "scene.gltf") << doc.dump();
+    const std::string render = "render " + (dir / "scene.gltf").string() + " --photons 1000 --out ";
+    const CommandResult quiet = runQsgi(render + (dir / "quiet").string() + " --quiet");
+    EXPECT_EQ(quiet.exitCode, 0) << quiet.output;
+    EXPECT_EQ(quiet.output, "") << "--quiet prints errors only";
+    const CommandResult loud = runQsgi(render + (dir / "loud").string());
+    EXPECT_EQ(loud.exitCode, 0) << loud.output;
+    std::istringstream lines(loud.output);
+    for (std::string line; std::getline(lines, line);) EXPECT_EQ(line.rfind("qsgi: ", 0), 0u) << line;
 }

@@ -1,6 +1,9 @@
 #include "output/ply_reader.h"
 
+#include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -10,6 +13,7 @@
 namespace qsgi {
 
 namespace {
+
 size_t sizeOfType(const std::string& t) {
     static const std::map<std::string, size_t> sizes = {
         {"char", 1}, {"uchar", 1}, {"int8", 1}, {"uint8", 1}, {"short", 2}, {"ushort", 2}, {"int16", 2},
@@ -30,66 +34,146 @@ double readScalar(const char* p, const std::string& t) {
     if (t == "uint" || t == "uint32") return get(uint32_t());
     return get(int32_t());
 }
+
+struct PlyProperty {
+    std::string name, type;         // type: the scalar's, or the list's items'
+    std::string countType;          // a list's count type; "" for a scalar
+    size_t offset = 0;              // a scalar's byte offset in a vertex row
+};
+
+struct PlyElement {
+    std::string name;
+    uint64_t count = 0;
+    int line = 0;  // of its `element` line
+    std::vector<PlyProperty> properties;
+    // The fewest bytes one element can take: a scalar's size (binary) or two characters, a digit
+    // and a separator (ASCII); a list's count and, for faces, three corners (fewer are refused).
+    uint64_t minimumBytes(bool ascii) const {
+        uint64_t bytes = 0;
+        for (const PlyProperty& p : properties) {
+            const uint64_t item = ascii ? 2 : sizeOfType(p.type);
+            if (p.countType.empty()) bytes += item;
+            else bytes += (ascii ? 2 : sizeOfType(p.countType)) + (name == "face" ? 3 * item : 0);
+        }
+        return bytes;
+    }
+};
+
+// A count in an `element` line: a non-negative decimal integer.
+bool parseCount(const std::string& word, uint64_t& count) {
+    if (word.empty() || word.size() > 19 || word.find_first_not_of("0123456789") != std::string::npos) return false;
+    count = std::stoull(word);
+    return true;
+}
+
+std::string number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
+
+const char* plural(const std::string& element) { return element == "vertex" ? "vertices" : element == "face" ? "faces" : "elements"; }
+
 }  // namespace
 
 VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (fs::is_directory(status)) throw InputError(path, "", "is a directory, not a PLY file");
+    if (fs::exists(status) && !fs::is_regular_file(status))
+        throw InputError(path, "", "is not a regular file (a device, pipe or socket), not a PLY file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, "", "cannot be opened for reading");
+    const uint64_t fileSize = fs::file_size(path, ec);
+    if (ec) throw InputError(path, "", "cannot be read (its size is unknown)");
+
+    // The header: every element with its count and properties, checked before any data is read.
     std::string line;
     if (!std::getline(in, line) || line != "ply") throw InputError(path, "line 1", "not a PLY file");
-    size_t vertexCount = 0, faceCount = 0;
-    bool inVertex = false, inFace = false, binaryLittleEndian = false, sawVertex = false;
-    std::string faceCountType, faceIndexType;
-    struct Property { std::string name, type; size_t offset; };
-    std::vector<Property> properties;
-    size_t stride = 0;
-    int lineNo = 1;
-    while (std::getline(in, line)) {
-        ++lineNo;
+    std::string format;
+    std::vector<PlyElement> elements;
+    bool ended = false;
+    for (int lineNo = 2; std::getline(in, line); ++lineNo) {
+        const std::string at = "line " + std::to_string(lineNo);
         std::istringstream words(line);
         std::string word;
         words >> word;
-        if (word == "end_header") break;
+        if (word == "end_header") {
+            ended = true;
+            break;
+        }
         if (word == "format") {
-            std::string format;
             words >> format;
-            binaryLittleEndian = format == "binary_little_endian";
         } else if (word == "element") {
-            std::string name;
-            words >> name;
-            inVertex = name == "vertex";
-            inFace = name == "face";
-            if (inFace) words >> faceCount;
-            if (inVertex) {
-                if (sawVertex || !properties.empty()) throw InputError(path, "line " + std::to_string(lineNo), "vertex must be the first element");
-                words >> vertexCount;
-                sawVertex = true;
+            PlyElement e;
+            std::string count;
+            words >> e.name >> count;
+            if (!parseCount(count, e.count))
+                throw InputError(path, at, "element '" + e.name + "' needs a count, a non-negative integer ('" +
+                                               count.substr(0, 40) + "' is not one)");
+            e.line = lineNo;
+            if (e.name == "vertex" && !elements.empty()) throw InputError(path, at, "vertex must be the first element");
+            elements.push_back(e);
+        } else if (word == "property") {
+            if (elements.empty()) throw InputError(path, at, "a property before any element");
+            PlyElement& e = elements.back();
+            PlyProperty p;
+            std::string type;
+            words >> type;
+            if (type == "list") {
+                words >> p.countType >> p.type >> p.name;
+                if (sizeOfType(p.countType) == 0 || sizeOfType(p.type) == 0)
+                    throw InputError(path, at, "unsupported list property types '" + p.countType + "' and '" + p.type + "'");
+            } else {
+                words >> p.name;
+                p.type = type;
+                if (sizeOfType(type) == 0) throw InputError(path, at, "unsupported property type '" + type + "'");
             }
-        } else if (word == "property" && inFace) {
-            std::string type, countType, indexType, name;
-            words >> type >> countType >> indexType >> name;
-            if (type != "list" || name != "vertex_indices" || sizeOfType(countType) == 0 || sizeOfType(indexType) == 0)
-                throw InputError(path, "line " + std::to_string(lineNo), "faces must be a single list property vertex_indices");
-            faceCountType = countType;
-            faceIndexType = indexType;
-        } else if (word == "property" && inVertex) {
-            std::string type, name;
-            words >> type >> name;
-            if (type == "list" || sizeOfType(type) == 0)
-                throw InputError(path, "line " + std::to_string(lineNo), "unsupported vertex property type '" + type + "'");
-            properties.push_back({name, type, stride});
-            stride += sizeOfType(type);
+            if (e.name == "vertex" && !p.countType.empty())
+                throw InputError(path, at, "unsupported vertex property type 'list'");
+            if (e.name == "face" && (p.countType.empty() || p.name != "vertex_indices" || !e.properties.empty()))
+                throw InputError(path, at, "faces must be a single list property vertex_indices");
+            e.properties.push_back(p);
         }
     }
-    if (!binaryLittleEndian) throw InputError(path, "header", "only binary_little_endian PLY is read");
-    if (!sawVertex) throw InputError(path, "header", "has no vertex element");
-    auto find = [&](const char* name) -> const Property& {
+    if (!ended) throw InputError(path, "header", "has no end_header line");
+
+    // Every element needs some bytes: counts the file cannot hold are refused before anything is
+    // allocated for them (a header may claim 10^8 vertices in a file of 3 KB).
+    const bool ascii = format == "ascii";
+    const uint64_t headerEnd = uint64_t(in.tellg());
+    const uint64_t remaining = fileSize > headerEnd ? fileSize - headerEnd : 0;
+    uint64_t needed = 0;
+    for (const PlyElement& e : elements) {
+        const uint64_t each = e.minimumBytes(ascii);
+        if (each == 0) continue;
+        if (e.count > (remaining - needed) / each)
+            throw InputError(path, "header, element " + e.name + " (line " + std::to_string(e.line) + ")",
+                             "declares " + std::to_string(e.count) + " " + plural(e.name) + " of at least " +
+                                 std::to_string(each) + " bytes each, but only " + std::to_string(remaining - needed) +
+                                 " bytes of the file's " + std::to_string(fileSize) + " are left for them");
+        needed += e.count * each;
+    }
+    if (format != "binary_little_endian") throw InputError(path, "header", "only binary_little_endian PLY is read");
+    if (elements.empty() || elements[0].name != "vertex") throw InputError(path, "header", "has no vertex element");
+
+    // Vertices: every property of every vertex finite, the nine qsgi reads within float's range.
+    const PlyElement& vertex = elements[0];
+    size_t stride = 0;
+    std::vector<PlyProperty> properties = vertex.properties;
+    for (PlyProperty& p : properties) {
+        p.offset = stride;
+        stride += sizeOfType(p.type);
+    }
+    auto find = [&](const char* name) -> const PlyProperty& {
         for (const auto& p : properties)
             if (p.name == name) return p;
         throw InputError(path, "header", std::string("has no vertex property '") + name + "'");
     };
-    const Property* fields[9] = {&find("x"), &find("y"), &find("z"), &find("nx"), &find("ny"), &find("nz"),
-                                 &find("radiosity_r"), &find("radiosity_g"), &find("radiosity_b")};
+    const PlyProperty* fields[9] = {&find("x"), &find("y"), &find("z"), &find("nx"), &find("ny"), &find("nz"),
+                                    &find("radiosity_r"), &find("radiosity_g"), &find("radiosity_b")};
+    const size_t vertexCount = size_t(vertex.count);
     if (vertexCount > (size_t(1) << 31)) throw InputError(path, "header", "implausible vertex count");
     std::vector<char> data(vertexCount * stride);
     if (!in.read(data.data(), std::streamsize(data.size())))
@@ -100,29 +184,72 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     out.radiosity.resize(vertexCount);
     for (size_t v = 0; v < vertexCount; ++v) {
         const char* row = data.data() + v * stride;
+        for (const PlyProperty& p : properties) {
+            const double value = readScalar(row + p.offset, p.type);
+            if (!std::isfinite(value))
+                throw InputError(path, "vertex " + std::to_string(v),
+                                 "property '" + p.name + "' is " + number(value) + ", not a finite number");
+        }
         float f[9];
-        for (int i = 0; i < 9; ++i) f[i] = float(readScalar(row + fields[i]->offset, fields[i]->type));
+        for (int i = 0; i < 9; ++i) {
+            const double value = readScalar(row + fields[i]->offset, fields[i]->type);
+            f[i] = float(value);
+            if (!std::isfinite(f[i]))
+                throw InputError(path, "vertex " + std::to_string(v),
+                                 "property '" + fields[i]->name + "' is " + number(value) + ", beyond the range of float");
+        }
         out.positions[v] = {f[0], f[1], f[2]};
         out.normals[v] = {f[3], f[4], f[5]};
         out.radiosity[v] = {f[6], f[7], f[8]};
-        if (!isFinite(out.radiosity[v])) throw InputError(path, "vertex " + std::to_string(v), "radiosity is not finite");
     }
-    // Faces (fanned into triangles), for the edge regions of `qsgi compare`.
-    if (faceCount > (size_t(1) << 31)) throw InputError(path, "header", "implausible face count");
-    std::vector<char> buffer(8);
-    for (size_t f = 0; f < faceCount && !faceIndexType.empty(); ++f) {
-        const std::string where = "face " + std::to_string(f);
-        if (!in.read(buffer.data(), std::streamsize(sizeOfType(faceCountType)))) throw InputError(path, where, "file ends here");
-        const double corners = readScalar(buffer.data(), faceCountType);
-        if (!(corners >= 3 && corners <= 255)) throw InputError(path, where, "has fewer than 3 corners");
-        std::vector<uint32_t> index(static_cast<size_t>(corners));
-        for (uint32_t& i : index) {
-            if (!in.read(buffer.data(), std::streamsize(sizeOfType(faceIndexType)))) throw InputError(path, where, "file ends here");
-            const double value = readScalar(buffer.data(), faceIndexType);
-            if (!(value >= 0 && value < double(vertexCount))) throw InputError(path, where, "refers to a vertex that does not exist");
-            i = uint32_t(value);
+
+    // Faces (fanned into triangles), for the edge regions of `qsgi compare`. Elements between the
+    // vertices and the faces are skipped.
+    char buffer[8];
+    for (size_t k = 1; k < elements.size(); ++k) {
+        const PlyElement& e = elements[k];
+        if (e.name == "face" && !e.properties.empty()) {
+            const PlyProperty& list = e.properties[0];
+            for (uint64_t f = 0; f < e.count; ++f) {
+                const std::string where = "face " + std::to_string(f);
+                if (!in.read(buffer, std::streamsize(sizeOfType(list.countType)))) throw InputError(path, where, "file ends here");
+                const double corners = readScalar(buffer, list.countType);
+                if (!(corners >= 3 && corners <= 255)) throw InputError(path, where, "has fewer than 3 corners");
+                std::vector<uint32_t> index(static_cast<size_t>(corners));
+                for (uint32_t& i : index) {
+                    if (!in.read(buffer, std::streamsize(sizeOfType(list.type)))) throw InputError(path, where, "file ends here");
+                    const double value = readScalar(buffer, list.type);
+                    if (!(value >= 0 && value < double(vertexCount)))
+                        throw InputError(path, where, "refers to a vertex that does not exist");
+                    i = uint32_t(value);
+                }
+                for (size_t c = 1; c + 1 < index.size(); ++c) out.triangles.push_back(Triangle{{index[0], index[c], index[c + 1]}});
+            }
+            break;
         }
-        for (size_t k = 1; k + 1 < index.size(); ++k) out.triangles.push_back(Triangle{{index[0], index[k], index[k + 1]}});
+        bool lists = false;
+        size_t scalarBytes = 0;
+        for (const PlyProperty& p : e.properties) {
+            lists = lists || !p.countType.empty();
+            scalarBytes += sizeOfType(p.type);
+        }
+        if (!lists) {  // fixed-size elements in one step (the header check bounds the product)
+            in.seekg(std::streamoff(e.count * scalarBytes), std::ios::cur);
+            continue;
+        }
+        for (uint64_t i = 0; i < e.count; ++i)
+            for (const PlyProperty& p : e.properties) {
+                uint64_t items = 1;
+                if (!p.countType.empty()) {
+                    if (!in.read(buffer, std::streamsize(sizeOfType(p.countType))))
+                        throw InputError(path, e.name + " " + std::to_string(i), "file ends here");
+                    const double n = readScalar(buffer, p.countType);
+                    if (!(n >= 0)) throw InputError(path, e.name + " " + std::to_string(i), "a list has a negative length");
+                    items = uint64_t(n);
+                }
+                in.seekg(std::streamoff(items * sizeOfType(p.type)), std::ios::cur);
+                if (!in) throw InputError(path, e.name + " " + std::to_string(i), "file ends here");
+            }
     }
     return out;
 }

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <set>
 
 #include "util/json_file.h"
 
@@ -302,6 +304,118 @@ bool keepEncodedImage(tinygltf::Image* image, int, std::string*, std::string*, i
     return true;
 }
 
+// ---- The files a glTF's uris name ----
+// tinygltf's own reader opens whatever a path names: a pipe blocks it for ever, and a directory
+// opens, seeks to an "end" of 2^63 - 1 and has that many bytes allocated. Its file callbacks are
+// replaced by these, which read a file only if it is a regular file of sane size and keep why
+// any other was not read, for the messages.
+
+constexpr uint64_t kMaxBufferFileBytes = uint64_t(1) << 32;  // glTF's limit for a binary glTF
+constexpr uint64_t kMaxImageFileBytes = uint64_t(1) << 31;   // tinygltf hands image bytes on with an int size
+
+struct UriFiles {
+    std::string baseDir;
+    std::set<std::string> imagePaths;             // the paths images' uris resolve to
+    std::map<std::string, std::string> problems;  // a path not read -> why ("names a directory, …")
+};
+
+// A uri as tinygltf turns it into a file name (its dlib::urldecode: %XX is a byte, '+' a space).
+std::string uriFileName(const std::string& uri) {
+    auto hex = [](char c) {
+        return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : 0;
+    };
+    std::string name;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '+') {
+            name += ' ';
+        } else if (uri[i] == '%' && uri.size() > i + 2) {
+            name += char((hex(uri[i + 1]) << 4) | hex(uri[i + 2]));
+            i += 2;
+        } else {
+            name += uri[i];
+        }
+    }
+    return name;
+}
+
+// The paths tinygltf looks for a uri's file at, in its order: beside the glTF file, then in the
+// working directory (its FindFile and JoinPath).
+std::vector<std::string> uriFilePaths(const std::string& baseDir, const std::string& uri) {
+    const std::string name = uriFileName(uri);
+    auto join = [&](const std::string& dir) {
+        return dir.empty() ? name : dir.back() == '/' ? dir + name : dir + "/" + name;
+    };
+    return {join(baseDir), join(".")};
+}
+
+// "" if `path` is a regular file of 1 to `limit` - 1 bytes (its size in `size`); else why not, as
+// what the uri names.
+std::string uriFileProblem(const std::string& path, uint64_t limit, uint64_t& size) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (!fs::exists(status)) return "names no file";
+    if (fs::is_directory(status)) return "names a directory, not a file";
+    if (!fs::is_regular_file(status)) return "names a device, pipe or socket, not a regular file";
+    size = fs::file_size(path, ec);
+    if (ec) return "names a file that cannot be read (" + ec.message() + ")";
+    if (size == 0) return "names an empty file";
+    if (size >= limit)
+        return "names a file of " + std::to_string(size) + " bytes, beyond the " +
+               (limit == kMaxImageFileBytes ? "2 GiB qsgi reads for an image" : "4 GiB qsgi reads for a buffer");
+    return "";
+}
+
+bool uriFileExists(const std::string& path, void*) {
+    std::error_code ec;
+    return fs::exists(path, ec);  // by its status: opening a pipe to try it would block
+}
+
+std::string uriFileExpand(const std::string& path, void*) { return path; }  // no ~ or $ expansion, as tinygltf's
+
+bool uriFileRead(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    UriFiles& files = *static_cast<UriFiles*>(user);
+    uint64_t size = 0;
+    std::string problem = uriFileProblem(path, files.imagePaths.count(path) ? kMaxImageFileBytes : kMaxBufferFileBytes, size);
+    if (problem.empty()) {
+        std::ifstream in(path, std::ios::binary);
+        out->resize(size_t(size));
+        if (!in || !in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size)))
+            problem = "names a file that cannot be read";
+    }
+    if (problem.empty()) return true;
+    files.problems[path] = problem;
+    if (err) *err += problem;
+    return false;
+}
+
+bool uriFileWrite(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err += "qsgi writes no file while reading a glTF";
+    return false;
+}
+
+// Why the file of `uri` was not read: what the reader found, else that it is nowhere tinygltf looks.
+std::string uriReadProblem(const UriFiles& files, const std::string& uri) {
+    for (const std::string& path : uriFilePaths(files.baseDir, uri)) {
+        auto found = files.problems.find(path);
+        if (found != files.problems.end()) return found->second;
+    }
+    return "names no file (looked beside the glTF file)";
+}
+
+// tinygltf's warnings about an image file it could not read: the loader says the same in its own
+// words, for the images a material uses.
+bool isImageFileWarning(const std::string& line) {
+    for (const char* start : {"File not found : ", "File read error : ", "File is empty : ",
+                              "Failed to load external 'uri' for image[", "Image data is empty for image["})
+        if (line.rfind(start, 0) == 0) return true;
+    return false;
+}
+
+bool isFileUri(const json& item) {
+    return item.is_object() && item.contains("uri") && item["uri"].is_string() &&
+           item["uri"].get<std::string>().rfind("data:", 0) != 0;
+}
+
 std::string firstLine(const std::string& s) {
     std::string out = s.substr(0, s.find('\n'));
     return out.empty() ? s : out;
@@ -372,8 +486,15 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
         }
     }
 
+    UriFiles files;
+    files.baseDir = baseDir;
+    if (doc.contains("images") && doc["images"].is_array())
+        for (const json& image : doc["images"])
+            if (isFileUri(image))
+                for (const std::string& p : uriFilePaths(baseDir, image["uri"].get<std::string>())) files.imagePaths.insert(p);
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(keepEncodedImage, nullptr);
+    loader.SetFsCallbacks({uriFileExists, uriFileExpand, uriFileRead, uriFileWrite, &files});
     std::string err, warn;
     bool ok = false;
     try {
@@ -383,11 +504,32 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     } catch (const std::exception& e) {
         throw InputError(path, "", std::string("not a readable glTF file: ") + e.what());
     }
-    if (!ok) throw InputError(path, "", "not a valid glTF file: " + firstLine(err.empty() ? warn : err));
+    if (!ok) {
+        // A buffer's file that could not be read, named by its place.
+        if (doc.contains("buffers") && doc["buffers"].is_array())
+            for (size_t i = 0; i < doc["buffers"].size(); ++i) {
+                const json& buffer = doc["buffers"][i];
+                if (!isFileUri(buffer)) continue;
+                const std::string uri = buffer["uri"].get<std::string>();
+                const std::vector<std::string> paths = uriFilePaths(baseDir, uri);
+                const auto read = std::find_if(paths.begin(), paths.end(), [](const std::string& p) { return uriFileExists(p, nullptr); });
+                if (read == paths.end() || files.problems.count(*read))
+                    throw InputError(path, "buffers[" + std::to_string(i) + "].uri", "'" + uri.substr(0, 200) + "' " +
+                                                                                        uriReadProblem(files, uri));
+            }
+        throw InputError(path, "", "not a valid glTF file: " + firstLine(err.empty() ? warn : err));
+    }
+    if (doc.contains("images") && doc["images"].is_array())
+        for (size_t i = 0; i < doc["images"].size() && i < out.model.images.size(); ++i) {
+            const tinygltf::Image& image = out.model.images[i];
+            if (isFileUri(doc["images"][i]) && image.bufferView < 0 && image.image.empty())
+                out.unreadableImages[int(i)] = uriReadProblem(files, doc["images"][i]["uri"].get<std::string>());
+        }
     for (size_t start = 0; start < warn.size();) {
         size_t end = warn.find('\n', start);
         if (end == std::string::npos) end = warn.size();
-        if (end > start) warnings.add(path + ": " + warn.substr(start, end - start));
+        if (end > start && !isImageFileWarning(warn.substr(start, end - start)))
+            warnings.add(path + ": " + warn.substr(start, end - start));
         start = end + 1;
     }
     return out;

@@ -2,6 +2,8 @@
 // specification that tinygltf does not enforce, and the valid constructs it refuses:
 //   - asset.version must be 2.x and asset.minVersion at most 2.0;
 //   - buffers and images are local files or data URIs: a remote URI (http:, https:, …) is refused;
+//     a uri's file is read only if it is a regular file of sane size (never a directory, a pipe or
+//     a device): an unreadable buffer is refused, an unreadable image recorded in unreadableImages;
 //   - a buffer without a uri (other than a GLB's BIN chunk) is valid as long as nothing reads it;
 //     tinygltf refuses the whole file, so such buffers are handed to it as a 1-byte placeholder and
 //     listed in absentBuffers, and any read through them is refused by the accessor reader.
@@ -11,6 +13,7 @@
 
 #include <tiny_gltf.h>
 
+#include <map>
 #include <set>
 #include <string>
 
@@ -25,6 +28,9 @@ struct GltfDocument {
     // Broken references, empty arrays and cameras with two projections, wherever they are: the
     // loader refuses those in objects the render reads and warns about the others.
     std::vector<GltfFinding> findings;
+    // Images whose uri's file was not read, and why ("is a directory, not a file"): the loader
+    // warns about the ones a material uses and leaves their factor alone.
+    std::map<int, std::string> unreadableImages;
 };
 
 // Throws InputError naming the file and the place in it; tinygltf's own warnings go to warnings.

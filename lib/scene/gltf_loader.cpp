@@ -78,9 +78,11 @@ const AccessorFormat kIndexFormat{
 // Textures and Materials
 
 // The mean colour of texture `textureIndex`, decoded from a buffer view or from the bytes of its
-// uri's file that gltf_document.cpp kept.
-TextureColour textureColour(const tinygltf::Model& model, const AccessorReader& reader, int textureIndex,
-                            const std::string& usedBy) {
+// uri's file that gltf_document.cpp kept (or, if it could not read them, why not). The image is
+// added to `decoded`.
+TextureColour textureColour(const GltfDocument& document, const AccessorReader& reader, int textureIndex,
+                            const std::string& usedBy, std::set<int>& decoded) {
+    const tinygltf::Model& model = document.model;
     TextureColour none;
     if (textureIndex < 0 || textureIndex >= int(model.textures.size())) {
         none.problem = "refers to texture " + std::to_string(textureIndex) + ", which does not exist";
@@ -93,6 +95,7 @@ TextureColour textureColour(const tinygltf::Model& model, const AccessorReader& 
     }
     const tinygltf::Image& image = model.images[source];
     const std::string imagePlace = gltfPlace("images", source);
+    decoded.insert(source);
     TextureColour colour;
     if (image.bufferView >= 0) {
         const auto bytes = reader.viewBytes(image.bufferView, usedBy + " -> " + imagePlace);
@@ -100,7 +103,10 @@ TextureColour textureColour(const tinygltf::Model& model, const AccessorReader& 
     } else if (!image.image.empty()) {
         colour = meanTextureColour(image.image.data(), image.image.size());
     } else {
-        colour.problem = "its file '" + image.uri.substr(0, 200) + "' could not be read";
+        const auto why = document.unreadableImages.find(source);
+        colour.problem = imagePlace + ".uri '" + image.uri.substr(0, 200) + "' " +
+                         (why != document.unreadableImages.end() ? why->second : "could not be read");
+        return colour;
     }
     if (!colour.mean) colour.problem = imagePlace + " " + colour.problem;
     return colour;
@@ -110,9 +116,9 @@ Vec3f vec3FromFactor(const std::vector<double>& f, Vec3f fallback) {
     return f.size() >= 3 ? Vec3f(float(f[0]), float(f[1]), float(f[2])) : fallback;
 }
 
-Material convertMaterial(const tinygltf::Model& model, const AccessorReader& reader, int index, const std::string& file,
-                         Warnings& warnings) {
-    const tinygltf::Material& m = model.materials[index];
+Material convertMaterial(const GltfDocument& document, const AccessorReader& reader, int index, const std::string& file,
+                         Warnings& warnings, std::set<int>& decodedImages) {
+    const tinygltf::Material& m = document.model.materials[index];
     const std::string place = gltfPlace("materials", index);
     Material out;
     out.name = m.name;
@@ -124,7 +130,7 @@ Material convertMaterial(const tinygltf::Model& model, const AccessorReader& rea
         throw InputError(file, place + ".pbrMetallicRoughness.baseColorFactor", "must lie in [0, 1] (glTF 2.0)");
     if (pbr.baseColorTexture.index >= 0) {
         const std::string texturePlace = place + ".pbrMetallicRoughness.baseColorTexture";
-        const TextureColour base = textureColour(model, reader, pbr.baseColorTexture.index, texturePlace);
+        const TextureColour base = textureColour(document, reader, pbr.baseColorTexture.index, texturePlace, decodedImages);
         if (base.mean) out.albedo = out.albedo * *base.mean;
         else warnings.add(file + ": " + texturePlace + ": " + base.problem + "; using baseColorFactor alone");
     }
@@ -134,7 +140,7 @@ Material convertMaterial(const tinygltf::Model& model, const AccessorReader& rea
     Vec3f emissive = vec3FromFactor(m.emissiveFactor, Vec3f(0.0f));
     if (m.emissiveTexture.index >= 0 && maxComponent(emissive) > 0) {
         const std::string texturePlace = place + ".emissiveTexture";
-        const TextureColour texture = textureColour(model, reader, m.emissiveTexture.index, texturePlace);
+        const TextureColour texture = textureColour(document, reader, m.emissiveTexture.index, texturePlace, decodedImages);
         if (texture.mean) emissive = emissive * *texture.mean;
         else warnings.add(file + ": " + texturePlace + ": " + texture.problem + "; using emissiveFactor alone");
     }
@@ -261,8 +267,8 @@ std::vector<uint32_t> triangleIndices(int mode, const std::vector<uint32_t>& idx
 class SceneBuilder {
 public:
     SceneBuilder(const GltfDocument& document, const std::string& file, Warnings& warnings, const GltfReadOptions& options)
-        : model_(document.model), findings_(document.findings), file_(file), warnings_(warnings), options_(options),
-          reader_(document, file) {}
+        : document_(document), model_(document.model), findings_(document.findings), file_(file), warnings_(warnings),
+          options_(options), reader_(document, file) {}
 
     Scene build() {
         Scene scene;
@@ -271,7 +277,7 @@ public:
         scene.nodes = buildHierarchy(model_, file_, nodeErrors);
         for (size_t i = 0; i < model_.materials.size(); ++i) {
             try {
-                scene.materials.push_back(convertMaterial(model_, reader_, int(i), file_, warnings_));
+                scene.materials.push_back(convertMaterial(document_, reader_, int(i), file_, warnings_, decodedImages_));
             } catch (const InputError& e) {
                 materialErrors.emplace(int(i), e);  // refused below if a rendered primitive uses it
                 scene.materials.push_back(Material{"(unusable)", Vec3f(1.0f), Vec3f(0.0f)});
@@ -339,6 +345,13 @@ public:
             if (used.contains(f.object)) throw e;
             unusedObjectError(e, f.object);
         }
+        // An image whose file could not be read: the material decoding it has warned and kept its
+        // factor (docs/inputs.md); one no material decodes is an object nothing reads.
+        for (const auto& [image, why] : document_.unreadableImages)
+            if (!decodedImages_.count(image))
+                unusedObjectError(InputError(file_, gltfPlace("images", image) + ".uri",
+                                             "'" + model_.images[size_t(image)].uri.substr(0, 200) + "' " + why),
+                                  gltfPlace("images", image));
         scene.finalize();
         checkSceneExtent(scene.positions, scene.bounds(), file_, "nodes");
         return scene;
@@ -396,6 +409,7 @@ private:
                 add("buffers", model_.bufferViews[v].buffer);
             }
         for (const auto& [gltfSkin, sceneSkin] : skinOf_) add("skins", gltfSkin);
+        for (int l : usedLights_) add("KHR_lights_punctual.lights", l);
         for (size_t c = 0; c < scene.cameras.size(); ++c)
             if (scene.cameras[c]) add("cameras", int(c));
         for (size_t a = 0; a < model_.animations.size(); ++a) add("animations", int(a));  // all are read
@@ -681,25 +695,40 @@ private:
                 throw InputError(file_, place + ".material", "refers to material " + std::to_string(prim.material) + ", which does not exist");
             material = uint32_t(prim.material);
             usedMaterials_.insert(prim.material);
-            // Every texture of the material reads a TEXCOORD_n set the primitive has (glTF 2.0 §3.9.6).
+            // Every texture of the material reads a TEXCOORD_n set the primitive has (glTF 2.0
+            // §3.9.6): its textureInfo's texCoord, or the KHR_texture_transform's that overrides it.
             const tinygltf::Material& m = model_.materials[size_t(prim.material)];
             struct TextureUse {
                 const char* name;
                 int index, texCoord;
+                const tinygltf::ExtensionMap& extensions;
             };
+            const auto& pbr = m.pbrMetallicRoughness;
             const TextureUse textures[] = {
-                {"pbrMetallicRoughness.baseColorTexture", m.pbrMetallicRoughness.baseColorTexture.index,
-                 m.pbrMetallicRoughness.baseColorTexture.texCoord},
-                {"pbrMetallicRoughness.metallicRoughnessTexture", m.pbrMetallicRoughness.metallicRoughnessTexture.index,
-                 m.pbrMetallicRoughness.metallicRoughnessTexture.texCoord},
-                {"emissiveTexture", m.emissiveTexture.index, m.emissiveTexture.texCoord},
-                {"normalTexture", m.normalTexture.index, m.normalTexture.texCoord},
-                {"occlusionTexture", m.occlusionTexture.index, m.occlusionTexture.texCoord}};
+                {"pbrMetallicRoughness.baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                 pbr.baseColorTexture.extensions},
+                {"pbrMetallicRoughness.metallicRoughnessTexture", pbr.metallicRoughnessTexture.index,
+                 pbr.metallicRoughnessTexture.texCoord, pbr.metallicRoughnessTexture.extensions},
+                {"emissiveTexture", m.emissiveTexture.index, m.emissiveTexture.texCoord, m.emissiveTexture.extensions},
+                {"normalTexture", m.normalTexture.index, m.normalTexture.texCoord, m.normalTexture.extensions},
+                {"occlusionTexture", m.occlusionTexture.index, m.occlusionTexture.texCoord, m.occlusionTexture.extensions}};
             const int textureCount = int(model_.textures.size());  // a texture that does not exist is a finding
-            for (const auto& [name, index, texCoord] : textures)
-                if (index >= 0 && index < textureCount && !prim.attributes.count("TEXCOORD_" + std::to_string(texCoord)))
-                    throw InputError(file_, place, "has no TEXCOORD_" + std::to_string(texCoord) + ", which " +
-                                                       gltfPlace("materials", prim.material) + "." + name + " reads");
+            for (const TextureUse& t : textures) {
+                if (t.index < 0 || t.index >= textureCount) continue;
+                std::string reader = gltfPlace("materials", prim.material) + "." + t.name;
+                int texCoord = t.texCoord;
+                auto transform = t.extensions.find("KHR_texture_transform");
+                if (transform != t.extensions.end() && transform->second.Has("texCoord")) {
+                    reader += ".extensions.KHR_texture_transform.texCoord";
+                    const tinygltf::Value& v = transform->second.Get("texCoord");
+                    const double set = v.IsNumber() ? v.GetNumberAsDouble() : -1;
+                    if (!(set >= 0 && set <= 2147483647.0 && std::floor(set) == set))
+                        throw InputError(file_, reader, "must be a non-negative integer (the TEXCOORD set the transformed texture reads)");
+                    texCoord = int(set);
+                }
+                if (!prim.attributes.count("TEXCOORD_" + std::to_string(texCoord)))
+                    throw InputError(file_, place, "has no TEXCOORD_" + std::to_string(texCoord) + ", which " + reader + " reads");
+            }
         }
 
         std::vector<Vec3f> objectPositions(vertexCount);
@@ -1000,6 +1029,7 @@ private:
         const int index = ref.GetNumberAsInt();
         if (index < 0 || index >= int(model_.lights.size()))
             throw InputError(file_, place, "refers to light " + std::to_string(index) + ", which does not exist");
+        if (!readingUnusedObjects_) usedLights_.insert(index);
         const tinygltf::Light& l = model_.lights[index];
         PunctualLight out;
         out.name = l.name.empty() ? "light " + std::to_string(index) : l.name;
@@ -1029,6 +1059,7 @@ private:
         scene.lights.push_back(out);
     }
 
+    const GltfDocument& document_;
     const tinygltf::Model& model_;
     const std::vector<GltfFinding>& findings_;
     const std::string& file_;
@@ -1036,7 +1067,8 @@ private:
     GltfReadOptions options_;
     AccessorReader reader_;
     std::map<int, int> skinOf_;  // glTF skin -> Scene::skins
-    std::set<int> usedMeshes_, usedMaterials_;
+    std::set<int> usedMeshes_, usedMaterials_, usedLights_;
+    std::set<int> decodedImages_;  // the images materials' textures decoded (convertMaterial)
     std::set<std::vector<int>> warnedWeights_;  // the WEIGHTS_n accessors already warned about (addInfluences)
     bool readingUnusedObjects_ = false;         // within checkUnusedObjects
     uint32_t defaultMaterial_ = 0;

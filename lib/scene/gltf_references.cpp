@@ -120,6 +120,20 @@ public:
                     add(at, at + "." + projection, std::string("is given but the camera's type is '") + type +
                                                         "' (glTF allows only the projection its type names)");
         });
+        // KHR_lights_punctual: a range, where given, is a positive number (its schema's
+        // exclusiveMinimum 0). tinygltf reads an absent range as 0, so only the JSON tells them apart.
+        if (doc_.contains("extensions") && doc_["extensions"].is_object() && doc_["extensions"].contains("KHR_lights_punctual")) {
+            const json& ext = doc_["extensions"]["KHR_lights_punctual"];
+            if (ext.is_object() && ext.contains("lights") && ext["lights"].is_array())
+                for (size_t l = 0; l < ext["lights"].size(); ++l) {
+                    const json& light = ext["lights"][l];
+                    const std::string at = "KHR_lights_punctual.lights[" + std::to_string(l) + "]";
+                    if (light.is_object() && light.contains("range") &&
+                        !(light["range"].is_number() && light["range"].get<double>() > 0))
+                        add(at, at + ".range", "is " + light["range"].dump().substr(0, 40) +
+                                                   "; a light's range must be a positive number (omit it for no limit)");
+                }
+        }
         // Top-level arrays, when present, hold at least one object (glTF 2.0 schema, minItems 1).
         for (const char* array : {"accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials",
                                   "meshes", "nodes", "samplers", "scenes", "skins", "textures"})

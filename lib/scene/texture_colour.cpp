@@ -2,8 +2,12 @@
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <png.h>
 
+#include <algorithm>
 #include <cmath>
+#include <csetjmp>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -12,30 +16,13 @@ namespace {
 
 double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 
-// The container's signature decides the reader (the mimeType and the file name may lie); OIIO
-// picks its plugin by the name's extension, so the name handed to it is only "texture.png" or
-// "texture.jpg".
+// The container's signature decides the reader (the mimeType and the file name may lie).
 const char* extensionOf(const unsigned char* bytes, size_t size) {
     static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     static const unsigned char jpeg[3] = {0xFF, 0xD8, 0xFF};
     if (size >= sizeof png && std::memcmp(bytes, png, sizeof png) == 0) return "png";
     if (size >= sizeof jpeg && std::memcmp(bytes, jpeg, sizeof jpeg) == 0) return "jpg";
     return nullptr;
-}
-
-// A PNG's chunks (length, type, data, CRC) must all lie inside the bytes and end with IEND. libpng
-// says the same of a truncated file, but on stderr as well as to OIIO; a cut-off download is the
-// commonest broken texture, so it is caught here, quietly.
-bool pngChunksComplete(const unsigned char* bytes, size_t size) {
-    size_t at = 8;
-    while (at + 12 <= size) {
-        const uint64_t length = (uint64_t(bytes[at]) << 24) | (uint64_t(bytes[at + 1]) << 16) |
-                                (uint64_t(bytes[at + 2]) << 8) | uint64_t(bytes[at + 3]);
-        if (length > size - at - 12) return false;
-        if (std::memcmp(bytes + at + 4, "IEND", 4) == 0) return true;
-        at += 12 + size_t(length);
-    }
-    return false;
 }
 
 // OIIO's messages may span lines; a warning is one.
@@ -46,29 +33,203 @@ std::string oneLine(std::string text) {
     return text;
 }
 
-}  // namespace
+std::string tooManyPixels(uint64_t width, uint64_t height) {
+    return "is " + std::to_string(width) + " x " + std::to_string(height) +
+           " pixels, more than qsgi decodes (16384 x 16384); skipped";
+}
 
-TextureColour meanTextureColour(const unsigned char* bytes, size_t size) {
+// The sum of the pixels' linear colours. 8-bit values go through a table of the sRGB curve, and
+// so do 16-bit ones (one pow per possible value, not per pixel).
+class LinearSum {
+public:
+    explicit LinearSum(bool sixteen) : sixteen_(sixteen), linear_(sixteen ? 65536 : 256) {
+        for (size_t v = 0; v < linear_.size(); ++v) linear_[v] = srgbToLinear(double(v) / double(linear_.size() - 1));
+    }
+    // `pixels` pixels of `channels` interleaved values (grey is one channel: it counts for all
+    // three); 16-bit values in the given byte order.
+    void addRow(const unsigned char* row, size_t pixels, int channels, bool bigEndian) {
+        for (size_t x = 0; x < pixels; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const size_t at = x * size_t(channels) + size_t(channels >= 3 ? c : 0);
+                size_t value = row[at];
+                if (sixteen_) {
+                    const unsigned char* v = row + 2 * at;
+                    value = bigEndian ? (size_t(v[0]) << 8 | v[1]) : (size_t(v[1]) << 8 | v[0]);
+                }
+                sum_[c] += linear_[value];
+            }
+    }
+    Vec3f mean(double pixels) const {
+        return Vec3f(float(sum_[0] / pixels), float(sum_[1] / pixels), float(sum_[2] / pixels));
+    }
+
+private:
+    bool sixteen_;
+    std::vector<double> linear_;
+    double sum_[3] = {0, 0, 0};
+};
+
+// ---- PNG ----
+// PNGs are decoded with libpng directly, under qsgi's own error handler. OpenImageIO's PNG reader
+// (2.4) installs an error handler that returns, so libpng falls back to its default one, which
+// prints "libpng error: …" on stderr for every broken file (a bad header, a CRC or zlib error,
+// data that ends early, a width past libpng's default limit), whatever --quiet says. Here an error
+// jumps back with its message and nothing is printed; warnings are dropped. The header is checked
+// first, so the common faults are reported in qsgi's words.
+
+uint32_t bigEndian32(const unsigned char* p) {
+    return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
+}
+
+struct PngHeader {
+    uint32_t width = 0, height = 0;
+    int bitDepth = 0, colourType = 0, compression = 0, filter = 0, interlace = 0;
+};
+
+// Why the PNG is not one libpng reads, in qsgi's words; "" if its structure is sound. Its chunks
+// lie inside the bytes and end with IEND (a cut-off download is the commonest broken texture),
+// and IHDR, the first, holds values PNG defines (PNG specification §11.2.2).
+std::string pngHeaderProblem(const unsigned char* bytes, size_t size, PngHeader& h) {
+    size_t at = 8;
+    bool ended = false;
+    while (!ended && at + 12 <= size) {
+        const uint64_t length = bigEndian32(bytes + at);
+        if (length > size - at - 12) break;
+        ended = std::memcmp(bytes + at + 4, "IEND", 4) == 0;
+        at += 12 + size_t(length);
+    }
+    if (!ended) return "is a truncated PNG (its chunks end before IEND)";
+    if (bigEndian32(bytes + 8) != 13 || std::memcmp(bytes + 12, "IHDR", 4) != 0)
+        return "is a PNG without its header (IHDR, 13 bytes, must be the first chunk)";
+    const unsigned char* ihdr = bytes + 16;
+    h = {bigEndian32(ihdr), bigEndian32(ihdr + 4), ihdr[8], ihdr[9], ihdr[10], ihdr[11], ihdr[12]};
+    const uint32_t most = 0x7FFFFFFF;
+    if (h.width == 0 || h.height == 0 || h.width > most || h.height > most)
+        return "is a PNG of " + std::to_string(h.width) + " x " + std::to_string(h.height) +
+               " pixels (IHDR: width and height must lie in 1..2^31-1)";
+    static const std::pair<int, int> depths[] = {{0, 0x1F}, {2, 0x18}, {3, 0x0F}, {4, 0x18}, {6, 0x18}};  // bits: 1 2 4 8 16
+    const std::string colourDepth = "colour type " + std::to_string(h.colourType) + " with bit depth " + std::to_string(h.bitDepth);
+    bool allowed = false, knownType = false;
+    for (const auto& [type, mask] : depths)
+        if (type == h.colourType) {
+            knownType = true;
+            for (int bit = 0; bit < 5; ++bit) allowed = allowed || ((mask >> bit & 1) && h.bitDepth == 1 << bit);
+        }
+    if (!knownType) return "is a PNG of IHDR colour type " + std::to_string(h.colourType) + ", which PNG does not define";
+    if (!allowed) return "is a PNG of IHDR " + colourDepth + ", a combination PNG does not allow";
+    if (h.compression != 0)
+        return "is a PNG of IHDR compression method " + std::to_string(h.compression) + " (PNG defines only 0, deflate)";
+    if (h.filter != 0) return "is a PNG of IHDR filter method " + std::to_string(h.filter) + " (PNG defines only 0)";
+    if (h.interlace > 1)
+        return "is a PNG of IHDR interlace method " + std::to_string(h.interlace) + " (PNG defines 0, none, and 1, Adam7)";
+    return "";
+}
+
+// libpng's read state over bytes in memory, destroyed however decoding ends.
+struct PngDecoder {
+    const unsigned char* bytes;
+    size_t size, at = 0;
+    char error[256] = "";  // libpng's message, when it stopped
+    png_structp png = nullptr;
+    png_infop info = nullptr;
+    PngDecoder(const unsigned char* b, size_t s) : bytes(b), size(s) {}
+    PngDecoder(const PngDecoder&) = delete;
+    PngDecoder& operator=(const PngDecoder&) = delete;
+    ~PngDecoder() {
+        if (png) png_destroy_read_struct(&png, info ? &info : nullptr, nullptr);
+    }
+};
+
+void pngStop(png_structp png, png_const_charp message) {
+    PngDecoder& d = *static_cast<PngDecoder*>(png_get_error_ptr(png));
+    std::snprintf(d.error, sizeof d.error, "%s", message ? message : "unknown error");
+    png_longjmp(png, 1);  // never returns to libpng, which would print the message
+}
+
+void pngIgnoreWarning(png_structp, png_const_charp) {}
+
+void pngReadBytes(png_structp png, png_bytep out, size_t length) {
+    PngDecoder& d = *static_cast<PngDecoder*>(png_get_io_ptr(png));
+    if (length > d.size - d.at) png_error(png, "the data ends early");
+    std::memcpy(out, d.bytes + d.at, length);
+    d.at += length;
+}
+
+// Runs `work` (libpng calls, and no object with a destructor of its own, since an error jumps
+// over its frame); false if libpng stopped with an error.
+template <typename Work>
+bool withPngErrors(PngDecoder& d, Work&& work) {
+    if (setjmp(png_jmpbuf(d.png))) return false;
+    work();
+    return true;
+}
+
+TextureColour meanPngColour(const unsigned char* bytes, size_t size) {
     TextureColour out;
-    const char* extension = extensionOf(bytes, size);
-    if (!extension) {
-        out.problem = "is neither PNG nor JPEG (the image formats glTF 2.0 allows)";
+    PngHeader header;
+    out.problem = pngHeaderProblem(bytes, size, header);
+    if (!out.problem.empty()) return out;
+    if (uint64_t(header.width) * header.height > kMaxTexturePixels) {
+        out.problem = tooManyPixels(header.width, header.height);
         return out;
     }
-    if (std::strcmp(extension, "png") == 0 && !pngChunksComplete(bytes, size)) {
-        out.problem = "is a truncated PNG (its chunks end before IEND)";
+    PngDecoder d(bytes, size);
+    d.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &d, pngStop, pngIgnoreWarning);
+    if (d.png) d.info = png_create_info_struct(d.png);
+    if (!d.png || !d.info) {
+        out.problem = "cannot be decoded: libpng could not start";
         return out;
     }
+    png_set_read_fn(d.png, &d, pngReadBytes);
+    // libpng refuses more than 10^6 pixels a side by default; the pixel count is qsgi's limit.
+    png_set_user_limits(d.png, 0x7FFFFFFF, 0x7FFFFFFF);
+    int channels = 0;
+    size_t rowBytes = 0;
+    if (withPngErrors(d, [&] {
+            png_read_info(d.png, d.info);
+            png_set_expand(d.png);  // palette to RGB, grey below 8 bits to 8, tRNS to alpha
+            png_read_update_info(d.png, d.info);
+            channels = png_get_channels(d.png, d.info);
+            rowBytes = png_get_rowbytes(d.png, d.info);
+        })) {
+        LinearSum sum(header.bitDepth == 16);
+        std::vector<unsigned char> row(rowBytes);
+        // A row at a time; an interlaced image pass by pass, its rows as the pass holds them
+        // (each pixel lies in exactly one pass), so memory stays at one row.
+        if (withPngErrors(d, [&] {
+                for (int pass = 0; pass < (header.interlace ? 7 : 1); ++pass) {
+                    const uint32_t cols = header.interlace ? PNG_PASS_COLS(header.width, pass) : header.width;
+                    const uint32_t rows = header.interlace ? PNG_PASS_ROWS(header.height, pass) : header.height;
+                    if (cols == 0) continue;  // libpng skips such passes
+                    for (uint32_t r = 0; r < rows; ++r) {
+                        png_read_row(d.png, row.data(), nullptr);
+                        sum.addRow(row.data(), cols, channels, true);
+                    }
+                }
+            })) {
+            out.mean = sum.mean(double(header.width) * double(header.height));
+            return out;
+        }
+    }
+    out.problem = std::string("is a corrupt PNG (libpng: ") + d.error + ")";
+    return out;
+}
+
+// ---- JPEG ----
+// Through OpenImageIO, whose JPEG reader takes over both of libjpeg's message routines
+// (error_exit and output_message), so libjpeg prints nothing.
+TextureColour meanJpegColour(const unsigned char* bytes, size_t size) {
+    TextureColour out;
     OIIO::Filesystem::IOMemReader memory(bytes, size);
-    auto input = OIIO::ImageInput::create(extension);
+    // OIIO picks its plugin by the name's extension, so the name handed to it is "texture.jpg".
+    auto input = OIIO::ImageInput::create("jpg");
     if (!input || !input->supports("ioproxy") || !input->set_ioproxy(&memory)) {
-        out.problem = std::string("cannot be decoded: this OpenImageIO cannot read ") + extension + " from memory";
+        out.problem = "cannot be decoded: this OpenImageIO cannot read jpg from memory";
         return out;
     }
-    // Colour as stored: OIIO would otherwise multiply it by alpha (associate it) on reading.
     OIIO::ImageSpec config, opened;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    if (!input->open(std::string("texture.") + extension, opened, config)) {
+    if (!input->open("texture.jpg", opened, config)) {
         out.problem = "cannot be decoded: " + oneLine(input->geterror());
         return out;
     }
@@ -80,36 +241,34 @@ TextureColour meanTextureColour(const unsigned char* bytes, size_t size) {
         return out;
     }
     if (width > kMaxTexturePixels / height) {
-        out.problem = "is " + std::to_string(width) + " x " + std::to_string(height) +
-                      " pixels, more than qsgi decodes (16384 x 16384); skipped";
+        out.problem = tooManyPixels(width, height);
         return out;
     }
-    // 8-bit images are read as 8 bits and anything deeper as 16, each value through a table of
-    // the sRGB curve (one pow per possible value, not per pixel).
     const bool sixteen = spec.format.size() > 1;
     const OIIO::TypeDesc readAs = sixteen ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
-    const size_t levels = sixteen ? 65536 : 256;
-    std::vector<double> linear(levels);
-    for (size_t v = 0; v < levels; ++v) linear[v] = srgbToLinear(double(v) / double(levels - 1));
-
-    std::vector<uint16_t> row16(sixteen ? width * size_t(channels) : 0);
-    std::vector<uint8_t> row8(sixteen ? 0 : width * size_t(channels));
-    double sum[3] = {0, 0, 0};
+    LinearSum sum(sixteen);
+    std::vector<unsigned char> row(width * size_t(channels) * (sixteen ? 2 : 1));
     for (int y = spec.y; y < spec.y + spec.height; ++y) {
-        void* row = sixteen ? static_cast<void*>(row16.data()) : static_cast<void*>(row8.data());
-        if (!input->read_scanline(y, spec.z, readAs, row)) {
+        if (!input->read_scanline(y, spec.z, readAs, row.data())) {
             out.problem = "is truncated or corrupt: " + oneLine(input->geterror());
             return out;
         }
-        for (size_t x = 0; x < width; ++x)
-            for (int c = 0; c < 3; ++c) {
-                const size_t at = x * size_t(channels) + size_t(channels >= 3 ? c : 0);  // grey: one channel
-                sum[c] += linear[sixteen ? row16[at] : row8[at]];
-            }
+        sum.addRow(row.data(), width, channels, false);  // native order: little-endian, as every machine qsgi builds on
     }
-    const double pixels = double(width) * double(height);
-    out.mean = Vec3f(float(sum[0] / pixels), float(sum[1] / pixels), float(sum[2] / pixels));
+    out.mean = sum.mean(double(width) * double(height));
     return out;
+}
+
+}  // namespace
+
+TextureColour meanTextureColour(const unsigned char* bytes, size_t size) {
+    const char* extension = extensionOf(bytes, size);
+    if (!extension) {
+        TextureColour out;
+        out.problem = "is neither PNG nor JPEG (the image formats glTF 2.0 allows)";
+        return out;
+    }
+    return std::strcmp(extension, "png") == 0 ? meanPngColour(bytes, size) : meanJpegColour(bytes, size);
 }
 
 }  // namespace qsgi

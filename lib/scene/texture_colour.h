@@ -1,4 +1,6 @@
-// The mean colour of a glTF texture image, decoded with OpenImageIO from its encoded bytes.
+// The mean colour of a glTF texture image, decoded from its encoded bytes: PNG with libpng under
+// qsgi's own error handler, JPEG with OpenImageIO (which takes over libjpeg's messages); neither
+// prints anything, so a broken texture is one warning in qsgi's words, also under --quiet.
 //
 // qsgi's surfaces are Lambertian with one albedo per material, so a base colour texture counts
 // only through its mean linear colour. tinygltf is told not to decode images at all (its decoder,
@@ -27,7 +29,8 @@ struct TextureColour {
 };
 
 // Decodes a PNG or JPEG (the formats glTF 2.0 allows) from memory and averages its pixels after
-// the sRGB transfer function; grey images give grey. Never throws on bad bytes: reports them.
+// the sRGB transfer function; grey images give grey. Never throws on bad bytes and never prints:
+// reports them (a PNG's header is checked against the PNG specification before libpng reads it).
 TextureColour meanTextureColour(const unsigned char* bytes, size_t size);
 
 }  // namespace qsgi

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the hand-made test inputs of tests/data: hostile files that qsgi must refuse
-(bad/gltf, bad/animation, bad/config) and valid edge cases that it must load (good/).
+(bad/gltf, bad/animation, bad/config, bad/ply) and valid edge cases that it must load (good/).
 
 Each bad file breaks one rule; bad/generated.tsv lists it with the words its error message must
 contain. Files found by fuzzing are added by hand to bad/<kind>/ and listed in bad/found.tsv.
@@ -194,6 +194,79 @@ m["textures"] = [{"source": 0}, {"source": 1}, {"source": 2}]
 m["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": i}, "baseColorFactor": [0.5, 0.25, 1, 1]}}
                   for i in range(3)]
 write("good/texture_unreadable.gltf", json.dumps(m, indent=1))
+
+
+def png_file(width, height, scanlines, depth=8, colour=2, interlace=0, compression=0, filter_method=0,
+             plte=None, ihdr_crc=None, idat=None):
+    """A PNG from its raw scanlines (each with its filter byte), any IHDR values, an optional PLTE,
+    a wrong IHDR CRC or IDAT bytes of one's own: a valid file or one hostile to a decoder."""
+    def chunk(kind, data, crc=None):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) if crc is None else crc)
+    ihdr = struct.pack(">IIBBBBB", width, height, depth, colour, compression, filter_method, interlace)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr, ihdr_crc) + (chunk(b"PLTE", plte) if plte else b"") +
+            chunk(b"IDAT", zlib.compress(scanlines) if idat is None else idat) + chunk(b"IEND", b""))
+
+
+def adam7(width, height, pixel):
+    """The raw scanlines of an interlaced 8-bit RGB image: Adam7's seven passes, each row with filter 0."""
+    passes = [(0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2)]
+    raw = b""
+    for x0, y0, dx, dy in passes:
+        xs = range(x0, width, dx)
+        if not xs:
+            continue
+        for y in range(y0, height, dy):
+            raw += b"\0" + b"".join(bytes(pixel(x, y)) for x in xs)
+    return raw
+
+
+def images_scene(images, factor):
+    """The floor with one material per image (embedded in buffer views), each base colour texture
+    over `factor`; the primitive uses material 0, and every material's texture is decoded."""
+    m = textured(True)
+    data = base64.b64decode(m["buffers"][0]["uri"].split(",")[1])
+    m["images"], m["textures"], m["materials"] = [], [], []
+    for i, image in enumerate(images):
+        data += b"\0" * (-len(data) % 4)
+        m["bufferViews"].append({"buffer": 0, "byteOffset": len(data), "byteLength": len(image)})
+        data += image
+        m["images"].append({"bufferView": len(m["bufferViews"]) - 1, "mimeType": "image/png"})
+        m["textures"].append({"source": i})
+        m["materials"].append({"pbrMetallicRoughness": {"baseColorTexture": {"index": i}, "baseColorFactor": factor}})
+    m["buffers"][0] = {"byteLength": len(data), "uri": b64(data)}
+    return m
+
+
+# PNGs that libpng refuses: each leaves its material's factor with a warning in qsgi's words, and
+# nothing is printed by a library (hostile_input_test.cpp, texture_colour_test.cpp).
+rgb_row = b"\0" + bytes([200, 100, 50] * 2)
+valid_idat = zlib.compress(rgb_row * 2)
+HOSTILE_PNGS = [
+    ("0 x 0 pixels", png_file(0, 0, b"")),
+    ("colour type 3 with bit depth 16", png_file(2, 2, rgb_row * 2, depth=16, colour=3, plte=bytes(6))),
+    ("colour type 5", png_file(2, 2, rgb_row * 2, colour=5)),
+    ("interlace method 2", png_file(2, 2, rgb_row * 2, interlace=2)),
+    ("compression method 1", png_file(2, 2, rgb_row * 2, compression=1)),
+    ("filter method 1", png_file(2, 2, rgb_row * 2, filter_method=1)),
+    ("2147483648 x 1 pixels", png_file(2**31, 1, rgb_row)),
+    ("corrupt PNG (libpng: IHDR: CRC error)", png_file(2, 2, rgb_row * 2, ihdr_crc=0)),
+    ("corrupt PNG", png_file(2, 2, b"", idat=b"\x78\x9c not a deflate stream")),
+    ("corrupt PNG", png_file(2, 2, b"\x05" + rgb_row[1:] + rgb_row)),   # filter type 5 does not exist
+    ("corrupt PNG", png_file(2, 2, b"\0\0" * 2, depth=8, colour=3)),     # a palette image without PLTE
+    ("corrupt PNG", png_file(2, 4, rgb_row * 2)),                         # two rows of the four it declares
+    ("truncated PNG", png_file(2, 2, rgb_row * 2)[:40]),
+]
+write("good/texture_png_hostile.gltf",
+      json.dumps(images_scene([image for _, image in HOSTILE_PNGS], [0.5, 0.25, 1, 1]), indent=1))
+write("good/texture_png_hostile.tsv", "# material\twords its warning must contain (written by make_inputs.py)\n" +
+      "".join(f"{i}\t{words}\n" for i, (words, _) in enumerate(HOSTILE_PNGS)))
+# Valid PNGs a decoder may mishandle, each over a factor of 1, their means worked out in
+# texture_colour_test.cpp: Adam7-interlaced 5 x 3 RGB, value (x * 37 + y * 11 + c * 50) % 256; a
+# row of 1,100,000 grey pixels of 128, wider than libpng's default limit of 10^6.
+write("good/texture_png_variants.gltf", json.dumps(images_scene([
+    png_file(5, 3, adam7(5, 3, lambda x, y: [(x * 37 + y * 11 + c * 50) % 256 for c in range(3)]), interlace=1),
+    png_file(1100000, 1, b"\0" + bytes([128]) * 1100000, colour=0),
+], [1, 1, 1, 1]), indent=1))
 
 # ---- glTF files that break the specification (bad/gltf) ----
 def accessor(i, **kw):
@@ -391,6 +464,34 @@ bad("gltf", "material_texture_missing.gltf", edited(lambda m: (
     m.update(materials=[{"emissiveTexture": {"index": 3}}]),
     m["meshes"][0]["primitives"][0].update(material=0))), "does not exist", "materials[0].emissiveTexture.index")
 bad("gltf", "node_children_empty.gltf", edited(lambda m: m["nodes"][0].update(children=[])), "empty array", "nodes[0].children")
+# KHR_texture_transform's texCoord overrides the textureInfo's: the set it names must exist, as
+# for texCoord itself; and a light's range, where given, is positive (exclusiveMinimum 0).
+def transform_texcoord(texture, value):
+    def edit(m):
+        info = {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": value, "scale": [2, 2]}}}
+        if texture == "baseColorTexture":
+            m["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = info
+        else:
+            m["materials"][0][texture] = info
+        m["extensionsUsed"].append("KHR_texture_transform")
+    return edit
+bad("gltf", "texture_transform_texcoord_missing.gltf", edited(transform_texcoord("baseColorTexture", 1), textured(True)),
+    "has no TEXCOORD_1, which materials[0].pbrMetallicRoughness.baseColorTexture.extensions.KHR_texture_transform.texCoord reads")
+bad("gltf", "texture_transform_texcoord_missing_on_normal_map.gltf", edited(transform_texcoord("normalTexture", 3), textured(True)),
+    "has no TEXCOORD_3, which materials[0].normalTexture.extensions.KHR_texture_transform.texCoord reads")
+bad("gltf", "texture_transform_texcoord_negative.gltf", edited(transform_texcoord("baseColorTexture", -1), textured(True)),
+    "KHR_texture_transform.texCoord: must be a non-negative integer")
+bad("gltf", "texture_transform_texcoord_fraction.gltf", edited(transform_texcoord("emissiveTexture", 0.5), textured(True)),
+    "materials[0].emissiveTexture.extensions.KHR_texture_transform.texCoord: must be a non-negative integer")
+def light(**kw):
+    return lambda m: m["extensions"]["KHR_lights_punctual"]["lights"][0].update(kw)
+bad("gltf", "light_range_zero.gltf", edited(light(range=0)), "KHR_lights_punctual.lights[0].range: is 0; a light's range must be a positive number")
+bad("gltf", "light_range_negative.gltf", edited(light(range=-2.5)), "KHR_lights_punctual.lights[0].range: is -2.5")
+bad("gltf", "light_range_string.gltf", edited(light(range="10")), 'KHR_lights_punctual.lights[0].range: is "10"')
+bad("gltf", "buffer_uri_directory.gltf", edited(lambda m: m["buffers"][0].update(uri=".")),
+    "buffers[0].uri: '.' names a directory, not a file")
+bad("gltf", "buffer_uri_missing_file.gltf", edited(lambda m: m["buffers"][0].update(uri="no-such.bin")),
+    "buffers[0].uri: 'no-such.bin' names no file")
 
 # Valid glTF that tinygltf alone refuses or that looks odd (issue 23): each loads as the floor.
 m = scene()
@@ -404,6 +505,11 @@ write("good/glb_trailing_bytes.glb", trailing)
 m = scene()
 m["meshes"][0]["primitives"].append({"attributes": {}})  # no POSITION: skipped, as glTF asks
 write("good/primitive_without_position.gltf", json.dumps(m, indent=1))
+# A light with a range and a texture whose KHR_texture_transform reads TEXCOORD_1, which exists.
+m = edited(lambda m: with_extra_attribute("TEXCOORD_1", [0] * 8, "VEC2")(m), textured(True))
+transform_texcoord("baseColorTexture", 1)(m)
+m["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = 5
+write("good/light_range_and_texture_transform.gltf", json.dumps(m, indent=1))
 
 # ---- transform files (bad/animation), rendered with good/base.gltf ----
 def anim(frames, **top):
@@ -466,6 +572,8 @@ def config(name, doc, words, names=None):
 
 
 config("unknown_key.json", {"photon": 1000}, 'did you mean "photons"')
+config("unknown_key_in_other_words.json", {"photon_count": 1000}, 'photon_count: unknown key (did you mean "photons"?)')
+config("unknown_key_with_prefix.json", {"num_threads": 2}, 'did you mean "threads"')
 config("photons_string.json", {"photons": "1000"}, "must be an integer")
 config("photons_negative.json", {"photons": -1000}, "outside 1..4294967296")
 config("photons_fraction.json", {"photons": 1000.5}, "must be an integer")
@@ -505,6 +613,73 @@ config("light_overflowing_power.json",
        {"lights": [{"type": "point", "position": [0, 2, 0], "intensity": [3e38, 3e38, 3e38]}]}, "W qsgi carries", "lights[0]")
 bad("gltf", "extras_nested_too_deep.gltf",
     json.dumps(scene())[:-1] + ', "extras": ' + "[" * 100000 + "]" * 100000 + "}", "nested deeper than 256")
+
+# ---- PLY files (bad/ply), compared with good/frame.ply by `qsgi compare` ----
+PLY_FIELDS = ["x", "y", "z", "nx", "ny", "nz", "radiosity_r", "radiosity_g", "radiosity_b"]
+PLY_VERTICES = [(-1, 0, 1, 0, 1, 0, 1, 1, 1), (1, 0, 1, 0, 1, 0, 2, 2, 2), (1, 0, -1, 0, 1, 0, 3, 3, 3),
+                (-1, 0, -1, 0, 1, 0, 4, 4, 4)]
+PLY_FACES = [(0, 1, 2), (0, 2, 3)]
+
+
+def ply(vertices=PLY_VERTICES, faces=PLY_FACES, vertex_count=None, face_count=None, fmt="binary_little_endian",
+        types=None, extra_element="", extra_data=b"", extra_properties=(), header_end="end_header\n"):
+    """A vertex-radiosity PLY as qsgi writes it (floats, then faces as uchar/int lists); counts,
+    types, formats and extra elements or vertex properties may be changed to make it hostile."""
+    types = types or {}
+    names = PLY_FIELDS + [name for name, _, _ in extra_properties]
+    header = f"ply\nformat {fmt} 1.0\nelement vertex {len(vertices) if vertex_count is None else vertex_count}\n"
+    header += "".join(f"property {types.get(n, 'float')} {n}\n" for n in PLY_FIELDS)
+    header += "".join(f"property {t} {n}\n" for n, t, _ in extra_properties)
+    header += extra_element
+    header += f"element face {len(faces) if face_count is None else face_count}\nproperty list uchar int vertex_indices\n"
+    header += header_end
+    data = b""
+    for v in vertices:
+        values = list(v) + [value for _, _, value in extra_properties]
+        for n, value in zip(names, values):
+            t = types.get(n, dict((p, t) for p, t, _ in extra_properties).get(n, "float"))
+            data += struct.pack("<d" if t == "double" else "<f", value)
+    data += extra_data
+    for f in faces:
+        data += struct.pack("<B%di" % len(f), len(f), *f)
+    return header.encode() + data
+
+
+def ply_case(name, content, words, names=None):
+    bad("ply", name, content, words, names)
+
+
+write("good/frame.ply", ply())
+many = PLY_VERTICES * 20  # a file of about 3 KB
+ply_case("vertex_count_huge.ply", ply(many, vertex_count=200000000),
+         "header, element vertex (line 3): declares 200000000 vertices of at least 36 bytes each")
+ply_case("face_count_huge.ply", ply(face_count=10**12), "declares 1000000000000 faces of at least 13 bytes each")
+ply_case("ascii_vertex_count_huge.ply",
+         "ply\nformat ascii 1.0\nelement vertex 1000000000\n" + "".join(f"property float {n}\n" for n in PLY_FIELDS) +
+         "end_header\n" + "0 0 0 0 1 0 1 1 1\n" * 40, "declares 1000000000 vertices of at least 18 bytes each")
+ply_case("other_element_count_huge.ply",
+         ply(extra_element="element material 1000000000000000\nproperty float shininess\n"),
+         "element material (line 13): declares 1000000000000000 elements")
+ply_case("vertex_count_negative.ply", ply(vertex_count=-1), "element 'vertex' needs a count")
+ply_case("vertex_count_words.ply", ply(vertex_count="many"), "element 'vertex' needs a count")
+nan_y = [list(v) for v in PLY_VERTICES]
+nan_y[2][1] = float("nan")
+ply_case("position_nan.ply", ply(nan_y), "vertex 2: property 'y' is nan, not a finite number")
+inf_nz = [list(v) for v in PLY_VERTICES]
+inf_nz[3][5] = float("-inf")
+ply_case("normal_inf.ply", ply(inf_nz), "vertex 3: property 'nz' is -inf, not a finite number")
+nan_b = [list(v) for v in PLY_VERTICES]
+nan_b[1][8] = float("inf")
+ply_case("radiosity_inf.ply", ply(nan_b), "vertex 1: property 'radiosity_b' is inf")
+ply_case("extra_property_nan.ply", ply(extra_properties=[("confidence", "float", float("nan"))]),
+         "vertex 0: property 'confidence' is nan")
+huge_x = [list(v) for v in PLY_VERTICES]
+huge_x[0][0] = 1e300
+ply_case("position_beyond_float.ply", ply(huge_x, types={"x": "double"}),
+         "vertex 0: property 'x' is 1e+300, beyond the range of float")
+ply_case("face_index_beyond.ply", ply(faces=[(0, 1, 2), (0, 2, 7)]), "face 1: refers to a vertex that does not exist")
+ply_case("no_end_header.ply", ply(header_end=""), "has no end_header line")
+
 
 with open(os.path.join(HERE, "bad", "generated.tsv"), "w") as f:
     f.write("# kind\tfile (relative to tests/data)\twords the error message must contain\tfile it names\n")
