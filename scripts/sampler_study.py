@@ -27,7 +27,7 @@ import numpy as np
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
-from qsgibatch import ply  # noqa: E402
+from qsgibatch import output_folder, ply  # noqa: E402
 from qsgibatch.qsgi import clear_run  # noqa: E402
 
 SCENES = [("cornell", "data/cornell/cornell.gltf", "tests/reference/cornell_f0000.ply"),
@@ -83,7 +83,9 @@ def main():
                 plys = [ply.read(p) for p in paths]
                 mean = sum(p.radiosity() for p in plys) / len(plys)
                 mean_path = os.path.join(tmp, "mean.ply")
-                ply.write_with_radiosity(mean_path, plys[0], mean)
+                tmp_fd = output_folder.open_folder(tmp)
+                output_folder.write_file(tmp_fd, "mean.ply", ply.with_radiosity(plys[0], mean))
+                os.close(tmp_fd)
                 squares = {r: 0.0 for r in REGIONS}
                 for p in paths:
                     for r, v in compare(args.qsgi, p, mean_path).items():

@@ -12,7 +12,10 @@ run (each point is exactly a `qsgi render` a user could repeat by hand), its plo
 and its Slurm submission is process-level work; none of it belongs in the renderer's library.
 
 Finished points are kept (OUT/points/NAME/result.json) and never recomputed; an interrupted point
-resumes its renders. Exit codes: 0 done, 2 bad config or command line, 1 a render failed."""
+resumes its renders. The sweep writes nothing through a link planted in OUT
+(scripts/qsgibatch/output_folder.py). Exit codes: 0 done, 2 bad config or command line, or a link
+or file planted where OUT needs a folder, 1 a render failed, 74 the machine failed opening a folder
+of OUT (an I/O error)."""
 import argparse
 import os
 import sys
@@ -28,7 +31,7 @@ for module, package in (("numpy", "python3-numpy"), ("matplotlib", "python3-matp
         sys.exit(f"sweep: needs the Python module {module} (Debian package {package}); "
                  "scripts/setup.sh --test installs it")
 
-from qsgibatch import grid, plots, reference, runner, table  # noqa: E402
+from qsgibatch import grid, output_folder, plots, reference, runner, table  # noqa: E402
 from qsgibatch.qsgi import Qsgi, QsgiError  # noqa: E402
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -71,7 +74,14 @@ def progress(done, total, point, result):
 
 
 def main(argv):
-    args = parse_arguments(argv)
+    try:
+        return run(parse_arguments(argv))
+    except output_folder.FolderError as e:  # a link planted in OUT: refused, not followed
+        print(f"sweep: {e}", file=sys.stderr)
+        return e.exit_code
+
+
+def run(args):
     try:
         config = grid.load(args.config, args.quick)
     except grid.ConfigError as e:
@@ -96,7 +106,8 @@ def main(argv):
     jobs = args.jobs or config.jobs
     qsgi = Qsgi(os.path.abspath(args.qsgi), config.scene, config.animation)
     try:
-        diagonal = qsgi.animation_diagonal(os.path.join(args.out, "probe"))
+        probe = output_folder.make_subfolder(args.out, "probe")  # a real folder before qsgi renders into it
+        diagonal = qsgi.animation_diagonal(probe)
         reference_path, description = reference.prepare(config, qsgi, args.out, diagonal, args.cores)
         if args.prepare:
             return 0

@@ -2,7 +2,11 @@
 machines computed). Every axis names its quantity and unit; errors are relative to the
 reference's mean radiosity at frame 0, times are per frame on this machine. Rows of different
 photon samplers (the CSV's `sampler`) are never joined into one line: each plot draws one series
-per estimator and sampler (colour: estimator; line style and marker: sampler) or one panel each."""
+per estimator and sampler (colour: estimator; line style and marker: sampler) or one panel each.
+
+Each plot is drawn in memory and written by output_folder.write_file: a link planted at its name or
+its temporary is replaced, never written through."""
+import io
 import math
 import os
 
@@ -13,6 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .grid import DEFAULT_RADIUS_FRACTION  # noqa: E402
+from .output_folder import open_folder, write_file  # noqa: E402
 
 ERROR_AXIS = "relative RMS error at frame 0"
 MIN_PHOTONS_FOR_SLOPE = 1e4  # below, the fixed cost per frame (regions, setup) hides the growth
@@ -47,10 +52,14 @@ def _finite(values):
 def _save(figure, out, name, title_note):
     figure.suptitle(title_note, fontsize=9)
     figure.tight_layout()
-    path = os.path.join(out, name)
-    figure.savefig(path + ".tmp.png", dpi=110)
+    image = io.BytesIO()
+    figure.savefig(image, dpi=110, format=os.path.splitext(name)[1][1:])
     plt.close(figure)
-    os.replace(path + ".tmp.png", path)
+    folder_fd = open_folder(out)
+    try:
+        write_file(folder_fd, name, image.getvalue())
+    finally:
+        os.close(folder_fd)
     return name
 
 

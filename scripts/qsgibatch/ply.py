@@ -52,19 +52,12 @@ def read(path) -> VertexPly:
     return VertexPly(header, vertices, data[start + count * dtype.itemsize:])
 
 
-def write_with_radiosity(path, template: VertexPly, radiosity: np.ndarray) -> None:
-    """Writes `template` with its radiosity replaced, atomically (temporary file, then rename)."""
+def with_radiosity(template: VertexPly, radiosity: np.ndarray) -> bytes:
+    """The bytes of `template` with its radiosity replaced (output_folder.write_file writes them)."""
     vertices = template.vertices.copy()
     for c, name in enumerate(("radiosity_r", "radiosity_g", "radiosity_b")):
         vertices[name] = radiosity[:, c]
-    temporary = f"{path}.tmp"
-    with open(temporary, "wb") as f:
-        f.write(template.header)
-        f.write(vertices.tobytes())
-        f.write(template.rest)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(temporary, path)
+    return template.header + vertices.tobytes() + template.rest
 
 
 def count_non_finite(path) -> tuple:

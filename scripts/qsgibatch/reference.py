@@ -9,7 +9,7 @@ import os
 
 import numpy as np
 
-from . import ply
+from . import output_folder, ply
 
 
 def _describe_build(build: dict) -> str:
@@ -29,7 +29,8 @@ def prepare(config, qsgi, out: str, diagonal: float, threads: int) -> tuple:
         with open(recipe_path) as f:
             if json.load(f) == recipe:
                 return reference_path, _describe_build(build)
-    os.makedirs(folder, exist_ok=True)
+    # A real folder, never a link planted at OUT/reference; its files written as every output is.
+    output_folder.make_subfolder(out, "reference")
     options = ["--estimator", "detp", "--detp-boundary", "linear", "--photons", str(build["photons"]),
                "--radius", repr(build["radius_fraction"] * diagonal), "--frames", "0:0"]
     runs = []
@@ -38,9 +39,10 @@ def prepare(config, qsgi, out: str, diagonal: float, threads: int) -> tuple:
         qsgi.render(run, options, seed, threads)
         runs.append(ply.read(os.path.join(run, "frame_0000.ply")))
     mean = np.mean([r.radiosity() for r in runs], axis=0)
-    ply.write_with_radiosity(reference_path, runs[0], mean)
-    temporary = recipe_path + ".tmp"
-    with open(temporary, "w") as f:
-        json.dump(recipe, f, indent=1)
-    os.replace(temporary, recipe_path)
+    folder_fd = output_folder.open_folder(folder)
+    try:
+        output_folder.write_file(folder_fd, "reference.ply", ply.with_radiosity(runs[0], mean))
+        output_folder.write_file(folder_fd, "reference.json", json.dumps(recipe, indent=1).encode())
+    finally:
+        os.close(folder_fd)
     return reference_path, _describe_build(build)

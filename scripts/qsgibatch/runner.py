@@ -5,13 +5,21 @@ where they stopped (qsgi render --resume), so a sweep can be interrupted and run
 Points run `jobs` at a time, each render with cores/jobs threads. A point's timings are marked
 `shared_cores` when another point ran during any part of it, or when processes outside the sweep
 kept more than a quarter of a core busy on average while it ran (`other_cores`, from /proc/stat):
-those numbers are not a quiet machine's, and the CSV says so."""
+those numbers are not a quiet machine's, and the CSV says so.
+
+Nothing here writes through a link planted in OUT (scripts/qsgibatch/output_folder.py): OUT/points
+and each point's folder are real folders opened without following links (a link or file planted
+there is refused, FolderError), result.json is written by output_folder.write_file (a link at the
+name or its temporary is replaced, never followed), and a point's run/ and seed2/ are refused when a
+link stands there, before qsgi renders into them or a stale one is removed."""
 import concurrent.futures
+import errno
 import glob
 import json
 import math
 import os
 import shutil
+import stat
 import statistics
 import threading
 import time
@@ -20,6 +28,7 @@ import numpy as np
 
 from . import ply
 from .grid import DEFAULT_RADIUS_FRACTION
+from .output_folder import open_folder, open_subfolder, write_file
 
 RESULT_VERSION = 2  # 2: points have a sampler (results of 1 came from qsgi before Sobol: random photons)
 
@@ -109,26 +118,57 @@ def _noise(a: str, b: str, reference: np.ndarray) -> float:
     return rms / mean if mean > 0 else rms
 
 
-def _discard_other_sampler(run, point):
-    """Removes a render folder left by another sampler (or by qsgi before samplers: no "sampler" in
-    its timing.json), which `qsgi render --resume` would refuse as rendered from other settings."""
+def open_point_folder(out, name) -> int:
+    """OUT/points/NAME, each made if missing, opened without following a link: a link or file
+    planted at either is refused (output_folder.FolderError). Returns the folder's fd."""
+    out_fd = open_folder(out)
     try:
-        with open(os.path.join(run, "timing.json")) as f:
+        points_fd = open_subfolder(out_fd, "points", os.path.join(out, "points"), create=True)
+    finally:
+        os.close(out_fd)
+    try:
+        return open_subfolder(points_fd, name, os.path.join(out, "points", name), create=True)
+    finally:
+        os.close(points_fd)
+
+
+def _discard_other_sampler(point_fd, name, where, point):
+    """Removes the render folder `name` of the point's folder when another sampler (or qsgi before
+    samplers: no "sampler" in its timing.json) left it, which `qsgi render --resume` would refuse
+    as rendered from other settings. A link or file standing at `name` (`where`, its path) is
+    refused (FolderError) rather than followed, by qsgi's render or by the removal; the removal
+    (relative to the point's folder, fd-based) follows no link inside it."""
+    run_fd = open_subfolder(point_fd, name, where, create=False)
+    if run_fd is None:
+        return
+    try:
+        # O_NONBLOCK: a FIFO planted at the name must not hang the open.
+        fd = os.open("timing.json", os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, dir_fd=run_fd)
+        with os.fdopen(fd) as f:
             config = json.load(f)["config"]
     except (OSError, ValueError, KeyError, TypeError):
         return  # nothing rendered yet, or nothing to judge by: qsgi decides
+    finally:
+        os.close(run_fd)
     sampler, _, bounces = point.sampler.partition(":")
     if config.get("sampler") != sampler or bounces and config.get("qmc_bounces") != int(bounces):
-        shutil.rmtree(run)
+        shutil.rmtree(name, dir_fd=point_fd)  # refuses a link at `name`, follows none inside (Linux)
 
 
 def finished(out, point):
     """The point's result.json if there is one of this result version and the point's sampler, else
-    None (whatever its reference: Sweep.cached checks that too)."""
+    None (whatever its reference: Sweep.cached checks that too). A link or other non-file planted at
+    the name is no result (computing the point replaces it)."""
     path = os.path.join(out, "points", point.name, "result.json")
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as e:
+        if e.errno in (errno.ENOENT, errno.ENOTDIR, errno.ELOOP):
+            return None
+        raise
+    with os.fdopen(fd) as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
         result = json.load(f)
     same = result.get("result_version") == RESULT_VERSION and result.get("sampler") == point.sampler
     return result if same else None
@@ -168,18 +208,23 @@ class Sweep:
                       wall_s=time.monotonic() - began)
         with self._computed_lock:
             self.computed += 1
-        path = os.path.join(self.folder(point), "result.json")
-        with open(path + ".tmp", "w") as f:
-            json.dump(result, f, indent=1, sort_keys=True)
-        os.replace(path + ".tmp", path)
+        folder_fd = open_point_folder(self.out, point.name)
+        try:
+            write_file(folder_fd, "result.json", json.dumps(result, indent=1, sort_keys=True).encode())
+        finally:
+            os.close(folder_fd)
         return result
 
     def _compute(self, point) -> dict:
         folder = self.folder(point)
         run = os.path.join(folder, "run")
         seed, second_seed = self.config.seeds
-        for previous in (run, os.path.join(folder, "seed2")):
-            _discard_other_sampler(previous, point)
+        folder_fd = open_point_folder(self.out, point.name)  # real folders before qsgi renders into them
+        try:
+            for name in ("run", "seed2"):
+                _discard_other_sampler(folder_fd, name, os.path.join(folder, name), point)
+        finally:
+            os.close(folder_fd)
         timing = self.qsgi.render(run, point.qsgi_options(self.diagonal), seed, self.threads)
         radius = (point.radius_fraction or DEFAULT_RADIUS_FRACTION) * self.diagonal
         frame0 = os.path.join(run, "frame_0000.ply")

@@ -12,7 +12,7 @@ import shutil
 import subprocess
 import sys
 
-from .output_folder import write_file
+from .output_folder import FolderError, make_subfolder, open_folder, open_subfolder, write_file
 from .runner import finished
 
 
@@ -46,9 +46,17 @@ def replace_merge_job(record: str, new_job: str) -> None:
     """Cancels the merge job an earlier submission left (recorded in `record`) and records the new
     one. A merge whose array had a failed or killed task waits forever on a dependency that can
     never be met, unless the cluster sets kill_invalid_depend; the resubmission supersedes it. The
-    record is read and written without following a link planted at its name, and only a job id
-    read from it reaches scancel."""
-    folder_fd = os.open(os.path.dirname(record) or ".", os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+    record is read and written without following a link planted at its name, a link planted as its
+    folder is refused (FolderError), and only a job id read from it reaches scancel."""
+    folder = os.path.dirname(record) or "."
+    parent, base = os.path.split(folder)
+    parent_fd = open_folder(parent or ".")
+    try:
+        folder_fd = open_subfolder(parent_fd, base, folder, create=False)
+    finally:
+        os.close(parent_fd)
+    if folder_fd is None:
+        raise FolderError(f"{folder}: no such folder")
     try:
         name = os.path.basename(record)
         old = ""
@@ -91,8 +99,12 @@ def submit_sweep(args, config, script) -> int:
         print(f"sweep: {e}", file=sys.stderr)
         return 2
     out = os.path.abspath(args.out)
-    logs = os.path.join(out, "slurm")
-    os.makedirs(logs, exist_ok=True)
+    os.makedirs(out, exist_ok=True)
+    try:
+        logs = make_subfolder(out, "slurm")  # a real folder: Slurm writes the jobs' logs in it
+    except FolderError as e:
+        print(f"sweep: {e}", file=sys.stderr)
+        return e.exit_code
     cpus = args.slurm_cpus
     command = [python_executable(), script, os.path.abspath(config.path), "--out", out, "--qsgi", os.path.abspath(args.qsgi),
                "--cores", str(cpus)] + (["--quick"] if args.quick else []) + \
@@ -112,6 +124,9 @@ def submit_sweep(args, config, script) -> int:
     except SlurmError as e:
         print(f"sweep: {e}", file=sys.stderr)
         return 2
+    except FolderError as e:  # a link planted as OUT/slurm since it was made: refused
+        print(f"sweep: {e}", file=sys.stderr)
+        return e.exit_code
     print(f"sweep: submitted {len(missing)} of {len(config.points)} points (jobs {prepare}, "
           f"{points if missing else '-'}, merge {merge}); logs in {logs}")
     return 0

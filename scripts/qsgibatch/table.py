@@ -1,7 +1,10 @@
 """sweep.csv: one row per grid point with every parameter and figure, in a fixed column order."""
 import csv
+import io
 import math
 import os
+
+from .output_folder import open_folder, write_file
 
 COLUMNS = [
     # parameters
@@ -30,14 +33,18 @@ def _cell(value):
 
 
 def write(path: str, results: list) -> None:
-    """Writes the rows atomically (a reader never sees half a table)."""
-    temporary = path + ".tmp"
-    with open(temporary, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
-        writer.writeheader()
-        for r in results:
-            writer.writerow({c: _cell(r.get(c, math.nan)) for c in COLUMNS})
-    os.replace(temporary, path)
+    """Writes the rows atomically (a reader never sees half a table) and through no link planted at
+    the name or its temporary (output_folder.write_file replaces it)."""
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=COLUMNS, extrasaction="ignore")
+    writer.writeheader()
+    for r in results:
+        writer.writerow({c: _cell(r.get(c, math.nan)) for c in COLUMNS})
+    folder_fd = open_folder(os.path.dirname(path) or ".")
+    try:
+        write_file(folder_fd, os.path.basename(path), text.getvalue().encode())
+    finally:
+        os.close(folder_fd)
 
 
 def read(path: str) -> list:
