@@ -36,7 +36,8 @@ extern "C" void requestStop(int signal) { gStopSignal = signal; }
 void installStopHandlers() {
     struct sigaction action {};
     action.sa_handler = requestStop;
-    action.sa_flags = SA_RESETHAND;
+    // SA_RESTART: a write or fsync the signal lands in goes on (the run stops after the frame).
+    action.sa_flags = SA_RESETHAND | SA_RESTART;
     sigemptyset(&action.sa_mask);
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
@@ -290,7 +291,11 @@ int main(int argc, char** argv) {
                          outcome.nextFrame, out.c_str());
             return 128 + int(gStopSignal);
         }
-        if (o.resume && !o.quiet && outcome.framesWritten == 0)
+        if (o.resume && !o.quiet && outcome.framesWritten == 0 && outcome.framesRemoved > 0)
+            std::fprintf(stderr, "qsgi: every frame asked for is already complete in %s; %d damaged frame%s outside them %s removed\n",
+                         out.c_str(), outcome.framesRemoved, outcome.framesRemoved == 1 ? "" : "s",
+                         outcome.framesRemoved == 1 ? "was" : "were");
+        else if (o.resume && !o.quiet && outcome.framesWritten == 0)
             std::fprintf(stderr, "qsgi: every frame is already complete in %s\n", out.c_str());
         else if (!o.quiet)
             std::fprintf(stderr, "qsgi: %s\n", display.summary(out, outcome).c_str());

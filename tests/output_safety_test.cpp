@@ -234,6 +234,55 @@ TEST(OutputSafety, ADiskThatFillsMidRunEndsCleanlyAndResumeCompletesItByteForByt
     EXPECT_TRUE(frameFiles(dir / "none").empty());
 }
 
+TEST(OutputSafety, TheLogNeverListsAFrameThatIsNotWholeWhateverFailsWhere) {
+    const fs::path dir = testScratchDir("safety-order");
+    const fs::path reference = referenceRun(dir, "0:3");
+    // A run of the same inputs over a folder already holding frames 0-3, the disk filling during
+    // frame 1: frames 1-3 of the earlier run stay listed and whole (they are rewritten with the
+    // same bytes, so a half-rewritten frame is whole too), nothing unlisted stays on disk.
+    const fs::path again = dir / "again";
+    copyFolder(reference, again);
+    uintmax_t budget = 2 * fs::file_size(reference / "timing.json") + fs::file_size(reference / "frame_0001.ply") / 2;
+    for (const char* ext : {"ply", "exr", "png"}) budget += fs::file_size(reference / ("frame_0000." + std::string(ext)));
+    const CommandResult full =
+        runPreloaded("QSGI_FAIL_WRITES_AFTER=" + std::to_string(budget), renderArguments("0:3") + " --quiet --out " + quoted(again));
+    EXPECT_EQ(full.exitCode, 74) << full.output;
+    EXPECT_EQ(loggedFrames(again), (std::vector<int>{0, 1, 2, 3}));
+    expectConsistent(again);
+    expectSameFrameFiles(reference, again);
+
+    // A damaged frame outside --frames and a disk that cannot take the new log: the frame stays
+    // listed with its files on disk (the log is rewritten before any file is unlinked).
+    const fs::path damaged = dir / "damaged";
+    copyFolder(reference, damaged);
+    std::ofstream(damaged / "frame_0000.png", std::ios::binary | std::ios::trunc) << "cut";
+    const CommandResult noSpace =
+        runPreloaded("QSGI_FAIL_WRITES_AFTER=100", renderArguments("0:3") + " --frames 2:3 --resume --out " + quoted(damaged));
+    EXPECT_EQ(noSpace.exitCode, 74) << noSpace.output;
+    EXPECT_EQ(loggedFrames(damaged), (std::vector<int>{0, 1, 2, 3}));
+    expectConsistent(damaged);
+
+    // A hand-edited name in the log ("../" out of the folder) is no file of the frame: the frame
+    // is computed again, nothing outside is read as if it were.
+    nlohmann::json log = nlohmann::json::parse(readFileBytes(damaged / "timing.json"));
+    log["frames"][1]["files"][0]["name"] = "frame_0001.d/../../outside.ply";
+    std::ofstream(damaged / "timing.json", std::ios::trunc) << log.dump(2);
+    const CommandResult edited = runQsgi(renderArguments("0:3") + " --resume --out " + quoted(damaged));
+    EXPECT_EQ(edited.exitCode, 0) << edited.output;
+    EXPECT_NE(edited.output.find("not a file of this frame"), std::string::npos) << edited.output;
+    expectSameFrameFiles(reference, damaged);
+
+    // A folder standing at a frame file's name: refused before any work, even with --overwrite.
+    const fs::path blocked = dir / "blocked";
+    fs::create_directories(blocked / "frame_0001.exr");
+    for (const char* mode : {"", " --overwrite"}) {
+        const CommandResult r = runQsgi(renderArguments("0:3") + mode + " --out " + quoted(blocked));
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_NE(r.output.find("frame_0001.exr"), std::string::npos) << r.output;
+        EXPECT_TRUE(frameFiles(blocked) == std::set<std::string>{"frame_0001.exr"}) << "nothing rendered";
+    }
+}
+
 TEST(OutputSafety, ARealSmallFileSystemFillsAndResumesWhereTheTestsRunAsRoot) {
     if (::geteuid() != 0) GTEST_SKIP() << "mounting a small tmpfs needs root";
     if (runCommand("unshare -m true").exitCode != 0) GTEST_SKIP() << "unshare -m is not allowed here (a container without CAP_SYS_ADMIN)";

@@ -11,6 +11,8 @@
 #include <memory>
 #include <vector>
 
+#include "util/error.h"
+
 namespace qsgi {
 
 namespace {
@@ -27,16 +29,21 @@ struct StateFree {
 
 std::string xxh3Hex(std::string_view bytes) { return hex(XXH3_64bits(bytes.data(), bytes.size())); }
 
-std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record) {
+std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record, const std::string& folderName) {
+    auto unreadable = [&](int error) {
+        return EnvironmentError(folderName, "cannot read " + record.name + " to verify it: " + std::strerror(error));
+    };
     struct stat link {};
-    if (::fstatat(folderFd, record.name.c_str(), &link, AT_SYMLINK_NOFOLLOW) != 0)
-        return errno == ENOENT ? "missing" : std::string("cannot be read: ") + std::strerror(errno);
+    if (::fstatat(folderFd, record.name.c_str(), &link, AT_SYMLINK_NOFOLLOW) != 0) {
+        if (errno == ENOENT) return std::string("missing");
+        throw unreadable(errno);
+    }
     if (S_ISLNK(link.st_mode)) return "is a symbolic link, not a file qsgi wrote";
     if (!S_ISREG(link.st_mode)) return "is not a regular file";
     if (uint64_t(link.st_size) != record.bytes)
         return "has " + std::to_string(link.st_size) + " bytes, timing.json says " + std::to_string(record.bytes);
     const int fd = ::openat(folderFd, record.name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
-    if (fd < 0) return std::string("cannot be read: ") + std::strerror(errno);
+    if (fd < 0) throw unreadable(errno);
     std::unique_ptr<XXH3_state_t, StateFree> state(XXH3_createState());
     XXH3_64bits_reset(state.get());
     std::vector<char> buffer(1 << 20);
@@ -47,7 +54,7 @@ std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record) 
         if (n < 0) {
             const int error = errno;
             ::close(fd);
-            return std::string("cannot be read: ") + std::strerror(error);
+            throw unreadable(error);
         }
         if (n == 0) break;
         XXH3_64bits_update(state.get(), buffer.data(), size_t(n));

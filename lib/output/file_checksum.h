@@ -17,8 +17,9 @@ namespace qsgi {
 std::string xxh3Hex(std::string_view bytes);
 
 // Why the file `record.name` in the folder open as `folderFd` is not the one recorded: missing, a
-// symbolic link, not a regular file, another size, another checksum, unreadable. nullopt when it
-// matches. Never follows a link at the name.
-std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record);
+// symbolic link, not a regular file, another size, another checksum. nullopt when it matches.
+// Never follows a link at the name. A file that cannot be read (permissions, an I/O error) proves
+// nothing either way: throws EnvironmentError naming it, rather than calling it damaged.
+std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record, const std::string& folderName);
 
 }  // namespace qsgi

@@ -71,7 +71,11 @@ OutputDirectory::~OutputDirectory() {
 }
 
 bool OutputDirectory::isTemporaryName(const std::string& name) {
-    return name.rfind(kTemporaryPrefix, 0) == 0 || name.find(kOldTemporaryMarker) != std::string::npos;
+    // Older qsgi's: frame_0001.qsgi-tmp.ply, timing.qsgi-tmp.json, and its write probe; nothing
+    // else of the user's that happens to hold the marker.
+    const bool old = (name.rfind("frame_", 0) == 0 || name.rfind("timing.", 0) == 0) &&
+                     name.find(std::string(kOldTemporaryMarker) + ".") != std::string::npos;
+    return name.rfind(kTemporaryPrefix, 0) == 0 || old || name == ".qsgi-write-test";
 }
 
 int OutputDirectory::createTemporary(const std::string& name, std::string& temporary) {
@@ -97,8 +101,10 @@ FileRecord OutputDirectory::write(const std::string& name, std::string_view byte
         ::unlinkat(fd_, temporary.c_str(), 0);
         fail(path_, "cannot write " + name, error);
     }
-    // The rename is durable once the folder is.
-    if (::fsync(fd_) != 0 && errno != EINVAL) fail(path_, "cannot sync the folder after writing " + name, errno);
+    // The rename is durable once the folder is. If that fails the file is in place all the same:
+    // the caller must know (NotDurableError), since undoing the write is no longer possible.
+    if (::fsync(fd_) != 0 && errno != EINVAL)
+        throw NotDurableError(path_.string(), "cannot sync the folder after writing " + name + ": " + std::strerror(errno));
     return FileRecord{name, bytes.size(), xxh3Hex(bytes)};
 }
 

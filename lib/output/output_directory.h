@@ -12,9 +12,16 @@
 #include <string_view>
 #include <vector>
 
+#include "util/error.h"
 #include "util/file_record.h"
 
 namespace qsgi {
+
+// A write whose file is in place under its name, but whose rename may not survive a crash.
+class NotDurableError : public EnvironmentError {
+public:
+    using EnvironmentError::EnvironmentError;
+};
 
 class OutputDirectory {
 public:
@@ -31,7 +38,9 @@ public:
 
     // Writes `bytes` under `name` (no path) atomically and durably; returns what timing.json
     // records of it. Throws EnvironmentError naming the folder, the file and the system's reason
-    // (No space left on device…); the temporary is gone either way.
+    // (No space left on device…); the temporary is gone either way, and `name` holds what it held
+    // before — except for NotDurableError: the file is in place, but the folder could not be
+    // synced after the rename.
     FileRecord write(const std::string& name, std::string_view bytes);
 
     // Throws InputError (permissions, read-only) or EnvironmentError unless a file can be

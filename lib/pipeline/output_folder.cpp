@@ -36,26 +36,30 @@ std::vector<std::string> frameFileNames(int frame) {
     return {frameFileName(frame, "ply"), frameFileName(frame, "exr"), frameFileName(frame, "png"), frameFileName(frame, "glb")};
 }
 
-std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& s) {
+std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& s,
+                                             const std::string& folderName) {
     if (record.files.empty()) return std::string("timing.json (an older qsgi's) records no checksums to verify its files by");
     std::vector<std::string> wanted = {frameFileName(record.frame, "ply")};
     if (s.writeExr) wanted.push_back(frameFileName(record.frame, "exr"));
     if (s.writePng) wanted.push_back(frameFileName(record.frame, "png"));
     if (s.writeGltf) wanted.push_back(frameFileName(record.frame, "glb"));
+    // Exactly the names qsgi gives this frame's files: a hand-edited name ("../x") reads nothing
+    // outside the folder.
+    const std::vector<std::string> names = frameFileNames(record.frame);
+    for (const FileRecord& file : record.files)
+        if (std::find(names.begin(), names.end(), file.name) == names.end())
+            return "timing.json lists '" + file.name + "', not a file of this frame";
     for (const std::string& name : wanted) {
         const bool listed = std::any_of(record.files.begin(), record.files.end(), [&](const FileRecord& f) { return f.name == name; });
         if (!listed) return name + " is not among the files timing.json lists for it";
     }
-    for (const FileRecord& file : record.files) {
-        if (!isFrameFileName(file.name) || file.name.rfind(frameFileName(record.frame, ""), 0) != 0)
-            return "timing.json lists '" + file.name + "', not a file of this frame";
-        if (const std::optional<std::string> mismatch = fileMismatch(folderFd, file)) return file.name + " " + *mismatch;
-    }
+    for (const FileRecord& file : record.files)
+        if (const std::optional<std::string> mismatch = fileMismatch(folderFd, file, folderName)) return file.name + " " + *mismatch;
     return std::nullopt;
 }
 
 OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerprint& fingerprint,
-                                      const RenderSettings& settings) {
+                                      const RenderSettings& settings, bool verify) {
     OutputFolderSurvey survey;
     survey.folder = folder;
     std::error_code ec;
@@ -63,12 +67,17 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
     survey.notAFolder = !survey.exists && fs::exists(folder, ec);
     if (!survey.exists) return survey;
     try {
-        for (const auto& entry : fs::directory_iterator(folder))
-            if (isFrameFileName(entry.path().filename().string())) survey.frameFiles.push_back(entry.path());
+        for (const auto& entry : fs::directory_iterator(folder)) {
+            if (!isFrameFileName(entry.path().filename().string())) continue;
+            const fs::file_status status = entry.symlink_status();
+            if (!fs::is_regular_file(status) && !fs::is_symlink(status)) survey.blockingEntries.push_back(entry.path());
+            else survey.frameFiles.push_back(entry.path());
+        }
     } catch (const fs::filesystem_error& e) {
         throw InputError(folder.string(), "--out", std::string("cannot read the output folder: ") + e.code().message());
     }
     std::sort(survey.frameFiles.begin(), survey.frameFiles.end());
+    std::sort(survey.blockingEntries.begin(), survey.blockingEntries.end());
 
     const fs::path logPath = folder / "timing.json";
     const fs::file_status logStatus = fs::symlink_status(logPath, ec);
@@ -101,10 +110,15 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
     const int folderFd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (folderFd < 0)
         throw InputError(folder.string(), "--out", std::string("cannot read the output folder: ") + std::strerror(errno));
-    for (const FrameTiming& f : earlier.frames) {
-        if (const std::optional<std::string> problem = frameFilesProblem(folderFd, f, settings))
-            survey.failedFrames.push_back({f.frame, *problem});
-        else survey.completeFrames.push_back(f);
+    try {
+        for (const FrameTiming& f : earlier.frames) {
+            const std::optional<std::string> problem = verify ? frameFilesProblem(folderFd, f, settings, folder.string()) : std::nullopt;
+            if (problem) survey.failedFrames.push_back({f.frame, *problem});
+            else survey.completeFrames.push_back(f);
+        }
+    } catch (...) {
+        ::close(folderFd);
+        throw;
     }
     ::close(folderFd);
     return survey;
@@ -122,6 +136,10 @@ std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, 
     using Holds = OutputFolderSurvey::Holds;
     const std::string place = settings.resume ? "--resume" : "--out";
     if (survey.notAFolder) return InputError(survey.folder.string(), "--out", "is not a folder");
+    // Not even --overwrite unlinks what is not a file: refused before any work, not at its write.
+    if (!survey.blockingEntries.empty())
+        return InputError(survey.blockingEntries.front().string(), place,
+                          "is a folder (or other non-file) where qsgi writes a frame file; move it away");
     if (settings.overwrite || survey.holds == Holds::Nothing || survey.holds == Holds::ThisRun) return std::nullopt;
     if (survey.holds == Holds::UnknownFiles)
         return InputError(survey.folder.string(), place,

@@ -41,8 +41,10 @@ struct OutputFolderSurvey {
     std::vector<FailedFrame> failedFrames;
     // AnotherRun: what differs ("photons 20000 there, 1000000 here"), or why the log is unreadable.
     std::vector<std::string> differences;
-    // Every frame_NNNN.* entry in the folder (what --overwrite unlinks, with timing.json).
+    // Every frame_NNNN.* file or link in the folder (what --overwrite unlinks, with timing.json).
     std::vector<std::filesystem::path> frameFiles;
+    // Entries under a frame file's name that are no file (a folder, a FIFO): refused.
+    std::vector<std::filesystem::path> blockingEntries;
 };
 
 // "frame_0012.ply" and the like.
@@ -53,14 +55,17 @@ bool isFrameFileName(const std::string& name);
 
 // Why `frame`'s files in the folder open as `folderFd` are not as `record` lists them (every file
 // the settings ask for listed; every listed file verified by fileMismatch), or nullopt when they are.
-std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& settings);
+// A file that cannot be read throws EnvironmentError naming it (fileMismatch): it proves nothing.
+std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& settings,
+                                             const std::string& folderName);
 
 // The names of a frame's files, whichever the settings write: what a failed frame's removal unlinks.
 std::vector<std::string> frameFileNames(int frame);
 
-// Reads the folder (every frame file of this run's is read whole, to verify it); writes nothing.
+// Reads the folder; writes nothing. With `verify`, every frame file of this run's is read whole
+// to verify it; without, the frames the log lists count as complete (for a refusal's first look).
 OutputFolderSurvey surveyOutputFolder(const std::filesystem::path& folder, const RunFingerprint& fingerprint,
-                                      const RenderSettings& settings);
+                                      const RenderSettings& settings, bool verify = true);
 
 // The first frame of first..last that the survey's complete frames of this run do not hold
 // (last + 1 when they hold them all): where --resume starts.

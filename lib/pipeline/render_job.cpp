@@ -192,7 +192,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     // anything, so that a refused render leaves the folder exactly as it was; then again under
     // the folder's lock, which decides.
     if (const std::optional<InputError> refusal =
-            outputFolderRefusal(surveyOutputFolder(settings_.outDir, fingerprint_, settings_), settings_))
+            outputFolderRefusal(surveyOutputFolder(settings_.outDir, fingerprint_, settings_, false), settings_))
         throw *refusal;
     OutputDirectory out(settings_.outDir);
     const FolderLock lock(out, "qsgi render");
@@ -212,21 +212,6 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     // The first frame to compute: with --resume, the first of the range this run's earlier
     // frames do not already hold. Earlier frames outside what is computed stay in the log.
     const int start = settings_.resume ? firstIncompleteFrame(folder, first_, last_) : first_;
-    // Frames the log lists whose files are not as it records them (cut short, overwritten,
-    // replaced by a link): computed again when this run's frames hold them; outside them, their
-    // files are unlinked and the log forgets them, so that it lists exactly what is whole.
-    for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames) {
-        const bool recomputed = failed.frame >= start && failed.frame <= last_;
-        if (!recomputed)
-            for (const std::string& name : frameFileNames(failed.frame)) out.remove(name);
-        if (!recomputed || settings_.resume)
-            warn("frame " + std::to_string(failed.frame) + " in " + settings_.outDir + " is not as timing.json records it (" +
-                 failed.reason + "): " +
-                 (recomputed ? "computing it again"
-                             : "outside --frames, so its files are removed; render it again with --frames " +
-                                   std::to_string(failed.frame) + ":" + std::to_string(failed.frame) + " --resume"));
-    }
-
     TimingLog log;
     log.config = optionValues(settings_, OptionSelection::Logged);
     log.degenerateTriangles = ImpactCount(scene_).degenerateTriangles();
@@ -246,14 +231,29 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     outcome.framesResumed = settings_.resume ? int(log.frames.size()) : 0;
     outcome.framesKept = settings_.resume ? 0 : int(log.frames.size());
     outcome.nextFrame = start;
-    if (start > last_) {
-        // Resumed with nothing left to do: the folder stays as it is, but for the log forgetting
-        // frames whose files were removed above.
-        if (!folder.failedFrames.empty()) out.write("timing.json", log.text());
-        return outcome;
+    // The earlier frames this run computes again stay listed until each is rewritten (with the
+    // same bytes): a run stopped or failing before it reaches them leaves them whole and listed.
+    for (const FrameTiming& f : earlierFrames)
+        if (f.frame >= start && f.frame <= last_) log.frames.push_back(f);
+    // Written before any frame, so the folder records its inputs' fingerprint from the start, and
+    // forgets the frames whose files are not as it recorded them (cut short, overwritten, replaced
+    // by a link) before their files are unlinked: the log never lists a frame that is not whole.
+    // Those this run's frames hold are computed again; the others it says how to render again.
+    if (start <= last_ || !folder.failedFrames.empty()) out.write("timing.json", log.text());
+    for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames) {
+        for (const std::string& name : frameFileNames(failed.frame)) out.remove(name);
+        const bool recomputed = failed.frame >= start && failed.frame <= last_;
+        if (!recomputed || settings_.resume)
+            warn("frame " + std::to_string(failed.frame) + " in " + settings_.outDir + " is not as timing.json records it (" +
+                 failed.reason + "): " +
+                 (recomputed ? "computing it again"
+                             : "outside --frames, so its files are removed; render it again with --frames " +
+                                   std::to_string(failed.frame) + ":" + std::to_string(failed.frame) + " --resume"));
     }
-    // Written before any frame, so the folder records its inputs' fingerprint from the start.
-    out.write("timing.json", log.text());
+    outcome.framesRemoved = 0;
+    for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames)
+        if (failed.frame < start || failed.frame > last_) ++outcome.framesRemoved;
+    if (start > last_) return outcome;  // resumed with nothing left to do
 
     EmbreeDevice device;
     auto imageMetadata = [&](int frame) {
@@ -329,29 +329,51 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         // A frame is on disk whole or not at all: every file, then timing.json listing them. A
         // failure (a full disk) removes the files already placed, so the folder holds exactly
         // the frames the log lists, and --resume continues from this one.
+        // Every file encoded before any is written: an encoder that fails leaves nothing behind.
         const std::vector<std::string> names = frameFileNames(frame);
+        std::vector<std::pair<std::string, std::string>> files;
+        files.emplace_back(names[0], encodeVertexRadiosityPly(scene_, result, *tonemap));
+        if (settings_.writeExr) files.emplace_back(names[1], encodeExr(*image, imageMetadata(frame), settings_.exrHalf));
+        if (settings_.writePng) files.emplace_back(names[2], encodePngPreview(*image, *exposure));
+        if (settings_.writeGltf) files.emplace_back(names[3], encodeVertexRadiosityGlb(scene_, result, *tonemap));
+        const auto listed = std::find_if(log.frames.begin(), log.frames.end(), [&](const FrameTiming& f) { return f.frame == frame; });
+        const bool listedBefore = listed != log.frames.end();
+        const std::vector<FrameTiming> logBefore = listedBefore ? std::vector<FrameTiming>{} : log.frames;
+        std::string writing;
         try {
-            timing.files.push_back(out.write(names[0], encodeVertexRadiosityPly(scene_, result, *tonemap)));
-            if (settings_.writeExr) timing.files.push_back(out.write(names[1], encodeExr(*image, imageMetadata(frame), settings_.exrHalf)));
-            if (settings_.writePng) timing.files.push_back(out.write(names[2], encodePngPreview(*image, *exposure)));
-            if (settings_.writeGltf) timing.files.push_back(out.write(names[3], encodeVertexRadiosityGlb(scene_, result, *tonemap)));
+            for (const auto& [name, bytes] : files) {
+                writing = name;
+                timing.files.push_back(out.write(name, bytes));
+            }
             timing.writeSeconds = clock.seconds();
-            log.frames.push_back(timing);
+            if (listedBefore) *listed = timing;
+            else log.frames.push_back(timing);
+            writing = "timing.json";
             // Rewritten after every frame, so it always describes the frames on disk (docs/design.md §7).
             out.write("timing.json", log.text());
         } catch (const EnvironmentError& e) {
-            if (!log.frames.empty() && log.frames.back().frame == frame) log.frames.pop_back();
             std::string problem = "writing frame " + std::to_string(frame) + " failed: " + e.problem() + ". ";
-            try {
-                for (const std::string& name : names) out.remove(name);
-                problem += "Its files were removed; ";
-            } catch (const EnvironmentError& removal) {
-                problem += "Removing its files failed too (" + removal.problem() + "); ";
+            const bool logPlaced = writing == "timing.json" && dynamic_cast<const NotDurableError*>(&e) != nullptr;
+            if (listedBefore || logPlaced) {
+                // Listed, and whole: each of its names holds the earlier bytes or the same new ones.
+                problem += "Its files are whole and listed; ";
+            } else {
+                // A frame the log on disk does not list: whatever of it was placed goes.
+                log.frames = logBefore;
+                std::string failures;
+                for (const std::string& name : names) {
+                    try {
+                        out.remove(name);
+                    } catch (const EnvironmentError& removal) {
+                        failures += (failures.empty() ? "" : "; ") + removal.problem();
+                    }
+                }
+                problem += failures.empty() ? "Its files were removed; " : "Removing its files failed too (" + failures + "); ";
             }
-            if (frame > start)
-                problem += "frames " + std::to_string(start) + "-" + std::to_string(frame - 1) + " are complete; ";
-            throw EnvironmentError(settings_.outDir, problem + "once the cause is fixed, add --resume to continue from frame " +
-                                                         std::to_string(frame));
+            const size_t listedFrames = log.frames.size();
+            problem += "timing.json lists the " + std::to_string(listedFrames) + (listedFrames == 1 ? " frame" : " frames") +
+                       " whole on disk; once the cause is fixed, add --resume to continue from frame " + std::to_string(frame);
+            throw EnvironmentError(settings_.outDir, problem);
         }
         outcome.nextFrame = frame + 1;
         ++outcome.framesWritten;

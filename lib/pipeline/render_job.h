@@ -37,6 +37,7 @@ struct RunOutcome {
     int nextFrame = 0;      // the first frame not written
     int framesResumed = 0;  // frames an earlier run had written (--resume)
     int framesKept = 0;     // frames of an earlier run of the same inputs outside this run's range (no --resume)
+    int framesRemoved = 0;  // frames outside the range whose files failed verification: unlinked
     int filesReplaced = 0;  // of another run, unlinked by --overwrite (frame files and timing.json)
     int framesWritten = 0;  // by this run
 };

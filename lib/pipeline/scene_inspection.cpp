@@ -79,8 +79,8 @@ nlohmann::json outputFolderReport(const RenderJob& job) {
     }
     if (!survey.failedFrames.empty() && survey.holds == Holds::ThisRun)
         render += "; " + std::to_string(survey.failedFrames.size()) +
-                  " frames it lists are not as its timing.json records them: computed again within the frames "
-                  "rendered, removed outside them";
+                  (survey.failedFrames.size() == 1 ? " frame it lists is" : " frames it lists are") +
+                  " not as its timing.json records them: computed again within the frames rendered, removed outside them";
     if (!job.hasLight()) render = "refuses: the scene has no lights";
     r["render"] = render;
     return r;
