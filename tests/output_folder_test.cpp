@@ -48,10 +48,11 @@ std::map<std::string, std::string> contents(const fs::path& dir) {
 }  // namespace
 
 TEST(OutputFolder, FrameFileNamesAreRecognisedExactly) {
-    for (const char* name : {"frame_0000.ply", "frame_0012.exr", "frame_12345.png", "frame_9999.glb", "frame_0001.x"})
+    for (const char* name : {"frame_0000.ply", "frame_0012.exr", "frame_12345.png", "frame_9999.glb"})
         EXPECT_TRUE(qsgi::isFrameFileName(name)) << name;
     for (const char* name : {"frame_000.ply", "frame_0001", "frame_0001.", "frames_0001.ply", "frame_00a1.ply", "timing.json",
-                             "my_frame_0001.ply", "frame_.ply", "frame_0001.qsgi-tmp.ply", "frame_0001.ply.qsgi-merge-tmp"})
+                             "my_frame_0001.ply", "frame_.ply", "frame_0001.qsgi-tmp.ply", "frame_0001.ply.qsgi-merge-tmp",
+                             "frame_0001.x", "frame_0003.png.bak", "frame_0003.ply~", "frame_0003.PLY"})
         EXPECT_FALSE(qsgi::isFrameFileName(name)) << name;
     EXPECT_EQ(qsgi::frameFileName(7, "ply"), "frame_0007.ply");
     EXPECT_TRUE(qsgi::isFrameFileName(qsgi::frameFileName(123456, "exr")));

@@ -28,8 +28,10 @@ bool isFrameFileName(const std::string& name) {
     if (name.rfind("frame_", 0) != 0) return false;
     size_t digits = 0;
     while (kPrefix + digits < name.size() && std::isdigit(static_cast<unsigned char>(name[kPrefix + digits]))) ++digits;
-    return digits >= 4 && kPrefix + digits + 1 < name.size() && name[kPrefix + digits] == '.' &&
-           name.find(".qsgi-") == std::string::npos;
+    if (digits < 4 || kPrefix + digits >= name.size() || name[kPrefix + digits] != '.') return false;
+    // Only the kinds qsgi writes: a user's frame_0003.png.bak or frame_0003.txt is not ours to unlink.
+    const std::string extension = name.substr(kPrefix + digits + 1);
+    return extension == "ply" || extension == "exr" || extension == "png" || extension == "glb";
 }
 
 std::vector<std::string> frameFileNames(int frame) {

@@ -49,8 +49,8 @@ struct OutputFolderSurvey {
 
 // "frame_0012.ply" and the like.
 std::string frameFileName(int frame, const char* extension);
-// "frame_0012.ply", "frame_12345.exr": a frame file's name as frameFileName writes it (not a
-// temporary of AtomicFile's or the Slurm merge's, whose names hold ".qsgi-").
+// "frame_0012.ply", "frame_12345.exr": a frame file's name as frameFileName writes it, with one
+// of the extensions qsgi writes (ply, exr, png, glb); not a temporary, not "frame_0003.png.bak".
 bool isFrameFileName(const std::string& name);
 
 // Why `frame`'s files in the folder open as `folderFd` are not as `record` lists them (every file

@@ -282,7 +282,7 @@ std::vector<RenderOption> declareOptions() {
                  false, false, [](RenderSettings& s, const json& v, const OptionSource&) { s.resume = v; },
                  [](const RenderSettings& s) { return json(s.resume); }});
     o.push_back({nullptr, "--overwrite", T::Boolean, 0, 0, "", {}, true, "", "false",
-                 "when the output folder holds another run (other inputs or settings), unlink its frame_NNNN.* files "
+                 "when the output folder holds another run (other inputs or settings), unlink its frame_NNNN.{ply,exr,png,glb} files "
                  "and timing.json first (nothing else, never recursively); without it such a folder is refused",
                  false, false, [](RenderSettings& s, const json& v, const OptionSource&) { s.overwrite = v; },
                  [](const RenderSettings& s) { return json(s.overwrite); }});
