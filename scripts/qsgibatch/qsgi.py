@@ -3,6 +3,10 @@
 import json
 import os
 import subprocess
+import time
+
+# qsgi's exit code when another run holds the output folder (sysexits' EX_TEMPFAIL).
+FOLDER_BUSY = 75
 
 
 class QsgiError(Exception):
@@ -33,7 +37,14 @@ class Qsgi:
                    "--threads", str(threads), "--no-exr", "--quiet", "--resume"] + options
         if self.animation:
             command += ["--animation", self.animation]
-        done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        # Exit 75: another render holds the folder (its lock). Array tasks all render the same
+        # scene probe; the holder is rendering what this one wants, so wait and go on with
+        # --resume, which then finds it done. Given up after ten minutes.
+        for _ in range(1200):
+            done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            if done.returncode != FOLDER_BUSY:
+                break
+            time.sleep(0.5)
         if done.returncode != 0:
             raise QsgiError(f"{' '.join(command)}\nexit {done.returncode}: {done.stdout.strip()}")
         with open(os.path.join(out, "timing.json")) as f:
