@@ -24,13 +24,6 @@ std::string cornellRender(const std::string& frames, const std::string& options,
            " --frames " + frames + " --width 20 --height 15 " + (quiet ? "--quiet " : "") + options;
 }
 
-std::vector<int> loggedFrames(const fs::path& dir) {
-    std::vector<int> frames;
-    const nlohmann::json log = nlohmann::json::parse(readFileBytes(dir / "timing.json"));
-    for (const auto& f : log["frames"]) frames.push_back(f["frame"]);
-    return frames;
-}
-
 std::set<std::string> namesIn(const fs::path& dir) {
     std::set<std::string> names;
     for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());

@@ -37,24 +37,10 @@ CommandResult runPreloaded(const std::string& environment, const std::string& ar
     return runCommand(asan + "LD_PRELOAD=" + QSGI_FAIL_WRITES + " " + environment + " " + QSGI_CLI + " " + arguments);
 }
 
-std::set<std::string> frameFiles(const fs::path& dir) {
-    std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir))
-        if (e.path().filename().string().rfind("frame_", 0) == 0) names.insert(e.path().filename().string());
-    return names;
-}
-
 void expectSameFrameFiles(const fs::path& reference, const fs::path& other) {
     const std::set<std::string> names = frameFiles(reference);
     EXPECT_EQ(frameFiles(other), names);
     for (const std::string& name : names) EXPECT_EQ(readFileBytes(reference / name), readFileBytes(other / name)) << name;
-}
-
-std::vector<int> loggedFrames(const fs::path& dir) {
-    std::vector<int> frames;
-    const nlohmann::json log = nlohmann::json::parse(readFileBytes(dir / "timing.json"));
-    for (const auto& f : log["frames"]) frames.push_back(f["frame"]);
-    return frames;
 }
 
 // The folder is consistent: timing.json lists exactly the frames whose files are on disk, each

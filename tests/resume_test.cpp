@@ -42,13 +42,6 @@ SignalledRun runAndSignal(const std::string& arguments, const char* signal, doub
     return {std::stoi(readFileBytes(rc)), readFileBytes(log)};
 }
 
-std::set<std::string> frameFiles(const fs::path& dir) {
-    std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir))
-        if (e.path().filename().string().rfind("frame_", 0) == 0) names.insert(e.path().filename().string());
-    return names;
-}
-
 void expectSameFrameFiles(const fs::path& reference, const fs::path& resumed) {
     const std::set<std::string> names = frameFiles(reference);
     ASSERT_EQ(names.size(), 90u);
@@ -56,13 +49,6 @@ void expectSameFrameFiles(const fs::path& reference, const fs::path& resumed) {
     for (const std::string& name : names) EXPECT_EQ(readFileBytes(reference / name), readFileBytes(resumed / name)) << name;
 }
 
-// The frames timing.json lists, in order.
-std::vector<int> loggedFrames(const fs::path& dir) {
-    std::vector<int> frames;
-    const nlohmann::json log = nlohmann::json::parse(readFileBytes(dir / "timing.json"));
-    for (const auto& f : log["frames"]) frames.push_back(f["frame"]);
-    return frames;
-}
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -26,6 +26,20 @@ std::string testScratchDir(const std::string& name) {
     return p.string();
 }
 
+std::set<std::string> frameFiles(const std::filesystem::path& dir) {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().rfind("frame_", 0) == 0) names.insert(e.path().filename().string());
+    return names;
+}
+
+std::vector<int> loggedFrames(const std::filesystem::path& dir) {
+    std::vector<int> frames;
+    const nlohmann::json log = nlohmann::json::parse(readFileBytes(dir / "timing.json"));
+    for (const auto& f : log["frames"]) frames.push_back(f["frame"]);
+    return frames;
+}
+
 CommandResult runQsgi(const std::string& arguments) { return runCommand(std::string(QSGI_CLI) + " " + arguments); }
 
 CommandResult runCommand(const std::string& commandLine) {

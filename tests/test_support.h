@@ -4,7 +4,9 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "estimate/estimator.h"
 #include "scene/scene.h"
@@ -38,6 +40,9 @@ struct CommandResult {
 CommandResult runQsgi(const std::string& arguments);     // the qsgi executable with these arguments
 CommandResult runCommand(const std::string& commandLine);  // any shell command line
 std::string readFileBytes(const std::filesystem::path& path);  // "" if unreadable
+// The names of an output folder's frame_* entries, and the frames its timing.json lists, in order.
+std::set<std::string> frameFiles(const std::filesystem::path& dir);
+std::vector<int> loggedFrames(const std::filesystem::path& dir);
 
 // Every field of the two segments has the same bits.
 bool sameBits(const qsgi::Segment& a, const qsgi::Segment& b);
