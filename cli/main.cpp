@@ -171,7 +171,7 @@ int runCompare(const std::string& a, const std::string& b, std::optional<double>
     const qsgi::AccuracyReport r = qsgi::compareSolutions(reference.positions, reference.normals, reference.triangles,
                                                           solution.radiosity, reference.radiosity, radius);
     const std::pair<const char*, const qsgi::ErrorStats*> rows[] = {
-        {"all", &r.all}, {"edge", &r.edge}, {"near_edge", &r.nearEdge}, {"interior", &r.interior}};
+        {"all", &r.all}, {"edge", &r.edge}, {"near_edge", &r.nearEdge}, {"interior", &r.interior}, {"contact", &r.contact}};
     if (json) {
         nlohmann::json j{{"solution", a}, {"reference", b}, {"radius", radius}};
         for (const auto& [name, s] : rows)
@@ -181,8 +181,9 @@ int runCompare(const std::string& a, const std::string& b, std::optional<double>
     }
     std::printf("%-34s %10s %14s %14s\n", "vertices", "count", "relative RMS", "relative bias");
     const std::string nearLabel = "within " + std::to_string(radius).substr(0, 6) + " of an edge";
-    const char* labels[] = {"all", "on an edge (border, crease > 45°)", nearLabel.c_str(), "interior"};
-    for (size_t i = 0; i < 4; ++i)
+    const char* labels[] = {"all", "on an edge (border, crease > 45°)", nearLabel.c_str(), "interior",
+                            "touching another surface"};
+    for (size_t i = 0; i < 5; ++i)
         std::printf("%-34s %10zu %14.5f %+14.5f\n", labels[i], rows[i].second->vertices, rows[i].second->relativeRms,
                     rows[i].second->relativeBias);
     return 0;

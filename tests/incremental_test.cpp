@@ -92,7 +92,8 @@ FrameSolverSettings solverSettings(const EstimatorCase& e, float radius, uint64_
 
 // Runs the animation incrementally and checks every frame against a from-scratch solve.
 void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e, int threads, bool envelope,
-                                 uint64_t photons, float radius, uint32_t generations = TrackedPaths::kGenerations) {
+                                 uint64_t photons, float radius, uint32_t generations = TrackedPaths::kGenerations,
+                                 const LightingSettings& lighting = {}) {
     SCOPED_TRACE(a.name + " / " + e.name + " / threads " + std::to_string(threads) + (envelope ? "" : " / no envelope"));
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     int moverA = -1, moverB = -1;
@@ -101,10 +102,11 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
     FrameSolverSettings incremental = solverSettings(e, radius, photons);
     incremental.useEnvelope = envelope;
     incremental.trackedGenerations = generations;
+    incremental.lighting = lighting;
     FrameSolverSettings full = incremental;
     full.fullRecompute = true;
     FrameSolver inc(incScene, device, incremental), ref(fullScene, device, full);
-    uint64_t retraced = 0;
+    uint64_t retraced = 0, gatherRecast = 0, gatherFull = 0;
     for (int f = 0; f < a.frames; ++f) {
         FrameTiming wi, wf;
         const VertexRadiosity& ri = inc.solve(a.localsAt(incScene, moverA, f), wi);
@@ -112,6 +114,8 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
         if (f > 0) {
             EXPECT_FALSE(wi.fromScratch);
             retraced += wi.pathsRetraced;
+            gatherRecast += wi.gatherRays;
+            gatherFull += wf.gatherRays;
         }
         ASSERT_TRUE(sameBits(ri.radiosity, rf.radiosity))
             << "frame " << f << ": first differing vertex " << firstDifference(ri.radiosity, rf.radiosity);
@@ -119,6 +123,12 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
     }
     // The scenes are built so the mover is in the light: the update did real work.
     EXPECT_GT(retraced, 0u);
+    // The gather re-cast some rays each frame, and fewer than a full recomputation casts.
+    if (lighting.gathers()) {
+        EXPECT_GT(gatherRecast, 0u);
+        EXPECT_LT(gatherRecast, gatherFull);
+        EXPECT_EQ(gatherFull, uint64_t(a.frames - 1) * incScene.vertexCount() * lighting.gatherRays);
+    }
     // A lowered generation limit is there to make the renumbering run.
     if (generations < TrackedPaths::kGenerations) {
         ASSERT_NE(inc.trackedPaths(), nullptr);
@@ -178,6 +188,42 @@ TEST(Incremental, EveryFrameEqualsFullRecomputationForEveryEstimator) {
             expectIncrementalEqualsFull(a, e, 2, true, photons, 0.12f);
             if (HasFatalFailure()) return;
         }
+}
+
+// The second pass (docs/design.md §5.1): exact direct light and a final gather over the photon
+// solution are kept across frames — shadow and gather rays re-cast only where a mover's old or new
+// bounds meet them — and every frame still equals a full recomputation, for every estimator, also
+// with direct light alone (the estimators then count light after its first bounce only). Lights
+// are static (emissive movers are refused: docs/design.md §2), so the emitters never move.
+LightingSettings exactDirect(uint32_t gatherRays) {
+    LightingSettings l;
+    l.direct = DirectLighting::Exact;
+    l.directSamples = 4;
+    l.gatherRays = gatherRays;
+    return l;
+}
+
+TEST(Incremental, WithExactDirectAndGatherEveryFrameEqualsFull) {
+    const std::vector<AnimatedScene> all = scenes();
+    for (const AnimatedScene& a : all)
+        for (const EstimatorCase& e : kEstimators) {
+            // Every estimator on the first scene; on the others one of each kind (the second
+            // pass's update is the same code whatever the estimator under it).
+            if (a.name != all[0].name && (!e.index || e.rule != DetpBoundary::Clip)) continue;
+            const uint64_t photons = e.index ? 6000 : 1500;
+            expectIncrementalEqualsFull(a, e, 2, true, photons, 0.12f, TrackedPaths::kGenerations, exactDirect(16));
+            if (HasFatalFailure()) return;
+        }
+}
+
+TEST(Incremental, WithExactDirectEqualsFullWithOneThreadAndWithoutGather) {
+    const AnimatedScene a = scenes()[0];
+    for (const EstimatorCase& e : kEstimators) {
+        if (!e.index) continue;
+        expectIncrementalEqualsFull(a, e, 1, true, 6000, 0.12f, TrackedPaths::kGenerations, exactDirect(16));
+        expectIncrementalEqualsFull(a, e, 2, true, 6000, 0.12f, TrackedPaths::kGenerations, exactDirect(0));
+        if (HasFatalFailure()) return;
+    }
 }
 
 TEST(Incremental, EqualsFullWithOneThreadAndWithoutTheEnvelope) {

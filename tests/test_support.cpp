@@ -373,3 +373,32 @@ bool sameSegments(const qsgi::RayCache& a, const qsgi::RayCache& b) {
         if (!sameBits(sa[i], sb[i])) return false;
     return true;
 }
+
+namespace testscenes {
+
+Scene floorUnderEmitter(int cells, Vec3f centre, float halfX, float halfZ, Vec3f emission, Vec3f albedo) {
+    Scene s;
+    const uint32_t floor = addMaterial(s, albedo), lamp = addMaterial(s, albedo, emission);
+    addGrid(s, s.addNode("Floor", Transform()), {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, cells, floor);
+    // cross(+x, +z) = −y: the front faces the floor.
+    addGrid(s, s.addNode("Lamp", Transform()), centre - Vec3f(halfX, 0, halfZ), {2 * halfX, 0, 0}, {0, 0, 2 * halfZ}, 1, lamp);
+    s.finalize();
+    return s;
+}
+
+Scene plateUnderSheet(float plateHalf, int plateCells, float sheetHalf, int sheetCells, float gap, bool sheetFacesUp,
+                      Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    addGrid(s, s.addNode("Plate", Transform()), {-plateHalf, 0, plateHalf}, {2 * plateHalf, 0, 0}, {0, 0, -2 * plateHalf},
+            plateCells, m);
+    const int sheet = s.addNode("Sheet", Transform());
+    if (sheetFacesUp)  // cross(+x, −z) = +y
+        addGrid(s, sheet, {-sheetHalf, gap, sheetHalf}, {2 * sheetHalf, 0, 0}, {0, 0, -2 * sheetHalf}, sheetCells, m);
+    else  // cross(+x, +z) = −y
+        addGrid(s, sheet, {-sheetHalf, gap, -sheetHalf}, {2 * sheetHalf, 0, 0}, {0, 0, 2 * sheetHalf}, sheetCells, m);
+    s.finalize();
+    return s;
+}
+
+}  // namespace testscenes

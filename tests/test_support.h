@@ -107,3 +107,19 @@ struct GltfWriter {
     void write(const std::string& path) const;
 };
 }  // namespace testscenes
+
+// Scenes of the direct-light and final-gather tests (tests/direct_light_test.cpp,
+// tests/final_gather_test.cpp).
+namespace testscenes {
+// A floor y = 0 (x, z in [-1, 1], `cells` per side, facing up) under an emissive rectangle of two
+// triangles (material emission `emission`, the floor's albedo) centred at `centre`, parallel to
+// the floor, half sizes `halfX` and `halfZ`, its front (CCW) side facing down.
+qsgi::Scene floorUnderEmitter(int cells, qsgi::Vec3f centre, float halfX, float halfZ, qsgi::Vec3f emission,
+                              qsgi::Vec3f albedo);
+// A plate y = 0 (half size `plateHalf`, facing up) under a single-sided sheet y = `gap` (half size
+// `sheetHalf`), both centred on the y axis. sheetFacesUp: the sheet's front (winding and vertex
+// normals) faces +y, away from the plate, else −y, toward it. The plate is instance 0, the sheet
+// instance 1.
+qsgi::Scene plateUnderSheet(float plateHalf, int plateCells, float sheetHalf, int sheetCells, float gap,
+                            bool sheetFacesUp, qsgi::Vec3f albedo);
+}  // namespace testscenes

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <unordered_map>
 
 #include "estimate/own_surface.h"
 #include "estimate/point_index.h"
@@ -122,6 +123,81 @@ std::vector<EdgeRegion> edgeRegions(const std::vector<Vec3f>& positions, const s
     return region;
 }
 
+namespace {
+
+// Squared distance from p to the triangle abc (closest point by regions, Ericson §5.1.5).
+double squaredDistanceToTriangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    const Vec3d ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    auto d2to = [&](const Vec3d& q) { return dot(p - q, p - q); };
+    if (d1 <= 0 && d2 <= 0) return d2to(a);
+    const Vec3d bp = p - b;
+    const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return d2to(b);
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return d2to(a + ab * (d1 / (d1 - d3)));
+    const Vec3d cp = p - c;
+    const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return d2to(c);
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return d2to(a + ac * (d2 / (d2 - d6)));
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return d2to(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
+    const double denom = va + vb + vc;
+    if (!(denom != 0)) return d2to(a);
+    return d2to(a + ab * (vb / denom) + ac * (vc / denom));
+}
+
+}  // namespace
+
+std::vector<bool> touchingOtherSurfaces(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles,
+                                        float tolerance) {
+    std::vector<bool> touching(positions.size(), false);
+    if (positions.empty() || triangles.empty()) return touching;
+    const MeshTopology topology(positions, triangles);
+    // A uniform grid of cells about a mean triangle across, each listing the triangles whose
+    // bounds (padded by the tolerance) overlap it.
+    Bounds3f bounds;
+    double meanSize = 0;
+    for (const Triangle& t : triangles) {
+        Bounds3f b;
+        for (uint32_t v : t.v) b.extend(positions[v]);
+        bounds.extend(b);
+        meanSize += double(maxComponent(b.diagonal()));
+    }
+    meanSize /= double(triangles.size());
+    const double extent = std::max(double(maxComponent(bounds.diagonal())), 1e-30);
+    const double cell = std::max({meanSize, double(tolerance), extent / 1024.0});
+    auto cellOf = [&](double x, int axis) { return int64_t(std::floor((x - double(bounds.lower[axis])) / cell)); };
+    auto key = [](int64_t x, int64_t y, int64_t z) { return uint64_t(x & 0x1FFFFF) << 42 | uint64_t(y & 0x1FFFFF) << 21 | uint64_t(z & 0x1FFFFF); };
+    std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+    for (uint32_t t = 0; t < triangles.size(); ++t) {
+        Bounds3f b;
+        for (uint32_t v : triangles[t].v) b.extend(positions[v]);
+        b = b.expanded(tolerance);
+        for (int64_t x = cellOf(b.lower.x, 0); x <= cellOf(b.upper.x, 0); ++x)
+            for (int64_t y = cellOf(b.lower.y, 1); y <= cellOf(b.upper.y, 1); ++y)
+                for (int64_t z = cellOf(b.lower.z, 2); z <= cellOf(b.upper.z, 2); ++z) grid[key(x, y, z)].push_back(t);
+    }
+    const double tolerance2 = double(tolerance) * double(tolerance);
+    for (uint32_t v = 0; v < positions.size(); ++v) {
+        const Vec3d p(positions[v]);
+        const auto it = grid.find(key(cellOf(p.x, 0), cellOf(p.y, 1), cellOf(p.z, 2)));
+        if (it == grid.end()) continue;
+        for (uint32_t t : it->second) {
+            // Its own triangles (at its welded position) do not count.
+            if (std::binary_search(topology.trianglesBegin(v), topology.trianglesEnd(v), t)) continue;
+            const Triangle& tri = triangles[t];
+            if (squaredDistanceToTriangle(p, Vec3d(positions[tri.v[0]]), Vec3d(positions[tri.v[1]]), Vec3d(positions[tri.v[2]])) <=
+                tolerance2) {
+                touching[v] = true;
+                break;
+            }
+        }
+    }
+    return touching;
+}
+
 AccuracyReport compareSolutions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
                                 const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values,
                                 const std::vector<Vec3f>& reference, float radius) {
@@ -136,6 +212,11 @@ AccuracyReport compareSolutions(const std::vector<Vec3f>& positions, const std::
     r.edge = errorStats(values, reference, subset(EdgeRegion::OnEdge));
     r.nearEdge = errorStats(values, reference, subset(EdgeRegion::NearEdge));
     r.interior = errorStats(values, reference, subset(EdgeRegion::Interior));
+    // Touching: within 10^-5 of the scene's size of another surface (the scenes' contacts are
+    // exact; a tolerance keeps float rounding of placed meshes from hiding them).
+    Bounds3f bounds;
+    for (const Vec3f& p : positions) bounds.extend(p);
+    r.contact = errorStats(values, reference, touchingOtherSurfaces(positions, triangles, 1e-5f * bounds.extent()));
     return r;
 }
 

@@ -22,7 +22,16 @@ struct AccuracyReport {
     ErrorStats edge;      // vertices on an edge of their surface (a border or a crease of more than 45°)
     ErrorStats nearEdge;  // within one radius of an edge, not on one
     ErrorStats interior;  // the rest
+    // Vertices where two surfaces touch (touchingOtherSurfaces): a block standing on a floor, a
+    // wall's foot. Across the others, not one of their partition: what a vertex there should be
+    // is the limit of two surfaces at once, and references disagree most there.
+    ErrorStats contact;
 };
+
+// Vertices within `tolerance` of a triangle that is not one of theirs (vertices welded by
+// position): where one surface rests on or runs into another.
+std::vector<bool> touchingOtherSurfaces(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles,
+                                        float tolerance);
 
 enum class EdgeRegion : uint8_t { OnEdge, NearEdge, Interior };
 

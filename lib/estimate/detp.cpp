@@ -25,6 +25,10 @@ const VertexDisc& discOf(const DiscRegions* regions, size_t v) { return regions 
 
 // The published rule applies: chosen, or the vertex has no own surface.
 bool usesPaperRule(DetpBoundary rule, const VertexDisc& disc) { return rule == DetpBoundary::Paper || disc.fallback; }
+
+// The segment crosses no disc: it is an emission segment, and only what arrives after the first
+// bounce is estimated (direct light is computed apart).
+bool leftOut(const Segment& s, bool afterFirstBounce) { return afterFirstBounce && s.bounce == 0; }
 }  // namespace
 
 Reach detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,
@@ -197,9 +201,11 @@ void recordCrossedDisc(const RTCFilterFunctionNArguments* args) {
 struct DetpDiscs::Crossed : CrossedDisc {};
 
 DetpDiscs::DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule,
-                     const DiscRegions* regions, const SceneBvh* bvh, const std::vector<uint8_t>* refitted)
+                     const DiscRegions* regions, const SceneBvh* bvh, const std::vector<uint8_t>* refitted,
+                     bool afterFirstBounce)
     : device_(device), scene_(scene), radius_(radius), rule_(rule), regions_(regions), bvh_(bvh),
-      refitted_(refitted ? *refitted : scene.vertexDynamic), staticDiscs_(device), dynamicDiscs_(device) {
+      afterFirstBounce_(afterFirstBounce), refitted_(refitted ? *refitted : scene.vertexDynamic), staticDiscs_(device),
+      dynamicDiscs_(device) {
     refitted_.resize(scene.vertexCount(), 0);
     const float eps = scene.sceneEpsilon();
     rayExtension_ = 1e-4f * radius + eps;
@@ -260,6 +266,12 @@ void DetpDiscs::crossings(const Segment& s, std::vector<Crossed>& out) const {
 
 void DetpDiscs::crossingsIn(const Segment& s, std::initializer_list<std::pair<RTCScene, const Part*>> bvhs,
                             std::vector<Crossed>& out) const {
+    // Every query (sums, findCrossings, recompute) comes through here: the one place to leave a
+    // segment out, which keeps the callers' segment indexes as they are.
+    if (leftOut(s, afterFirstBounce_)) {
+        out.clear();
+        return;
+    }
     // Per thread and reused: an allocation per segment cost as much as a small BVH's traversal.
     thread_local std::vector<CrossedDisc> crossed;
     crossed.clear();
@@ -406,20 +418,25 @@ void DetpDiscs::findCrossings(const std::vector<Segment>& segments, Discs which,
 }
 
 DetpVertexSums detpVertexSums(const Scene& scene, uint32_t v, const std::vector<const Segment*>& segments, float radius,
-                              DetpBoundary rule, const DiscRegions* regions, const SceneBvh* bvh, const PowerQuantizer& q) {
+                              DetpBoundary rule, const DiscRegions* regions, const SceneBvh* bvh, const PowerQuantizer& q,
+                              bool afterFirstBounce) {
     DetpVertexSums sums;
     const VertexDisc& disc = discOf(regions, v);
     DiscCrossing at;
     for (const Segment* s : segments)
-        if (detpCounts(*s, scene.positions[v], scene.normals[v], disc, radius, rule, bvh, at))
+        if (!leftOut(*s, afterFirstBounce) && detpCounts(*s, scene.positions[v], scene.normals[v], disc, radius, rule, bvh, at))
             sums.add(s->power, at, q, rule == DetpBoundary::Linear);
     return sums;
 }
 
 std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
-                                  const DiscRegions* regions, const SceneBvh* bvh) {
+                                  const DiscRegions* regions, const SceneBvh* bvh, bool afterFirstBounce) {
     const PowerQuantizer q(cache.maxPhotonPower);
-    const std::vector<Segment> segments = cache.decodeAll();
+    std::vector<Segment> segments = cache.decodeAll();
+    // Nothing indexes these segments: the left-out ones can go.
+    if (afterFirstBounce)
+        segments.erase(std::remove_if(segments.begin(), segments.end(), [](const Segment& s) { return leftOut(s, true); }),
+                       segments.end());
     const bool moments = rule == DetpBoundary::Linear;
     VertexSums sums(scene.vertexCount());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, scene.vertexCount(), 16), [&](const tbb::blocked_range<size_t>& r) {
@@ -436,11 +453,11 @@ std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, flo
 
 std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
                                        const DiscRegions* regions, const SceneBvh* bvh,
-                                       const std::vector<uint32_t>& vertexOrder) {
+                                       const std::vector<uint32_t>& vertexOrder, bool afterFirstBounce) {
     const PowerQuantizer q(cache.maxPhotonPower);
     const bool moments = rule == DetpBoundary::Linear;
     const std::vector<Segment> segments = cache.decodeAll();
-    const ImpactIndex index(segments);
+    const ImpactIndex index(segments, afterFirstBounce);
     VertexSums sums(scene.vertexCount());
     const float searchRadius = radius * (1 + kFlannCandidateMargin);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertexOrder.size(), 64), [&](const tbb::blocked_range<size_t>& r) {

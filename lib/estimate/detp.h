@@ -16,6 +16,11 @@
 // the vertices (slightly enlarged, so it finds a superset) and keeps exactly what detpCrossing
 // accepts; brute force applies detpCrossing to every pair. Both count the same set, and
 // fixed-point sums make them equal to the last bit.
+//
+// afterFirstBounce (--direct exact: direct light is computed apart): segments of bounce 0 cross
+// no disc. They are left out where crossings are found, not taken out of the segment lists, so
+// a list's indexes (findCrossings' `segment`, an update's remembered bounces) stay those of the
+// segments given.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -93,8 +98,9 @@ public:
     // puts there every vertex a move can ever touch, so that the other discs' crossings never
     // change and can be remembered. regions (and bvh, the scene's triangles) may be null for the
     // paper rule; both are read at query time, so they must hold the pose being queried.
+    // afterFirstBounce: every query below finds no crossing for a segment of bounce 0.
     DetpDiscs(const EmbreeDevice& device, const Scene& scene, float radius, DetpBoundary rule, const DiscRegions* regions,
-              const SceneBvh* bvh, const std::vector<uint8_t>* refitted = nullptr);
+              const SceneBvh* bvh, const std::vector<uint8_t>* refitted = nullptr, bool afterFirstBounce = false);
 
     // Moves the refitted discs to the scene's current pose.
     void updateDynamic();
@@ -143,6 +149,7 @@ private:
     DetpBoundary rule_;
     const DiscRegions* regions_;
     const SceneBvh* bvh_;
+    bool afterFirstBounce_;
     float rayExtension_;  // lets Embree's float tests see crossings at t* ≈ 0 and at the rule's end
     float searchRadius_;  // the discs in Embree, slightly enlarged (a superset of the exact test)
     Bounds3f escapeBounds_;  // escaping segments are traced until they leave this box
@@ -152,21 +159,24 @@ private:
 };
 
 // One vertex's sums from the given segments (the exact test on each; an update's recomputed
-// vertices, with the segments the tracked-path grid lists near the disc).
+// vertices, with the segments the tracked-path grid lists near the disc). afterFirstBounce, here
+// and below: segments of bounce 0 cross nothing.
 DetpVertexSums detpVertexSums(const Scene& scene, uint32_t vertex, const std::vector<const Segment*>& segments, float radius,
-                              DetpBoundary rule, const DiscRegions* regions, const SceneBvh* bvh, const PowerQuantizer& q);
+                              DetpBoundary rule, const DiscRegions* regions, const SceneBvh* bvh, const PowerQuantizer& q,
+                              bool afterFirstBounce = false);
 
 // Index-free reference: every segment against every disc.
 std::vector<Vec3f> detpBruteForce(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
-                                  const DiscRegions* regions, const SceneBvh* bvh);
+                                  const DiscRegions* regions, const SceneBvh* bvh, bool afterFirstBounce = false);
 
 // Approximate DETP (--detp-index flann): candidates are the segments whose impact lies within
 // radius·(1 + kFlannCandidateMargin) of the vertex, then the exact test. It misses segments that
 // cross a disc but land far away (silhouettes, convex edges, escaping photons).
 constexpr float kFlannCandidateMargin = 0.25f;
+// With afterFirstBounce the index holds the impacts of later segments only.
 std::vector<Vec3f> detpFlannCandidates(const Scene& scene, const RayCache& cache, float radius, DetpBoundary rule,
                                        const DiscRegions* regions, const SceneBvh* bvh,
-                                       const std::vector<uint32_t>& vertexOrder);
+                                       const std::vector<uint32_t>& vertexOrder, bool afterFirstBounce = false);
 
 // The segments of blocks [beginBlock, endBlock) of the cache, decoded, in the order DETP traces
 // them through the discs: the Morton order of their end points, or the cache's own.

@@ -11,6 +11,10 @@
 //     tracked segments the grid lists around its disc, each tested exactly.
 // --no-ray-cache keeps every step index-free (the reference); --detp-index flann has no update
 // (its frames are solved from scratch, and timing.json says so).
+// After the first bounce only (--direct exact), segments of bounce 0 cross no disc in any of
+// these steps: DetpDiscs and the reference functions leave them out where crossings are found,
+// so they are never remembered, and the segment lists (and the remembered bounces that index
+// into them) stay as they are.
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -30,7 +34,8 @@ class DetpEstimator final : public Estimator {
 public:
     DetpEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
         : settings_(settings), scene_(context.scene), bvh_(context.bvh), device_(context.device),
-          regions_(context.regions), progress_(context.progress), moments_(settings.boundary == DetpBoundary::Linear) {
+          regions_(context.regions), progress_(context.progress), moments_(settings.boundary == DetpBoundary::Linear),
+          afterFirstBounce_(context.afterFirstBounce) {
         mayBeTouched_ = context.scene.vertexDynamic;
         mayBeTouched_.resize(scene_.vertexCount(), 0);
         if (regions_) {
@@ -54,7 +59,7 @@ public:
             bruteForceSums(allVertices(), all);
         } else if (e.detpIndex == DetpIndex::Flann) {
             const auto order = e.sortQueries ? mortonOrder(scene_.positions) : inputOrder(scene_.vertexCount());
-            out.irradiance = detpFlannCandidates(scene_, cache, e.radius, e.boundary, regions_, &bvh_, order);
+            out.irradiance = detpFlannCandidates(scene_, cache, e.radius, e.boundary, regions_, &bvh_, order, afterFirstBounce_);
             computeRadiosity(scene_, out);
             stats.verticesUpdated = scene_.vertexCount();
             return;
@@ -153,7 +158,7 @@ private:
     DetpDiscs& discs() {
         if (!discs_)
             discs_ = std::make_unique<DetpDiscs>(device_, scene_, settings_.radius, settings_.boundary, regions_, &bvh_,
-                                                 &mayBeTouched_);
+                                                 &mayBeTouched_, afterFirstBounce_);
         return *discs_;
     }
     std::vector<uint32_t> allVertices() const { return inputOrder(scene_.vertexCount()); }
@@ -343,7 +348,8 @@ private:
     }
 
     DetpVertexSums vertexSums(uint32_t v, const std::vector<const Segment*>& segments) const {
-        return detpVertexSums(scene_, v, segments, settings_.radius, settings_.boundary, regions_, &bvh_, quantizer_);
+        return detpVertexSums(scene_, v, segments, settings_.radius, settings_.boundary, regions_, &bvh_, quantizer_,
+                              afterFirstBounce_);
     }
     void bruteForceSums(const std::vector<uint32_t>& vertices, const std::vector<const Segment*>& segments) {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
@@ -358,6 +364,7 @@ private:
     const DiscRegions* regions_;
     WorkCounter* progress_;
     bool moments_;
+    bool afterFirstBounce_;  // segments of bounce 0 cross no disc
     PowerQuantizer quantizer_{0.0f};
     std::vector<uint8_t> mayBeTouched_;  // per vertex: a move can touch it (its disc is refitted)
     std::unique_ptr<DetpDiscs> discs_;

@@ -137,9 +137,23 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
     return disc;
 }
 
+// Whether some cell centre of v's disc is reachable from `start`: then the full regions keep that
+// start (they look further only when nothing is reachable from it).
+bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
+                         float radius) {
+    const DiscPatternPoints& points = discPatternPoints();
+    for (int c = 0; c < kDiscCells; ++c)
+        if (segmentClear(Vec3d(start),
+                         liftedDiscPoint(disc, scene.positions[v], scene.normals[v], radius, points.centres[size_t(c)].x,
+                                         points.centres[size_t(c)].y),
+                         bvh))
+            return true;
+    return false;
+}
+
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
-                             OwnSurfaceScratch& scratch, DiscRegions::StaticAnswers* answers) {
+                             OwnSurfaceScratch& scratch, DiscRegions::StaticAnswers* answers, bool startOnly = false) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
     discFrame(normal, disc.tangent, disc.bitangent);
@@ -154,6 +168,18 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     const double sideStep = std::min(1e-3 * double(radius), double(scene.sceneEpsilon()));
     const Vec3d lifted = Vec3d(scene.positions[v]) + Vec3d(normal) * double(own.epsAbove);
     const Vec3f start(lifted + Vec3d(own.towardSurface) * sideStep);
+    if (startOnly) {
+        disc.start = start;
+        if (someCentreReachable(start, disc, v, scene, bvh, radius)) {
+            disc.reachableArea = 1.0f / kDiscCells;  // at least that cell: not buried
+            return disc;
+        }
+        // Nothing reachable from any centre: decide exactly as the full regions do, keep the start.
+        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, nullptr);
+        disc.start = full.start;
+        disc.reachableArea = full.reachableArea;
+        return disc;
+    }
     StaticShortcuts shortcuts;
     // Every ray of the disc (from any of the starts below) stays within r + ε⁺ + the side step
     // of v; the BVH's ray epsilon is far more than their rounding. Worth asking for a moving
@@ -199,7 +225,7 @@ void DiscRegions::computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounte
 
 std::vector<uint32_t> DiscRegions::recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
                                              WorkCounter* progress) {
-    return compute(scene, bvh, vertices, true, progress);
+    return compute(scene, bvh, vertices, !startsOnly_, progress);
 }
 
 std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
@@ -226,7 +252,8 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
         for (size_t i = range.begin(); i != range.end(); ++i) {
             StaticAnswers* answers = keepAnswers ? &answers_[size_t(answerSlot_[vertices[i]])] : nullptr;
             if (answers && scene.vertexDynamic[vertices[i]]) answers = nullptr;
-            VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local, answers);
+            VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local,
+                                                startsOnly_ ? nullptr : answers, startsOnly_);
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);
         }
@@ -255,6 +282,11 @@ std::vector<uint32_t> DiscRegions::touchedBy(const Scene& scene, const std::vect
         if (hit) touched.push_back(v);
     }
     return touched;
+}
+
+Vec3f vertexRayStart(const Scene& scene, const VertexDisc& disc, uint32_t v) {
+    if (!disc.fallback) return disc.start;
+    return Vec3f(Vec3d(scene.positions[v]) + Vec3d(scene.normals[v]) * double(scene.sceneEpsilon()));
 }
 
 uint64_t DiscRegions::fallbackVertices() const {

@@ -21,7 +21,7 @@ std::unique_ptr<Estimator> Estimator::create(const EstimatorSettings& settings, 
 
 VertexRadiosity estimateVertexRadiosity(const Scene& scene, const SceneBvh& bvh, const RayCache& cache,
                                         const EstimatorSettings& settings, const EmbreeDevice& device,
-                                        const DiscRegions* regions) {
+                                        const DiscRegions* regions, bool afterFirstBounce) {
     std::optional<DiscRegions> own;
     if (needsDiscRegions(settings) && !regions) {
         own.emplace(makeDiscRegions(settings));
@@ -31,7 +31,9 @@ VertexRadiosity estimateVertexRadiosity(const Scene& scene, const SceneBvh& bvh,
     if (!needsDiscRegions(settings)) regions = nullptr;
     VertexRadiosity out;
     FrameTiming stats;
-    Estimator::create(settings, EstimatorContext{scene, bvh, device, regions})->solve(cache, out, stats);
+    EstimatorContext context{scene, bvh, device, regions};
+    context.afterFirstBounce = afterFirstBounce;
+    Estimator::create(settings, context)->solve(cache, out, stats);
     return out;
 }
 

@@ -70,6 +70,10 @@ struct EstimatorContext {
     bool updatesFollow = false;
     // Counts a solve's work for a progress display (null: none); the solver names the stage.
     WorkCounter* progress = nullptr;
+    // Exact direct light (--direct exact, docs/design.md §5.1): direct light is computed apart, so
+    // the estimate holds only what arrives after at least one bounce — segments of bounce 0
+    // (emission segments, and with them first impacts) count nowhere.
+    bool afterFirstBounce = false;
 };
 
 class Estimator {
@@ -105,9 +109,9 @@ std::unique_ptr<Estimator> makeDetpEstimator(const EstimatorSettings& settings, 
 
 // Irradiance and radiosity at every vertex of the scene's current pose, from scratch. bvh holds
 // that pose. regions: the disc regions of that pose (makeDiscRegions); computed here when null
-// and needed.
+// and needed. afterFirstBounce: as EstimatorContext's.
 VertexRadiosity estimateVertexRadiosity(const Scene& scene, const SceneBvh& bvh, const RayCache& cache,
                                         const EstimatorSettings& settings, const EmbreeDevice& device,
-                                        const DiscRegions* regions = nullptr);
+                                        const DiscRegions* regions = nullptr, bool afterFirstBounce = false);
 
 }  // namespace qsgi

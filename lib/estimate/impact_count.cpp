@@ -4,7 +4,8 @@
 
 namespace qsgi {
 
-ImpactCount::ImpactCount(const Scene& scene) : sums_(scene.triangleCount()) {
+ImpactCount::ImpactCount(const Scene& scene, bool afterFirstBounce)
+    : sums_(scene.triangleCount()), afterFirstBounce_(afterFirstBounce) {
     updateGeometry(scene);
     vertexTrianglesBegin_.assign(scene.vertexCount() + 1, 0);
     for (const Triangle& t : scene.triangles)
@@ -37,6 +38,7 @@ void ImpactCount::updateGeometry(const Scene& scene) {
 }
 
 bool ImpactCount::counts(const Segment& s) const {
+    if (afterFirstBounce_ && s.bounce == 0) return false;
     return s.hasImpact() && dot(s.direction, frontNormal_[s.triangle]) < 0;
 }
 

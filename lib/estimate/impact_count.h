@@ -1,7 +1,8 @@
 // Impact count (docs/design.md §5): E_τ = Σ Φ / A_τ over the impacts on triangle τ; a vertex takes the
 // mean E_τ of its non-degenerate triangles. Only impacts on the side the triangle's vertex
 // normals face count, so E is the irradiance "on the side the vertex normal faces" (docs/design.md §2),
-// as for the other estimators.
+// as for the other estimators. With afterFirstBounce (--direct exact) the segments of bounce 0 —
+// the emission and with it the first impact — count nowhere: direct light is computed apart.
 #pragma once
 
 #include <vector>
@@ -14,7 +15,7 @@ namespace qsgi {
 
 class ImpactCount {
 public:
-    explicit ImpactCount(const Scene& scene);
+    explicit ImpactCount(const Scene& scene, bool afterFirstBounce = false);
 
     // Recomputes the triangle sums from every segment of the cache.
     void accumulate(const RayCache& cache);
@@ -44,6 +45,7 @@ private:
     // the order a whole-scene pass sums it, so an update gives the same bits.
     std::vector<uint32_t> vertexTrianglesBegin_, vertexTriangles_;
     uint32_t degenerate_ = 0;
+    bool afterFirstBounce_;
 };
 
 }  // namespace qsgi

@@ -12,7 +12,8 @@ namespace {
 
 class ImpactCountEstimator final : public Estimator {
 public:
-    ImpactCountEstimator(const EstimatorContext& context) : scene_(context.scene), sums_(context.scene) {}
+    ImpactCountEstimator(const EstimatorContext& context)
+        : scene_(context.scene), sums_(context.scene, context.afterFirstBounce), afterFirstBounce_(context.afterFirstBounce) {}
 
     void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
         quantizer_ = PowerQuantizer(cache.maxPhotonPower);
@@ -37,9 +38,10 @@ public:
             for (uint32_t v : scene_.triangles[t].v) changed[v] = 1;
         };
         for (uint32_t t : moved) mark(t);
+        // A segment left out (bounce 0, after the first bounce only) changed no sum.
         for (const auto* list : {&change.removed, &change.added})
             for (const Segment& s : *list)
-                if (s.hasImpact()) mark(s.triangle);
+                if (s.hasImpact() && !(afterFirstBounce_ && s.bounce == 0)) mark(s.triangle);
         std::vector<uint32_t> vertices;
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
             if (changed[v]) vertices.push_back(v);
@@ -50,6 +52,7 @@ public:
 private:
     const Scene& scene_;
     ImpactCount sums_;
+    bool afterFirstBounce_;  // segments of bounce 0 count nowhere (ImpactCount leaves them out)
     PowerQuantizer quantizer_{0.0f};
 };
 

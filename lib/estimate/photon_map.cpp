@@ -21,13 +21,13 @@ PhotonMap::Impact PhotonMap::impactOf(const Segment& s) {
     return Impact{s.impactPoint(), s.direction, s.power, s.triangle, keyOf(s)};
 }
 
-PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh)
-    : frontNormals_(scene.frontFaceNormals()), bvh_(bvh), quantizer_(cache.maxPhotonPower) {
+PhotonMap::PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh, bool afterFirstBounce)
+    : frontNormals_(scene.frontFaceNormals()), bvh_(bvh), quantizer_(cache.maxPhotonPower), afterFirstBounce_(afterFirstBounce) {
     // Per block in parallel, joined in block order: the cache's (path, bounce) order.
     std::vector<std::vector<Impact>> perBlock(cache.blockCount());
     cache.forEachBlock([&](size_t b, const std::vector<Segment>& block) {
         for (const Segment& s : block)
-            if (s.hasImpact()) perBlock[b].push_back(impactOf(s));
+            if (takes(s)) perBlock[b].push_back(impactOf(s));
     });
     size_t total = 0;
     for (const auto& impacts : perBlock) total += impacts.size();
@@ -112,9 +112,9 @@ void PhotonMap::addImpact(const Segment& s) {
 
 void PhotonMap::update(const std::vector<Segment>& removed, const std::vector<Segment>& added, const Scene& scene) {
     for (const Segment& s : removed)
-        if (s.hasImpact()) removeImpact(keyOf(s));
+        if (takes(s)) removeImpact(keyOf(s));
     for (const Segment& s : added)
-        if (s.hasImpact()) addImpact(s);
+        if (takes(s)) addImpact(s);
     frontNormals_ = scene.frontFaceNormals();
     // Queries pay for the small tree's size and the big tree's dead points; rebuilding costs all
     // impacts. Past a quarter added, or more dead than live, the big tree is rebuilt.
@@ -331,9 +331,9 @@ std::vector<Vec3f> PhotonMap::bruteForce(const Scene& scene, const DiscRegions* 
 
 // Which estimates a change can alter
 
-void PhotonMap::impactsOf(const std::vector<Segment>& segments, std::vector<Impact>& impacts, std::vector<Vec3f>& points) {
+void PhotonMap::impactsOf(const std::vector<Segment>& segments, std::vector<Impact>& impacts, std::vector<Vec3f>& points) const {
     for (const Segment& s : segments)
-        if (s.hasImpact()) {
+        if (takes(s)) {
             impacts.push_back(impactOf(s));
             points.push_back(impacts.back().point);
         }

@@ -17,6 +17,10 @@
 // when they have changed: they churn every frame, where a tree's build would cost more than the
 // queries it saves. Every answer is bit-identical to a
 // map built from scratch over the same impacts, and to bruteForce(), the index-free reference.
+//
+// With afterFirstBounce (--direct exact: direct light is computed apart) the impacts of bounce-0
+// segments never enter the map: its indexes, neighbour lists and changes hold only the impacts
+// of later bounces, so every answer is that of a map over those alone.
 #pragma once
 
 #include <cstdint>
@@ -38,13 +42,15 @@ class PhotonMap {
 public:
     // Copies the impacts of the cache's segments (their (path, bounce) must be unique) and builds
     // the kd-tree. bvh: the scene's triangles in the current pose, to decide impacts in mixed
-    // cells; it must outlive the map (a refit in place is fine).
-    PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh);
+    // cells; it must outlive the map (a refit in place is fine). afterFirstBounce: the impacts
+    // of bounce-0 segments are left out, here and in every change.
+    PhotonMap(const RayCache& cache, const Scene& scene, const SceneBvh* bvh, bool afterFirstBounce = false);
 
     // One frame's change of the photon set: the impacts of `removed` (found by (path, bounce);
     // they must be in the map) leave, those of `added` (not yet in it) enter; segments without an
-    // impact are ignored. scene: the new pose, for the triangles' front normals. Costs the
-    // changed impacts, plus now and then a rebuild of the big tree (decided from counts alone).
+    // impact (or, with afterFirstBounce, of bounce 0) are ignored. scene: the new pose, for the
+    // triangles' front normals. Costs the changed impacts, plus now and then a rebuild of the big
+    // tree (decided from counts alone).
     // A change that does not match the map throws std::logic_error and leaves it unusable.
     void update(const std::vector<Segment>& removed, const std::vector<Segment>& added, const Scene& scene);
 
@@ -104,8 +110,11 @@ private:
     };
     static uint64_t keyOf(const Segment& s) { return uint64_t(s.path) << 16 | s.bounce; }
     static Impact impactOf(const Segment& s);
-    // The impacts of the segments that have one, and their points.
-    static void impactsOf(const std::vector<Segment>& segments, std::vector<Impact>& impacts, std::vector<Vec3f>& points);
+    // Whether the segment's impact belongs in the map: it has one, and after the first bounce
+    // when only those count.
+    bool takes(const Segment& s) const { return s.hasImpact() && !(afterFirstBounce_ && s.bounce == 0); }
+    // The impacts of the segments the map holds, and their points.
+    void impactsOf(const std::vector<Segment>& segments, std::vector<Impact>& impacts, std::vector<Vec3f>& points) const;
 
     // Equal distances are ordered by (path, bounce), never by where the impacts are stored: the k
     // nearest are the same set whatever order the cache holds them in or updates left them in.
@@ -184,6 +193,7 @@ private:
     std::vector<Vec3f> frontNormals_;
     const SceneBvh* bvh_;  // of the impacted triangles, for the 45° test
     PowerQuantizer quantizer_;
+    bool afterFirstBounce_;  // impacts of bounce-0 segments stay out
 };
 
 }  // namespace qsgi

@@ -23,10 +23,11 @@ class PhotonMapEstimator final : public Estimator {
 public:
     PhotonMapEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
         : settings_(settings), scene_(context.scene), bvh_(context.bvh), regions_(context.regions),
-          keepLists_(context.updatesFollow && settings.useIndex), progress_(context.progress) {}
+          keepLists_(context.updatesFollow && settings.useIndex), progress_(context.progress),
+          afterFirstBounce_(context.afterFirstBounce) {}
 
     void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
-        map_.emplace(cache, scene_, &bvh_);
+        map_.emplace(cache, scene_, &bvh_, afterFirstBounce_);
         map_->keepLists(keepLists_);
         const EstimatorSettings& e = settings_;
         if (e.useIndex) {
@@ -101,6 +102,7 @@ private:
     const DiscRegions* regions_;
     bool keepLists_;  // updates follow: neighbour lists kept (indexed only; brute force is the reference)
     WorkCounter* progress_;
+    bool afterFirstBounce_;  // the map holds the impacts of bounces ≥ 1 only
     std::optional<PhotonMap> map_;
 };
 

@@ -49,15 +49,22 @@ FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSo
     : scene_(scene), settings_(settings),
       work_([this](const char* name, uint64_t done, uint64_t total) { stage(name, done, total); }),
       bvh_(device, scene), tracer_(scene, bvh_, aimedAtEstimator(settings.trace, settings.estimator)) {
+    // The second pass's rays start where the disc regions say, whatever the estimator (docs/design.md
+    // §5.1): impact count and DETP's paper rule, which read no regions, get their start points only.
+    const bool exactDirect = settings_.lighting.exactDirect();
     if (needsDiscRegions(settings_.estimator)) regions_.emplace(makeDiscRegions(settings_.estimator));
-    estimator_ = Estimator::create(settings_.estimator,
-                                   EstimatorContext{scene_, bvh_, device, regions(), !settings_.fullRecompute, &work_});
+    else if (exactDirect) regions_.emplace(DiscRegions::startsOnly(settings_.estimator.radius));
+    const DiscRegions* estimatorRegions = needsDiscRegions(settings_.estimator) ? regions() : nullptr;
+    estimator_ = Estimator::create(settings_.estimator, EstimatorContext{scene_, bvh_, device, estimatorRegions,
+                                                                         !settings_.fullRecompute, &work_, exactDirect});
+    if (exactDirect) lighting_.emplace(settings_.lighting, settings_.trace.seed);
 }
 
 FrameSolver::~FrameSolver() = default;
 
 void FrameSolver::reset() {
     solved_ = regionsValid_ = false;
+    if (lighting_) lighting_->reset();
     tracked_.reset();
     lastCache_.reset();
 }
@@ -172,6 +179,12 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     std::sort(redecided.begin(), redecided.end());
     redecided.erase(std::unique(redecided.begin(), redecided.end()), redecided.end());
     touched.swap(redecided);
+    // The second pass re-casts from every vertex whose start may have moved; an estimator that
+    // reads no regions (they are the second pass's alone) recomputes the moved vertices only.
+    const std::vector<uint32_t> newStarts = touched;
+    if (!needsDiscRegions(settings_.estimator))
+        touched.erase(std::remove_if(touched.begin(), touched.end(), [&](uint32_t v) { return !change.vertexMoved[v]; }),
+                      touched.end());
     const double regionSeconds = clock.seconds();
 
     std::string why;
@@ -195,6 +208,7 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
         if (change.any) solveIncrementally(change, touched, stats);
     }
     stats.estimationSeconds += regionSeconds;
+    if (lighting_) secondPass(change, newStarts, stats);
     if (tracked_) {
         stats.trackedPaths = tracked_->trackedPaths();
         stats.trackedSegments = tracked_->trackedSegments();
@@ -202,7 +216,8 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
         stats.segments = foldedSegments_ + tracked_->trackedSegments();
     }
     // The regions' kept static answers are incremental state too.
-    stats.estimatorStateBytes = estimator_->stateBytes() + (regions_ ? regions_->keptAnswerBytes() : 0);
+    stats.estimatorStateBytes = estimator_->stateBytes() + (regions_ ? regions_->keptAnswerBytes() : 0) +
+                                (lighting_ ? lighting_->stateBytes() : 0);
     if (regions_) {
         stats.ownSurfaceFallbacks = regions_->fallbackVertices();
         stats.buriedVertices = regions_->buriedVertices();
@@ -225,7 +240,7 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
 
     clock.restart();
     work_.start("estimating", 0);
-    estimator_->solve(cache, result_, stats);
+    estimator_->solve(cache, estimate(), stats);
     stats.estimationSeconds = clock.seconds();
     if (!settings_.fullRecompute) lastCache_ = std::move(cache);
 }
@@ -269,8 +284,21 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
     const FrameChange frameChange{changes.removed,         changes.added, change.vertexMoved, change.triangleMoved,
                                   change.movedTriangles, touched,       *tracked_};
     stage("updating");
-    estimator_->update(frameChange, result_, stats);
+    estimator_->update(frameChange, estimate(), stats);
     stats.estimationSeconds += clock.seconds();
+}
+
+}  // namespace qsgi
+
+namespace qsgi {
+
+void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats) {
+    if (!lighting_->solved() || settings_.fullRecompute) {
+        lighting_->solve(scene_, bvh_, *regions_, photons_, result_, stats, &work_);
+        return;
+    }
+    stage("gathering");
+    lighting_->update(scene_, bvh_, *regions_, MovedGeometry{change.bounds, touched}, photons_, result_, stats);
 }
 
 }  // namespace qsgi

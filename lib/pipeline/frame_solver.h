@@ -12,6 +12,8 @@
 
 #include "estimate/disc_regions.h"
 #include "estimate/estimator.h"
+#include "estimate/lighting_settings.h"
+#include "estimate/two_pass_lighting.h"
 #include "scene/scene.h"
 #include "trace/envelope.h"
 #include "trace/photon_tracer.h"
@@ -25,6 +27,8 @@ namespace qsgi {
 struct FrameSolverSettings {
     EstimatorSettings estimator;
     TraceSettings trace;
+    // Direct light from the photons or exact, and the final gather (TwoPassLighting).
+    LightingSettings lighting;
     bool fullRecompute = false;  // every frame from scratch
     bool alwaysUpdate = false;   // never fall back to scratch for a large change (tests, measurements)
     bool useEnvelope = true;     // false: track every path (for tests and the memory comparison)
@@ -89,6 +93,11 @@ private:
     // The incremental state from the last frame's cache: tracked paths and the estimator's own.
     void startTracking(FrameTiming& stats);
     void solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats);
+    // Where the estimator's answer goes: result_ itself, or photons_ under a second pass.
+    VertexRadiosity& estimate() { return lighting_ ? photons_ : result_; }
+    // The second pass for this frame: from scratch the first time and under --full-recompute,
+    // else brought from the last frame's.
+    void secondPass(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats);
 
     Scene& scene_;
     FrameSolverSettings settings_;
@@ -98,6 +107,10 @@ private:
     PhotonTracer tracer_;
     std::optional<DiscRegions> regions_;
     std::unique_ptr<Estimator> estimator_;
+    // With exact direct light: the second pass, and the estimator's answer it reads (the
+    // estimator updates that in place frame after frame; result_ is the combination).
+    std::optional<TwoPassLighting> lighting_;
+    VertexRadiosity photons_;
     bool regionsValid_ = false;
     bool solved_ = false;
     std::vector<Vec3f> previousPositions_;  // the moving instances' vertices before a pose

@@ -270,6 +270,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     };
     FrameSolverSettings solverSettings;
     solverSettings.estimator = settings_.estimator;
+    solverSettings.lighting = settings_.lighting;
     solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces, EmissionAim{settings_.aimEmission, 0},
                                          effectiveSampling(settings_)};
     solverSettings.fullRecompute = settings_.fullRecompute;

@@ -109,9 +109,10 @@ json getCamera(const RenderSettings& s) {
 }
 
 // Every setting is reachable: each field of RenderSettings is set by an option below, except the
-// four that record where values came from (configPath, radiusGiven, qmcBouncesGiven,
+// five that record where values came from (configPath, radiusGiven, qmcBouncesGiven, gatherGiven,
 // framesSource). A field added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 36, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 38, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<LightingSettings>() == 3, "a LightingSettings field was added or removed: give it an option");
 static_assert(fieldCount<EstimatorSettings>() == 7, "an EstimatorSettings field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
 
@@ -192,6 +193,30 @@ std::vector<RenderOption> declareOptions() {
                  "queries in input order instead of Morton order", true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.sortQueries = v; },
                  [](const RenderSettings& s) { return json(s.estimator.sortQueries); }});
+    // The second pass (docs/design.md §5.1)
+    o.push_back({"direct", "--direct", T::Choice, 0, 0, "", namesOf(kDirectLightingNames), true, "", "photons",
+                 "direct light: exact (shadow rays from each vertex; the estimator then counts only light after its "
+                 "first bounce) or photons (all of it from the photons: the paper's method)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) {
+                     s.lighting.direct = choiceValue(kDirectLightingNames, v);
+                 },
+                 [](const RenderSettings& s) { return json(directLightingName(s.lighting.direct)); }});
+    o.push_back({"direct_samples", "--direct-samples", T::Integer, 1, double(kMaxDirectSamples), "", {}, true, "S", "16",
+                 "exact direct only: shadow rays per vertex toward the emissive triangles, chosen by power (one per "
+                 "point, spot and directional light besides)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.lighting.directSamples = v.get<uint32_t>(); },
+                 [](const RenderSettings& s) { return orNull(s.lighting.exactDirect(), json(s.lighting.directSamples)); }});
+    o.push_back({"gather", "--gather", T::Integer, 0, double(kMaxGatherRays), "", {}, true, "M", "0",
+                 "exact direct only: final-gather rays per vertex over the photon solution (0: none; the vertex then "
+                 "takes the estimator's indirect light as it is)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) {
+                     s.lighting.gatherRays = v.get<uint32_t>();
+                     s.gatherGiven = true;
+                 },
+                 [](const RenderSettings& s) { return orNull(s.lighting.exactDirect(), json(s.lighting.gatherRays)); }});
     // Frames after the first
     o.push_back({"full_recompute", "--full-recompute", T::Boolean, 0, 0, "", {}, true, "", "false",
                  "compute every frame from scratch instead of updating the previous one (the same bytes; the "

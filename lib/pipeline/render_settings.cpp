@@ -108,6 +108,13 @@ void validateSettings(const RenderSettings& s) {
         checkedInteger(s.sampling.qmcBounces, 0, std::min<int64_t>(s.maxBounces, kMaxQmcBounces),
                        s.configPath.empty() ? "command line" : s.configPath + " or the command line", "qmc_bounces",
                        " (at most max_bounces, and the Sobol table covers 32 scatterings)");
+    // The gather replaces the estimate of indirect light only; with direct light from the photons
+    // there is nothing apart for it to add to.
+    if (s.gatherGiven && s.lighting.gatherRays > 0 && !s.lighting.exactDirect())
+        throw InputError(s.configPath.empty() ? "command line" : s.configPath + " or the command line", "gather",
+                         std::to_string(s.lighting.gatherRays) +
+                             " gather rays need --direct exact (the gather adds one bounce over the photons to exact "
+                             "direct light); give --gather 0 with --direct photons");
 }
 
 }  // namespace qsgi

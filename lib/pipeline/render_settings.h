@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "estimate/estimator.h"
+#include "estimate/lighting_settings.h"
 #include "scene/scene.h"
 #include "trace/photon_numbers.h"
 
@@ -30,6 +31,8 @@ struct RenderSettings {
     std::string outDir = "out";
     EstimatorSettings estimator;     // radius 0 here: chosen from the scene (defaultRadius)
     bool radiusGiven = false;
+    LightingSettings lighting;  // direct light exact or from photons, and the final gather
+    bool gatherGiven = false;   // gather from the config or the command line
     uint64_t photons = 1000000;
     uint64_t seed = 1;
     uint32_t maxBounces = 32;

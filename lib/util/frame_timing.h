@@ -45,6 +45,10 @@ struct FrameTiming {
     double discRegionsSeconds = 0;
     uint64_t discRegionsUpdated = 0;
     uint64_t ownSurfaceFallbacks = 0, buriedVertices = 0;
+    // The second pass (--direct exact, --gather M; docs/design.md §5.1): time and rays cast this
+    // frame for exact direct light and for the final gather (which includes combining the passes).
+    double directSeconds = 0, gatherSeconds = 0;
+    uint64_t shadowRays = 0, gatherRays = 0;
     // The frame's files as written, which --resume verifies before it trusts them ("files" in
     // timing.json; not a timing, so not in forEachTimingField's list).
     std::vector<FileRecord> files;
@@ -84,6 +88,10 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("disc_regions_updated", f.discRegionsUpdated);
     visit("own_surface_fallbacks", f.ownSurfaceFallbacks);
     visit("buried_vertices", f.buriedVertices);
+    visit("direct_s", f.directSeconds);
+    visit("shadow_rays", f.shadowRays);
+    visit("gather_s", f.gatherSeconds);
+    visit("gather_rays", f.gatherRays);
 }
 
 }  // namespace qsgi

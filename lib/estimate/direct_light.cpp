@@ -1,0 +1,170 @@
+#include "estimate/direct_light.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+#include "estimate/vertex_samples.h"
+#include "trace/sampling.h"
+
+namespace qsgi {
+
+void DirectLight::readEmitters(const Scene& scene) {
+    emitters_.clear();
+    cdf_.clear();
+    double total = 0;
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
+        const Material& m = scene.materials[scene.triangleMaterial[t]];
+        const float area = scene.triangleArea(t);
+        if (!m.isEmissive() || !(area > 0)) continue;
+        // Chosen by power, as photons are (LightSampler): luminance of π L_e A.
+        const double power = double(luminance(m.emission)) * double(area);
+        if (!(power > 0)) continue;
+        emitters_.push_back({t, m.emission, area, power});
+        total += power;
+    }
+    double running = 0;
+    for (Emitter& e : emitters_) {
+        e.probability /= total;
+        running += e.probability;
+        cdf_.push_back(running);
+    }
+    if (!cdf_.empty()) cdf_.back() = 1.0;
+}
+
+template <class Visit>
+void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& starts, uint32_t v, Visit&& visit) const {
+    // The irradiance is v's own: distance and cosines from v itself. Only the shadow ray leaves
+    // from s_v, lifted clear of v's own surface; measured from s_v, a concave surface's direct
+    // light would come out too high by about twice the lift over the distance (4 % inside a
+    // sphere of radius 5r).
+    const Vec3d p(scene.positions[v]);
+    const Vec3d start(starts.point(v));
+    const Vec3d n(starts.normal(v));
+    constexpr float kInfinity = std::numeric_limits<float>::infinity();
+    // The shadow segment from s_v to `target`: its direction and length.
+    auto shadowTo = [&](const Vec3d& target, Vec3f& direction, float& tfar) {
+        const Vec3d d = target - start;
+        const double len = length(d);
+        if (!(len > 0)) return false;
+        direction = Vec3f(d / len);
+        tfar = float(len);
+        return true;
+    };
+    Vec3f direction;
+    float tfar;
+    for (const PunctualLight& l : scene.lights) {
+        if (l.type == LightType::Directional) {
+            const Vec3d w = -Vec3d(l.direction);
+            const double cosV = dot(n, w);
+            if (cosV > 0) visit(Vec3f(w), kInfinity, Vec3d(l.intensity) * cosV);
+            continue;
+        }
+        const Vec3d d = Vec3d(l.position) - p;
+        const double d2 = dot(d, d);
+        if (!(d2 > 0)) continue;
+        const Vec3d w = d / std::sqrt(d2);
+        const double cosV = dot(n, w);
+        if (!(cosV > 0)) continue;
+        // A spot light sends its intensity inside the outer cone only (its photons likewise).
+        if (l.type == LightType::Spot && dot(-w, Vec3d(l.direction)) < double(l.cosOuterCone)) continue;
+        if (shadowTo(Vec3d(l.position), direction, tfar)) visit(direction, tfar, Vec3d(l.intensity) * (cosV / d2));
+    }
+    if (emitters_.empty() || samples_ == 0) return;
+    const VertexSamples numbers(seed_, v, VertexStream::Direct);
+    const double perSample = 1.0 / double(samples_);
+    for (uint32_t i = 0; i < samples_; ++i) {
+        const float u0 = numbers.uniform(i, 0);
+        const size_t e = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), double(u0)) - cdf_.begin());
+        const Emitter& emitter = emitters_[std::min(e, emitters_.size() - 1)];
+        const Triangle& tri = scene.triangles[emitter.triangle];
+        float b1, b2;
+        uniformTriangle(numbers.uniform(i, 1), numbers.uniform(i, 2), b1, b2);
+        const Vec3d x = Vec3d(scene.positions[tri.v[0]]) * double(1 - b1 - b2) + Vec3d(scene.positions[tri.v[1]]) * double(b1) +
+                        Vec3d(scene.positions[tri.v[2]]) * double(b2);
+        const Vec3d d = x - p;
+        const double d2 = dot(d, d);
+        if (!(d2 > 0)) continue;
+        const Vec3d w = d / std::sqrt(d2);
+        const double cosV = dot(n, w);
+        const double cosE = -dot(Vec3d(scene.geometricNormal(emitter.triangle)), w);
+        if (!(cosV > 0) || !(cosE > 0)) continue;
+        // L_e cosθ_v cosθ_e / (d² p), p = P(emitter) / area.
+        const double weight = cosV * cosE / d2 * double(emitter.area) / emitter.probability * perSample;
+        if (shadowTo(x, direction, tfar)) visit(direction, tfar, Vec3d(emitter.radiance) * weight);
+    }
+}
+
+Vec3f DirectLight::vertexIrradiance(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, uint32_t v,
+                                    uint64_t& rays) const {
+    if (scene.vertexHidden[v]) return Vec3f(0.0f);
+    const Vec3f origin = starts.point(v);
+    Vec3d sum(0.0);
+    forEachShadowRay(scene, starts, v, [&](const Vec3f& w, float tfar, const Vec3d& irradiance) {
+        // From t = 0, as the disc regions' rays (s_v is lifted clear of v's own surface; a surface
+        // beside v lies nearer than a ray epsilon). Stop short of the light's own surface: an
+        // emissive triangle does not shadow itself.
+        const float end = std::isinf(tfar) ? tfar : tfar * (1 - 1e-5f) - bvh.rayEpsilon();
+        if (end > 0) {
+            ++rays;
+            if (bvh.occluded(origin, w, 0.0f, end)) return;
+        }
+        sum += irradiance;
+    });
+    return Vec3f(sum);
+}
+
+void DirectLight::computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
+    readEmitters(scene);
+    irradiance_.assign(scene.vertexCount(), Vec3f(0.0f));
+    if (progress) progress->setTotal(scene.vertexCount());
+    std::atomic<uint64_t> rays{0};
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
+        uint64_t cast = 0;
+        for (uint32_t v = r.begin(); v != r.end(); ++v) irradiance_[v] = vertexIrradiance(scene, bvh, starts, v, cast);
+        rays += cast;
+        if (progress) progress->add(r.size());
+    });
+    raysCast_ = rays.load();
+}
+
+void DirectLight::recompute(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                            const std::vector<uint32_t>& vertices) {
+    irradiance_.resize(scene.vertexCount(), Vec3f(0.0f));
+    std::atomic<uint64_t> rays{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+        uint64_t cast = 0;
+        for (size_t i = r.begin(); i != r.end(); ++i) irradiance_[vertices[i]] = vertexIrradiance(scene, bvh, starts, vertices[i], cast);
+        rays += cast;
+    });
+    raysCast_ = rays.load();
+}
+
+std::vector<uint32_t> DirectLight::raysMeeting(const Scene& scene, const VertexStarts& starts,
+                                               const std::vector<Bounds3f>& boxes) const {
+    std::vector<uint8_t> meets(scene.vertexCount(), 0);
+    if (boxes.empty()) return {};
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t v = r.begin(); v != r.end(); ++v) {
+            const Vec3f origin = starts.point(v);
+            bool hit = false;
+            forEachShadowRay(scene, starts, v, [&](const Vec3f& w, float tfar, const Vec3d&) {
+                for (const Bounds3f& box : boxes) {
+                    if (hit) return;
+                    double t0 = 0, t1 = double(tfar);
+                    hit = box.clip(origin, w, t0, t1);
+                }
+            });
+            meets[v] = hit;
+        }
+    });
+    std::vector<uint32_t> out;
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v)
+        if (meets[v]) out.push_back(v);
+    return out;
+}
+
+}  // namespace qsgi

@@ -1,0 +1,71 @@
+// Direct light, exact (docs/design.md §5.1): the irradiance D_v that reaches vertex v straight from
+// the emitters, with v's normal n_v, distances and cosines measured from v itself and visibility
+// by shadow rays from v's start point s_v (VertexStarts), lifted clear of v's own surface:
+//   point light   I · cosθ_v / d²   when the segment s_v → light is clear (spot lights only inside
+//                 their cone, as their photons are);
+//   directional   E · cosθ_v        when the ray from s_v against the light's direction is clear;
+//   emissive      (1/S) Σ_i L_e · cosθ_v · cosθ_e / (d² · p(x_i)) over S points x_i, each chosen by
+//   triangles     the emitter's power and uniformly on it (p = P(triangle) / area), from v's own
+//                 scrambled Sobol points: stratified over the emitters by power, with the cosine
+//                 and distance terms exact. Only the front (CCW) side emits, as for photons.
+// One ray per punctual light; S for all emissive triangles together. Each vertex's sum runs in a
+// fixed order in one thread, so the bits depend on nothing but the geometry and the seed.
+//
+// After a move only vertices whose start moved, or one of whose shadow segments meets a mover's old
+// or new bounds, can change (a segment that meets neither saw the same geometry before and after):
+// raysMeeting() finds them from the segments alone, without tracing, and recompute() gives them
+// exactly what computeAll() would. Lights are static (docs/design.md §2): the emitters stay as
+// computeAll() read them.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "estimate/vertex_starts.h"
+#include "scene/scene.h"
+#include "trace/scene_bvh.h"
+#include "util/work_counter.h"
+
+namespace qsgi {
+
+class DirectLight {
+public:
+    DirectLight(uint32_t samples, uint64_t seed) : samples_(samples), seed_(seed) {}
+
+    // Every vertex, for the scene's current pose (bvh holds it). Reads the emitters anew.
+    void computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress = nullptr);
+    // The given vertices only, with the emitters as computeAll() last read them.
+    void recompute(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint32_t>& vertices);
+    // Vertices (increasing) one of whose shadow segments meets one of `boxes`.
+    std::vector<uint32_t> raysMeeting(const Scene& scene, const VertexStarts& starts, const std::vector<Bounds3f>& boxes) const;
+
+    const std::vector<Vec3f>& irradiance() const { return irradiance_; }
+    // Shadow rays cast by the last computeAll() or recompute().
+    uint64_t raysCast() const { return raysCast_; }
+
+private:
+    struct Emitter {
+        uint32_t triangle;
+        Vec3f radiance;  // L_e
+        float area;
+        double probability;  // of being chosen
+    };
+    void readEmitters(const Scene& scene);
+    // Calls visit(direction, tfar, irradianceIfClear) for each shadow ray of vertex v: the segment
+    // from starts.point(v) (direction unit; tfar infinite toward a directional light) and what it
+    // brings v if clear. Rays that could carry nothing (the emitter behind v or v behind the
+    // emitter) are not visited.
+    template <class Visit>
+    void forEachShadowRay(const Scene& scene, const VertexStarts& starts, uint32_t v, Visit&& visit) const;
+    // Adds the shadow rays it casts to `rays`.
+    Vec3f vertexIrradiance(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, uint32_t v, uint64_t& rays) const;
+
+    uint32_t samples_;
+    uint64_t seed_;
+    std::vector<Emitter> emitters_;
+    std::vector<double> cdf_;  // emitters_' cumulative probabilities, last = 1
+    std::vector<Vec3f> irradiance_;
+    uint64_t raysCast_ = 0;
+};
+
+}  // namespace qsgi

@@ -1,0 +1,135 @@
+#include "estimate/final_gather.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <cmath>
+#include <limits>
+
+#include "estimate/vertex_samples.h"
+#include "trace/sampling.h"
+
+namespace qsgi {
+
+namespace {
+constexpr float kBarycentricScale = 65535.0f;
+uint16_t quantised(float b) { return uint16_t(std::lround(std::clamp(b, 0.0f, 1.0f) * kBarycentricScale)); }
+}  // namespace
+
+Vec3f FinalGather::direction(const VertexStarts& starts, uint32_t v, uint32_t ray) const {
+    const VertexSamples numbers(seed_, v, VertexStream::Gather);
+    return cosineHemisphere(starts.normal(v), numbers.uniform(ray, 0), numbers.uniform(ray, 1));
+}
+
+GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
+                               const Vec3f& direction) const {
+    GatherHit out;
+    // From t = 0, as the disc regions' rays: s_v is lifted clear of v's own surface, and a surface
+    // beside v (the floor at the foot of a wall) lies a hair from s_v, nearer than a ray epsilon.
+    const auto hit = bvh.intersect(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
+    if (!hit) {
+        out.t = std::numeric_limits<float>::infinity();
+        return out;
+    }
+    out.t = hit->t;
+    out.triangle = dot(direction, frontNormals[hit->triangle]) < 0 ? hit->triangle : GatherHit::kBackFace;
+    out.b1 = quantised(hit->u);
+    out.b2 = quantised(hit->v);
+    return out;
+}
+
+void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                             const std::vector<Vec3f>& frontNormals, uint32_t v) {
+    GatherHit* hits = &hits_[size_t(v) * rays_];
+    if (scene.vertexHidden[v]) {
+        for (uint32_t j = 0; j < rays_; ++j) hits[j] = GatherHit{};
+        return;
+    }
+    for (uint32_t j = 0; j < rays_; ++j) hits[j] = castRay(bvh, frontNormals, starts.point(v), direction(starts, v, j));
+}
+
+void FinalGather::castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
+    hits_.assign(scene.vertexCount() * size_t(rays_), GatherHit{});
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    if (progress) progress->setTotal(scene.vertexCount());
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t v = r.begin(); v != r.end(); ++v) castVertex(scene, bvh, starts, frontNormals, v);
+        if (progress) progress->add(r.size());
+    });
+    raysCast_ = uint64_t(scene.vertexCount()) * rays_;
+}
+
+void FinalGather::cast(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint32_t>& vertices) {
+    if (vertices.empty()) return;
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) castVertex(scene, bvh, starts, frontNormals, vertices[i]);
+    });
+    raysCast_ += uint64_t(vertices.size()) * rays_;
+}
+
+uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                                    const std::vector<Bounds3f>& boxes, const std::vector<uint8_t>& skip) {
+    if (boxes.empty() || rays_ == 0) return 0;
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    const uint64_t recast = tbb::parallel_reduce(
+        tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), uint64_t(0),
+        [&](const tbb::blocked_range<uint32_t>& r, uint64_t count) {
+            for (uint32_t v = r.begin(); v != r.end(); ++v) {
+                if (skip[v] || scene.vertexHidden[v]) continue;
+                const Vec3f origin = starts.point(v);
+                const Vec3f& n = starts.normal(v);
+                // Every ray leaves into v's hemisphere: a box wholly behind its plane meets none.
+                std::vector<const Bounds3f*> ahead;
+                for (const Bounds3f& box : boxes) {
+                    float reach = 0;
+                    for (int c = 0; c < 8; ++c) {
+                        const Vec3f corner((c & 1) ? box.upper.x : box.lower.x, (c & 2) ? box.upper.y : box.lower.y,
+                                           (c & 4) ? box.upper.z : box.lower.z);
+                        reach = std::max(reach, dot(corner - origin, n));
+                    }
+                    if (reach >= 0) ahead.push_back(&box);
+                }
+                if (ahead.empty()) continue;
+                GatherHit* hits = &hits_[size_t(v) * rays_];
+                for (uint32_t j = 0; j < rays_; ++j) {
+                    const Vec3f d = direction(starts, v, j);
+                    bool meets = false;
+                    for (const Bounds3f* box : ahead) {
+                        double t0 = 0, t1 = double(hits[j].t);
+                        if ((meets = box->clip(origin, d, t0, t1))) break;
+                    }
+                    if (!meets) continue;
+                    hits[j] = castRay(bvh, frontNormals, origin, d);
+                    ++count;
+                }
+            }
+            return count;
+        },
+        [](uint64_t a, uint64_t b) { return a + b; });
+    raysCast_ += recast;
+    return recast;
+}
+
+void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const {
+    out.assign(scene.vertexCount(), Vec3f(0.0f));
+    if (rays_ == 0) return;
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t v = r.begin(); v != r.end(); ++v) {
+            // In ray order, in one thread: the same bits for any schedule.
+            Vec3d sum(0.0);
+            const GatherHit* hits = &hits_[size_t(v) * rays_];
+            for (uint32_t j = 0; j < rays_; ++j) {
+                const GatherHit& h = hits[j];
+                if (h.triangle >= GatherHit::kBackFace) continue;
+                const Triangle& tri = scene.triangles[h.triangle];
+                const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
+                const double w0 = std::max(0.0, 1.0 - w1 - w2);
+                sum += Vec3d(firstPass[tri.v[0]]) * w0 + Vec3d(firstPass[tri.v[1]]) * w1 + Vec3d(firstPass[tri.v[2]]) * w2;
+            }
+            out[v] = Vec3f(sum / double(rays_));
+        }
+    });
+}
+
+}  // namespace qsgi

@@ -1,0 +1,34 @@
+// How a vertex's irradiance is put together from the photons (docs/design.md §5.1, issue 33): either
+// all of it from the photons' density estimate (the paper's method), or direct light exact by
+// shadow rays plus — with a final gather — one bounce gathered over the photon solution.
+#pragma once
+
+#include <cstdint>
+
+#include "util/enum_names.h"
+
+namespace qsgi {
+
+enum class DirectLighting { Photons, Exact };
+inline constexpr NamedValue<DirectLighting> kDirectLightingNames[] = {{DirectLighting::Photons, "photons"},
+                                                                      {DirectLighting::Exact, "exact"}};
+inline const char* directLightingName(DirectLighting d) { return nameOf(kDirectLightingNames, d); }
+
+struct LightingSettings {
+    // Photons: E_v is the estimator's answer. Exact: E_v = D_v + (gatherRays > 0 ? the gathered
+    // mean of the first pass : the estimator's answer after the first bounce).
+    DirectLighting direct = DirectLighting::Photons;
+    // Shadow rays per vertex toward the emissive triangles (one per punctual light besides).
+    uint32_t directSamples = 16;
+    // Final-gather rays per vertex (0: no gather).
+    uint32_t gatherRays = 0;
+
+    bool exactDirect() const { return direct == DirectLighting::Exact; }
+    bool gathers() const { return exactDirect() && gatherRays > 0; }
+};
+
+// Limits of the options: a vertex's samples are points of one Sobol sequence, indexed by 32 bits.
+constexpr int64_t kMaxDirectSamples = int64_t(1) << 16;
+constexpr int64_t kMaxGatherRays = int64_t(1) << 16;
+
+}  // namespace qsgi

@@ -1,0 +1,85 @@
+#include "estimate/two_pass_lighting.h"
+
+#include <algorithm>
+
+#include "util/stopwatch.h"
+
+namespace qsgi {
+
+TwoPassLighting::TwoPassLighting(const LightingSettings& settings, uint64_t seed)
+    : settings_(settings), direct_(settings.directSamples, seed), gather_(settings.gathers() ? settings.gatherRays : 0, seed) {}
+
+size_t TwoPassLighting::stateBytes() const {
+    return starts_.size() * 2 * sizeof(Vec3f) + direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes();
+}
+
+void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const VertexRadiosity& photons,
+                            VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress) {
+    Stopwatch clock;
+    starts_.refreshAll(scene, regions);
+    if (progress) progress->start("direct", scene.vertexCount());
+    direct_.computeAll(scene, bvh, starts_, progress);
+    stats.directSeconds = clock.seconds();
+    stats.shadowRays = direct_.raysCast();
+    clock.restart();
+    if (settings_.gathers()) {
+        if (progress) progress->start("gathering", scene.vertexCount());
+        gather_.castAll(scene, bvh, starts_, progress);
+        stats.gatherRays = gather_.raysCast();
+    }
+    combine(scene, photons, out);
+    stats.gatherSeconds = clock.seconds();
+    solved_ = true;
+}
+
+void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const MovedGeometry& moved,
+                             const VertexRadiosity& photons, VertexRadiosity& out, FrameTiming& stats) {
+    Stopwatch clock;
+    // A segment that grazes a mover's bounds is re-cast: the margin covers Embree's hits on the
+    // bounds' faces and the start points' lift.
+    const float margin = 4 * scene.sceneEpsilon() + bvh.rayEpsilon();
+    std::vector<Bounds3f> boxes;
+    for (const Bounds3f& b : moved.bounds)
+        if (!b.empty()) boxes.push_back(b.expanded(margin));
+    const std::vector<uint32_t> newStarts = starts_.refresh(scene, regions, moved.touched);
+    // Lights are static (an emissive mover is refused, docs/design.md §2): the emitters read at the
+    // first solve stand.
+    std::vector<uint32_t> vertices = direct_.raysMeeting(scene, starts_, boxes);
+    vertices.insert(vertices.end(), newStarts.begin(), newStarts.end());
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    direct_.recompute(scene, bvh, starts_, vertices);
+    stats.directSeconds = clock.seconds();
+    stats.shadowRays = direct_.raysCast();
+    clock.restart();
+    if (settings_.gathers()) {
+        gather_.resetRayCount();
+        gather_.cast(scene, bvh, starts_, newStarts);
+        std::vector<uint8_t> skip(scene.vertexCount(), 0);
+        for (uint32_t v : newStarts) skip[v] = 1;
+        gather_.recastMeeting(scene, bvh, starts_, boxes, skip);
+        stats.gatherRays = gather_.raysCast();
+    }
+    combine(scene, photons, out);
+    stats.gatherSeconds = clock.seconds();
+}
+
+void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const {
+    const std::vector<Vec3f>& direct = direct_.irradiance();
+    const size_t n = scene.vertexCount();
+    out.irradiance.resize(n);
+    if (settings_.gathers()) {
+        std::vector<Vec3f> firstPass(n);
+        for (size_t v = 0; v < n; ++v) {
+            const Material& m = scene.materials[scene.vertexMaterial[v]];
+            firstPass[v] = scene.vertexHidden[v] ? Vec3f(0.0f) : m.albedo * (direct[v] + photons.irradiance[v]);
+        }
+        gather_.gather(scene, firstPass, out.irradiance);
+        for (size_t v = 0; v < n; ++v) out.irradiance[v] = direct[v] + out.irradiance[v];
+    } else {
+        for (size_t v = 0; v < n; ++v) out.irradiance[v] = direct[v] + photons.irradiance[v];
+    }
+    computeRadiosity(scene, out);
+}
+
+}  // namespace qsgi

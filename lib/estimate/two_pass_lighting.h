@@ -1,0 +1,62 @@
+// The second pass over the photons' solution (docs/design.md §5.1, issue 33). Per vertex v with albedo
+// ρ_v: D_v direct irradiance, exact (DirectLight); I_v the estimator's answer counting only light
+// after its first bounce; F_u = ρ_u (D_u + I_u) the first pass; then
+//   E_v = D_v + (M > 0 ? mean of F over v's gather rays (FinalGather) : I_v),  B_v = ρ_v E_v + π L_e,v.
+// It owns what that takes — the direct light and the gather's kept hits — and keeps each up to date
+// across a move, touching only what the move can change, so that every update gives the bits a
+// from-scratch solve of the same pose gives. The rays leave from the disc regions' start points
+// (DiscRegions, whose owner keeps them current; every estimator's, impact count's too).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "estimate/direct_light.h"
+#include "estimate/final_gather.h"
+#include "estimate/lighting_settings.h"
+#include "estimate/vertex_radiosity.h"
+#include "estimate/vertex_starts.h"
+#include "scene/scene.h"
+#include "trace/scene_bvh.h"
+#include "util/frame_timing.h"
+#include "util/work_counter.h"
+
+namespace qsgi {
+
+// What a pose changed, as the second pass reads it. The scene and BVH already hold the new pose.
+struct MovedGeometry {
+    const std::vector<Bounds3f>& bounds;  // old and new bounds of each moved part
+    // Vertices whose disc regions were recomputed or that moved: every vertex whose start point
+    // or normal may have changed is among them.
+    const std::vector<uint32_t>& touched;
+};
+
+class TwoPassLighting {
+public:
+    TwoPassLighting(const LightingSettings& settings, uint64_t seed);
+
+    // From scratch for the current pose (bvh and regions hold it). photons: the estimator's answer
+    // (after the first bounce).
+    void solve(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const VertexRadiosity& photons,
+               VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress = nullptr);
+    // The last solve's or update's state brought to the current pose.
+    void update(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const MovedGeometry& moved,
+                const VertexRadiosity& photons, VertexRadiosity& out, FrameTiming& stats);
+    bool solved() const { return solved_; }
+    void reset() { solved_ = false; }
+
+    // Bytes kept across frames (starts, direct light, gather hits).
+    size_t stateBytes() const;
+
+private:
+    void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const;
+
+    LightingSettings settings_;
+    VertexStarts starts_;
+    DirectLight direct_;
+    FinalGather gather_;
+    bool solved_ = false;
+};
+
+}  // namespace qsgi
