@@ -6,8 +6,9 @@ For every case it renders the same frames twice (incremental, then --full-recomp
 and reports from the two timing.json files:
 - the median and slowest frame after the first, each way, and their ratio;
 - where an incremental frame's time goes (find, retrace, estimator update, disc regions,
-  recompute; writing the PLY apart, outside the frame's time), the paths and segments changed,
-  the vertices recomputed;
+  recompute, exact direct light, the gather; writing the PLY apart, outside the frame's time), the
+  paths and segments changed, the vertices recomputed, the shadow and gather rays re-cast against
+  those a full frame casts;
 - the price of the frame's changed work at the full frame's own rates: the added segments at the
   full frame's seconds per segment (tracing plus estimation) and the recomputed vertices at its
   estimation seconds per vertex; overhead = frame time / price - 1;
@@ -32,11 +33,15 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 SCENES = os.path.join(ROOT, "out", "bench", "scenes")
 
 
+PHOTONS_ONLY = ["--direct", "photons", "--gather", "0"]  # the photon update alone (the paper's method)
+
+
 def cases(quick):
     cornell = ["data/cornell/cornell.gltf", "--animation", "data/cornell/animation.json"]
+    tree = ["data/tree/tree.gltf", "--animation", "data/tree/animation.json"]
     photons = "200000" if quick else "1000000"
     frames = "0:4" if quick else "0:10"
-    return [
+    photon_cases = [
         ("cornell detp clip", cornell + ["--estimator", "detp", "--radius", "0.05", "--photons", photons, "--frames", frames]),
         ("cornell impact count", cornell + ["--estimator", "impact-count", "--photons", photons, "--frames", frames]),
         ("cornell photon map k=50", cornell + ["--estimator", "photon-map", "--k", "50", "--radius", "0.05",
@@ -53,6 +58,16 @@ def cases(quick):
                                                                 "--estimator", "detp", "--radius", "0.05",
                                                                 "--photons", photons, "--frames", "0:4" if quick else "0:24"]),
     ]
+    # The renderer's defaults: exact direct light and the final gather over the photon solution
+    # (docs/design.md §5.1), whose update re-casts only the rays a move can change.
+    gather_cases = [
+        ("cornell impact count, exact direct + gather (defaults)", cornell + ["--photons", photons, "--frames", frames]),
+        ("cornell detp clip, exact direct + gather", cornell + ["--estimator", "detp", "--radius", "0.05",
+                                                                "--photons", photons, "--frames", frames]),
+        ("tree impact count, exact direct + gather (defaults)", tree + ["--photons", photons, "--frames", frames]),
+        ("tree detp clip, exact direct + gather", tree + ["--estimator", "detp", "--photons", photons, "--frames", frames]),
+    ]
+    return [(name, args + PHOTONS_ONLY) for name, args in photon_cases] + gather_cases
 
 
 def run(qsgi, args, out):
@@ -67,7 +82,8 @@ def run(qsgi, args, out):
 
 
 def frame_time(f):
-    return f["photon_update_s"] + f["estimation_s"]
+    # The second pass's shadow and gather rays (zero under --direct photons) count too.
+    return f["photon_update_s"] + f["estimation_s"] + f.get("direct_s", 0) + f.get("gather_s", 0)
 
 
 def measure(name, args, qsgi):
@@ -97,6 +113,8 @@ def measure(name, args, qsgi):
         "from_scratch": {str(f["frame"]): f["from_scratch_reason"] for f in fi if f["from_scratch"]},
         "find_s": med("find_affected_s"), "retrace_s": med("retrace_s"), "update_s": med("estimator_update_s"),
         "regions_s": med("disc_regions_s"), "recompute_s": med("recompute_s"), "write_s": med("write_s", fi),
+        "direct_s": med("direct_s"), "gather_s": med("gather_s"), "shadow_rays": med("shadow_rays"),
+        "gather_rays": med("gather_rays"), "full_gather_rays": statistics.median(f.get("gather_rays", 0) for f in ff),
         "paths_retraced": med("paths_retraced"), "segments_removed": med("segments_removed"),
         "segments_added": med("segments_added"), "segments": mid["segments"],
         "vertices_recomputed": med("vertices_recomputed"), "vertices_updated": med("vertices_updated"),
@@ -124,7 +142,9 @@ def main():
         results.append(r)
         print(f"| {r['case']} | {r['ratio']:.2f}x | {r['incremental_median_s']:.3f} / {r['incremental_max_s']:.3f} s | "
               f"{r['full_median_s']:.3f} s | find {r['find_s']:.3f}, retrace {r['retrace_s']:.3f}, update {r['update_s']:.3f}, "
-              f"regions {r['regions_s']:.3f}, recompute {r['recompute_s']:.3f}, writing {r['write_s']:.3f} apart | "
+              f"regions {r['regions_s']:.3f}, recompute {r['recompute_s']:.3f}, direct {r['direct_s']:.3f}, "
+              f"gather {r['gather_s']:.3f}, writing {r['write_s']:.3f} apart | "
+              f"rays re-cast {r['gather_rays']:.0f}/{r['full_gather_rays']:.0f} gather, {r['shadow_rays']:.0f} shadow | "
               f"{r['paths_retraced']:.0f} paths, {r['segments_added']:.0f}/{r['segments']} segments, "
               f"{r['vertices_recomputed']:.0f}/{r['vertices']} vertices | price {r['price_s']:.3f} s, overhead {100 * r['overhead']:.0f} % | "
               f"{r['state_bytes_per_tracked_segment']:.0f} B/seg, RSS {r['peak_rss_incremental'] / 2**20:.0f}/{r['peak_rss_full'] / 2**20:.0f} MiB | "

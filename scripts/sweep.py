@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Speed/accuracy sweeps: qsgi renders over a grid of photon counts, radii, k, estimators and photon
-samplers (random, sobol), judged against a reference, tabulated in OUT/sweep.csv and plotted in
-OUT/*.png.
+"""Speed/accuracy sweeps: qsgi renders over a grid of photon counts, radii, k, estimators, photon
+samplers (random, sobol) and lightings (direct light from the photons or exact, final gather),
+judged against a reference, tabulated in OUT/sweep.csv and plotted in OUT/*.png.
 
     scripts/sweep.py configs/sweep-cornell.json --quick --out out/sweep-quick
     scripts/sweep.py configs/sweep-tree.json --out out/sweep-tree --jobs 2

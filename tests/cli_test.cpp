@@ -373,28 +373,40 @@ TEST(Cli, AnimationsTheFileCarriesAreAnnouncedWhenNotPlayed) {
     EXPECT_EQ(played.output.find("note:"), std::string::npos) << played.output;
 }
 
-// The status line lives through a long stage: while disc regions are computed (2 s here, one
-// thread, a wide radius) it is redrawn with a moving clock and a growing bar of vertices.
-TEST(Cli, TheStatusLineMovesDuringALongRegionsStage) {
-    const fs::path out = fs::path(testScratchDir("status")) / "out";
-    const CommandResult t = runQsgiOnTerminal({"render", cornell(), "--estimator", "detp", "--radius", "0.3", "--threads", "1",
-                                               "--photons", "1000", "--no-exr", "--out", out.string()});
+// The status line lives through a long stage: it is redrawn with a moving clock and a growing
+// bar. `stage` as the line names it, `timing` the stage's seconds in timing.json.
+static void expectTheStatusLineMoves(const std::vector<std::string>& arguments, const char* stage, const char* timing) {
+    SCOPED_TRACE(stage);
+    const fs::path out = fs::path(testScratchDir(std::string("status-") + stage)) / "out";
+    std::vector<std::string> all = arguments;
+    all.insert(all.end(), {"--threads", "1", "--no-exr", "--out", out.string()});
+    const CommandResult t = runQsgiOnTerminal(all);
     ASSERT_EQ(t.exitCode, 0) << t.output;
     std::set<std::string> clocks, bars;
     std::istringstream drawings(t.output);
+    const std::string marker = std::string("  ") + stage + " [";
     for (std::string drawn; std::getline(drawings, drawn, '\r');) {
-        const size_t stage = drawn.find("  regions [");
-        if (stage == std::string::npos) continue;
+        const size_t at = drawn.find(marker);
+        if (at == std::string::npos) continue;
         const size_t elapsed = drawn.find(" elapsed");
         ASSERT_NE(elapsed, std::string::npos) << drawn;
         clocks.insert(drawn.substr(elapsed - 4, 4));
-        bars.insert(drawn.substr(stage));
+        bars.insert(drawn.substr(at));
     }
     // How long the stage took decides what must have been seen: the clock crosses a whole second
     // at least floor(s) times, and the ticker (four times a second) redraws the bar at least
     // twice a second on any machine.
-    const double seconds = nlohmann::json::parse(readFileBytes(out / "timing.json"))["frames"][0]["disc_regions_s"].get<double>();
-    EXPECT_GE(double(clocks.size()), std::floor(seconds)) << seconds << " s of regions; the clock did not move:\n" << t.output;
-    EXPECT_GE(double(bars.size()), std::floor(2 * seconds)) << seconds << " s of regions; the bar did not move:\n" << t.output;
+    const double seconds = nlohmann::json::parse(readFileBytes(out / "timing.json"))["frames"][0][timing].get<double>();
+    EXPECT_GE(double(clocks.size()), std::floor(seconds)) << seconds << " s of " << stage << "; the clock did not move:\n" << t.output;
+    EXPECT_GE(double(bars.size()), std::floor(2 * seconds)) << seconds << " s of " << stage << "; the bar did not move:\n" << t.output;
     EXPECT_GE(bars.size(), 1u) << t.output;
+}
+
+// Disc regions (2 s here, one thread, a wide radius) and the final gather (about as long: 512 rays
+// from each of data/cornell's 21,636 vertices, one thread).
+TEST(Cli, TheStatusLineMovesDuringLongRegionsAndGatherStages) {
+    expectTheStatusLineMoves({"render", cornell(), "--estimator", "detp", "--radius", "0.3", "--photons", "1000",
+                              "--direct", "photons", "--gather", "0"},
+                             "regions", "disc_regions_s");
+    expectTheStatusLineMoves({"render", cornell(), "--photons", "1000", "--gather", "512"}, "gathering", "gather_s");
 }

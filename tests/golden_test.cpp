@@ -4,8 +4,9 @@
 //  - Another compiler or CPU may round a few operations differently (FMA contraction, libm), which
 //    can send a rare photon elsewhere; each photon carries ~1/N of the power, so such flips move
 //    single triangles by a few percent and the image mean by far less than 0.2 %.
-//  - A real change is far larger: 10x fewer photons raises the impact-count noise by sqrt(10)
-//    (relative mean error ~0.15 here with Sobol photons, ~0.3 with random ones), a changed albedo shifts whole walls by several percent.
+//  - A real change is far larger: 10x fewer photons raises the photons-only impact-count noise by
+//    sqrt(10) (relative mean error ~0.3 with random photons), a changed albedo shifts whole walls by
+//    several percent.
 // Set QSGI_UPDATE_GOLDENS=1 (scripts/update-goldens.sh) to rewrite the goldens on purpose.
 #include <gtest/gtest.h>
 
@@ -33,6 +34,9 @@ struct GoldenCase {
 // Test names show the case's name, not its bytes.
 void PrintTo(const GoldenCase& c, std::ostream* os) { *os << c.name; }
 
+// The paper's method: every watt from the photons' density estimate.
+const std::string kPhotonsOnly = " --direct photons --gather 0";
+
 std::vector<GoldenCase> goldenCases() {
     const std::string cornell = (sourceDir() / "data/cornell/cornell.gltf").string();
     const std::string animation = (sourceDir() / "data/cornell/animation.json").string();
@@ -42,11 +46,14 @@ std::vector<GoldenCase> goldenCases() {
         {"cornell_f0030", cornell + " --animation " + animation + " --frames 30:30 --photons 200000" + size, 30},
         {"sphere_point_light", (sourceDir() / "tests/scenes/sphere_point_light.gltf").string() + " --photons 200000" + size, 0},
         {"plane_point_light", (sourceDir() / "tests/scenes/plane_point_light.gltf").string() + " --photons 200000" + size, 0},
-        // The random sampler's renders, byte for byte what qsgi drew before Sobol became the default.
+        // The random sampler's renders from the photons alone, byte for byte what qsgi drew before
+        // Sobol photons, exact direct light and the gather became the defaults (issues 20, 33).
         {"cornell_f0000_random",
-         cornell + " --animation " + animation + " --frames 0:0 --photons 200000 --sampler random" + size, 0},
+         cornell + " --animation " + animation + " --frames 0:0 --photons 200000 --sampler random" + kPhotonsOnly + size, 0},
         {"plane_point_light_random",
-         (sourceDir() / "tests/scenes/plane_point_light.gltf").string() + " --photons 200000 --sampler random" + size, 0},
+         (sourceDir() / "tests/scenes/plane_point_light.gltf").string() + " --photons 200000 --sampler random" +
+             kPhotonsOnly + size,
+         0},
     };
 }
 
@@ -100,17 +107,20 @@ TEST_P(GoldenImage, FreshRenderMatchesTheGolden) {
 INSTANTIATE_TEST_SUITE_P(Renders, GoldenImage, ::testing::ValuesIn(goldenCases()),
                          [](const auto& info) { return info.param.name; });
 
-// The check must be able to fail: a render with 10x fewer photons, and one with a different wall
-// albedo, are both rejected against the frame-0 golden.
+// The check must be able to fail: a photons-only render with 10x fewer photons (against the
+// photons-only golden: the defaults' gather hides most of the photons' noise, by design), and a
+// render with a different wall albedo (against the defaults' frame-0 golden), are both rejected.
 TEST(GoldenImageCheck, CatchesFewerPhotonsAndAChangedAlbedo) {
     const fs::path golden = sourceDir() / "tests/golden/cornell_f0000.exr";
+    const fs::path photonsGolden = sourceDir() / "tests/golden/cornell_f0000_random.exr";
     ASSERT_TRUE(fs::exists(golden));
+    ASSERT_TRUE(fs::exists(photonsGolden));
     const GoldenCase base = goldenCases()[0];
     const ImageTolerance tolerance;
 
-    std::string fewer = base.arguments;
+    std::string fewer = goldenCases()[4].arguments;
     fewer.replace(fewer.find("--photons 200000"), 16, "--photons 20000");
-    const auto noisy = compareImages(renderFresh(fewer, 0, "golden_fewer"), golden, tolerance);
+    const auto noisy = compareImages(renderFresh(fewer, 0, "golden_fewer"), photonsGolden, tolerance);
     ASSERT_TRUE(noisy.readable) << noisy.problem;
     std::printf("10x fewer photons: mean relative error %.3g, failing pixels %.3g %%\n", noisy.meanRelativeError,
                 100 * noisy.failingPixelFraction);

@@ -41,7 +41,7 @@ TEST(PlyPin, PhotonOnlyRendersKeepTheirBytesForEveryEstimator) {
         SCOPED_TRACE(pinned.name);
         const fs::path out = dir / pinned.name;
         const CommandResult r = runQsgi("render " + (cornell / "cornell.gltf").string() + " --animation " +
-                                        (cornell / "animation.json").string() + " --frames 0:2 --photons 100000 --no-exr " +
+                                        (cornell / "animation.json").string() + " --frames 0:2 --photons 100000 --direct photons --gather 0 --no-exr " +
                                         pinned.options + " --quiet --out '" + out.string() + "'");
         ASSERT_EQ(r.exitCode, 0) << r.output;
         const std::pair<std::string, std::string> here = {qsgi::xxh3Hex(readFileBytes(out / "frame_0000.ply")),

@@ -16,10 +16,26 @@ constexpr float kBarycentricScale = 65535.0f;
 uint16_t quantised(float b) { return uint16_t(std::lround(std::clamp(b, 0.0f, 1.0f) * kBarycentricScale)); }
 }  // namespace
 
-Vec3f FinalGather::direction(const VertexStarts& starts, uint32_t v, uint32_t ray) const {
-    const VertexSamples numbers(seed_, v, VertexStream::Gather);
-    return cosineHemisphere(starts.normal(v), numbers.uniform(ray, 0), numbers.uniform(ray, 1));
-}
+// A vertex's gather directions: its frame and its numbers, made once for all its rays (the scan
+// of a frame's update makes every direction again: they are not stored).
+class FinalGather::Directions {
+public:
+    Directions(const VertexStarts& starts, uint32_t v, uint64_t seed)
+        : numbers_(seed, v, VertexStream::Gather), n_(starts.normal(v)) {
+        orthonormalBasis(n_, t_, b_);
+    }
+    // Cosine-weighted about n_v (pdf cosθ/π), as cosineHemisphere.
+    Vec3f operator()(uint32_t ray) const {
+        const float u0 = numbers_.uniform(ray, 0), u1 = numbers_.uniform(ray, 1);
+        const float r = std::sqrt(u0), phi = 2 * kPi * u1;
+        const float z = std::sqrt(std::max(0.0f, 1 - u0));
+        return normalize(t_ * (r * std::cos(phi)) + b_ * (r * std::sin(phi)) + n_ * z);
+    }
+
+private:
+    VertexSamples numbers_;
+    Vec3f n_, t_, b_;
+};
 
 GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                                const Vec3f& direction) const {
@@ -45,7 +61,8 @@ void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const Vert
         for (uint32_t j = 0; j < rays_; ++j) hits[j] = GatherHit{};
         return;
     }
-    for (uint32_t j = 0; j < rays_; ++j) hits[j] = castRay(bvh, frontNormals, starts.point(v), direction(starts, v, j));
+    const Directions direction(starts, v, seed_);
+    for (uint32_t j = 0; j < rays_; ++j) hits[j] = castRay(bvh, frontNormals, starts.point(v), direction(j));
 }
 
 void FinalGather::castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
@@ -75,12 +92,13 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
     const uint64_t recast = tbb::parallel_reduce(
         tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), uint64_t(0),
         [&](const tbb::blocked_range<uint32_t>& r, uint64_t count) {
+            std::vector<const Bounds3f*> ahead;
             for (uint32_t v = r.begin(); v != r.end(); ++v) {
                 if (skip[v] || scene.vertexHidden[v]) continue;
                 const Vec3f origin = starts.point(v);
                 const Vec3f& n = starts.normal(v);
                 // Every ray leaves into v's hemisphere: a box wholly behind its plane meets none.
-                std::vector<const Bounds3f*> ahead;
+                ahead.clear();
                 for (const Bounds3f& box : boxes) {
                     float reach = 0;
                     for (int c = 0; c < 8; ++c) {
@@ -92,8 +110,9 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
                 }
                 if (ahead.empty()) continue;
                 GatherHit* hits = &hits_[size_t(v) * rays_];
+                const Directions direction(starts, v, seed_);
                 for (uint32_t j = 0; j < rays_; ++j) {
-                    const Vec3f d = direction(starts, v, j);
+                    const Vec3f d = direction(j);
                     bool meets = false;
                     for (const Bounds3f* box : ahead) {
                         double t0 = 0, t1 = double(hits[j].t);

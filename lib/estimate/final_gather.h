@@ -57,7 +57,7 @@ public:
     size_t bytes() const { return hits_.capacity() * sizeof(GatherHit); }
 
 private:
-    Vec3f direction(const VertexStarts& starts, uint32_t v, uint32_t ray) const;
+    class Directions;
     GatherHit castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                       const Vec3f& direction) const;
     void castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,

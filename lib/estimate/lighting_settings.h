@@ -14,6 +14,8 @@ inline constexpr NamedValue<DirectLighting> kDirectLightingNames[] = {{DirectLig
                                                                       {DirectLighting::Exact, "exact"}};
 inline const char* directLightingName(DirectLighting d) { return nameOf(kDirectLightingNames, d); }
 
+// The defaults here are the paper's method, which the library's callers (tests, benchmarks) get
+// unless they ask; the renderer's defaults (RenderSettings) are exact direct light and a gather.
 struct LightingSettings {
     // Photons: E_v is the estimator's answer. Exact: E_v = D_v + (gatherRays > 0 ? the gathered
     // mean of the first pass : the estimator's answer after the first bounce).

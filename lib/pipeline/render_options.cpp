@@ -194,7 +194,7 @@ std::vector<RenderOption> declareOptions() {
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.sortQueries = v; },
                  [](const RenderSettings& s) { return json(s.estimator.sortQueries); }});
     // The second pass (docs/design.md §5.1)
-    o.push_back({"direct", "--direct", T::Choice, 0, 0, "", namesOf(kDirectLightingNames), true, "", "photons",
+    o.push_back({"direct", "--direct", T::Choice, 0, 0, "", namesOf(kDirectLightingNames), true, "", "exact",
                  "direct light: exact (shadow rays from each vertex; the estimator then counts only light after its "
                  "first bounce) or photons (all of it from the photons: the paper's method)",
                  true, true,
@@ -202,13 +202,13 @@ std::vector<RenderOption> declareOptions() {
                      s.lighting.direct = choiceValue(kDirectLightingNames, v);
                  },
                  [](const RenderSettings& s) { return json(directLightingName(s.lighting.direct)); }});
-    o.push_back({"direct_samples", "--direct-samples", T::Integer, 1, double(kMaxDirectSamples), "", {}, true, "S", "16",
+    o.push_back({"direct_samples", "--direct-samples", T::Integer, 1, double(kMaxDirectSamples), "", {}, true, "S", "64",
                  "exact direct only: shadow rays per vertex toward the emissive triangles, chosen by power (one per "
                  "point, spot and directional light besides)",
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.lighting.directSamples = v.get<uint32_t>(); },
                  [](const RenderSettings& s) { return orNull(s.lighting.exactDirect(), json(s.lighting.directSamples)); }});
-    o.push_back({"gather", "--gather", T::Integer, 0, double(kMaxGatherRays), "", {}, true, "M", "0",
+    o.push_back({"gather", "--gather", T::Integer, 0, double(kMaxGatherRays), "", {}, true, "M", "256",
                  "exact direct only: final-gather rays per vertex over the photon solution (0: none; the vertex then "
                  "takes the estimator's indirect light as it is)",
                  true, true,

@@ -1,16 +1,29 @@
 """The sweep config (configs/sweep-*.json) and the grid points it names.
 
 A point is one qsgi render: estimator, boundary rule, photons, radius (as a fraction of the
-animation's bounding-box diagonal, so one config fits any scale), k, update strategy, frames and
-photon sampler. Three families: `accuracy` (the grid the plots of the trade are drawn from, for
-every sampler of grid.samplers), `full` (the same renders with --full-recompute at one radius: the
-second line style of the Pareto plot) and `extreme` (radius from 1e-6 of the diagonal to all of
-it, photons from 1 up: stability); those two use the first sampler of the list only.
+animation's bounding-box diagonal, so one config fits any scale), k, update strategy, frames,
+photon sampler and lighting (direct light from the photons or exact, and the final gather).
+Three families: `accuracy` (the grid the plots of the trade are drawn from, for every sampler of
+grid.samplers and every valid lighting of grid.direct x grid.gather), `full` (the same renders
+with --full-recompute at one radius: the second line style of the Pareto plot) and `extreme`
+(radius from 1e-6 of the diagonal to all of it, photons from 1 up: stability); those two use the
+first sampler of the list only, and the paper's lighting (direct light from the photons, no
+gather) whatever the grid's.
 
 The `grid` keys: photons, radius_fraction, k (photon map; default [50]), estimators,
-full_recompute_radius_fraction (default 0.015) and samplers: a list of "random", "sobol" (qsgi's
+full_recompute_radius_fraction (default 0.015), samplers: a list of "random", "sobol" (qsgi's
 default number of Sobol bounces: no --qmc-bounces) or "sobol:K" (--qmc-bounces K, 0..32); default
-["sobol"], qsgi's default sampler."""
+["sobol"], qsgi's default sampler; direct: a list of "photons" (the paper's method: all light from
+the photons) and "exact" (shadow rays from each vertex), default ["photons"]; gather: a list of
+final-gather ray counts per vertex, 0 for none, default [0]; direct_samples: shadow rays per vertex
+under exact direct light, an integer or a list of them, default 64. A gather needs exact direct
+light (qsgi exits 2 on --gather M > 0 with --direct photons): such pairs of direct x gather are left
+out of the grid, and a grid with none left is a ConfigError.
+
+Every point passes --direct and --gather (and --direct-samples under exact) explicitly, whatever
+they are: a point means the same render whatever qsgi's defaults are. Names spell the lighting only
+when it is not the paper's (photons, gather 0), so folders of sweeps from before keep their
+names."""
 import dataclasses
 import json
 import math
@@ -22,11 +35,29 @@ DEFAULT_K = 50
 DEFAULT_RADIUS_FRACTION = 0.015  # qsgi's default radius (render_settings.cpp: defaultRadius)
 KNOWN_KEYS = {"scene", "animation", "reference", "frames", "seeds", "grid", "extremes", "quick",
               "reference_build", "jobs"}
-GRID_KEYS = {"photons", "radius_fraction", "k", "estimators", "full_recompute_radius_fraction", "samplers"}
+GRID_KEYS = {"photons", "radius_fraction", "k", "estimators", "full_recompute_radius_fraction", "samplers",
+             "direct", "gather", "direct_samples"}
 DEFAULT_SAMPLER = "sobol"  # qsgi's default sampler, at its default --qmc-bounces
 MAX_QMC_BOUNCES = 32       # qsgi render --qmc-bounces: 0..32 (and at most max_bounces, 32 by default)
+DIRECT_LIGHTING = ("photons", "exact")  # qsgi render --direct
+# The sweep's lighting where a config names none: the paper's method, whatever qsgi's default is
+# (points made before the lighting axes rendered it; their names and results stay valid).
+DEFAULT_DIRECT = "photons"
+DEFAULT_GATHER = 0
+DEFAULT_DIRECT_SAMPLES = 64   # the sweep's, passed explicitly (not qsgi's default)
+MAX_DIRECT_SAMPLES = 1 << 16  # qsgi render --direct-samples: 1..65536
+MAX_GATHER = 1 << 16          # qsgi render --gather: 0..65536
 EXTREME_KEYS = {"radius_fraction", "radius_photons", "photons", "estimators"}
 REFERENCE_KEYS = {"photons", "seeds", "radius_fraction"}
+
+
+def lighting_label(direct: str, gather: int, direct_samples=None) -> str:
+    """The lighting as the plots name it: "photons", "exact", "exact+gather 256"; with
+    direct_samples (where a sweep has several), "exact 64+gather 256"."""
+    if direct != "exact":
+        return direct
+    label = "exact" if direct_samples is None else f"exact {direct_samples:g}"
+    return label + (f"+gather {gather:g}" if gather else "")
 
 
 class ConfigError(Exception):
@@ -44,6 +75,9 @@ class Point:
     full_recompute: bool
     frames: str           # "A:B"
     sampler: str = DEFAULT_SAMPLER  # random | sobol (qsgi's default K) | sobol:K
+    direct: str = DEFAULT_DIRECT    # photons | exact
+    gather: int = DEFAULT_GATHER    # final-gather rays per vertex (exact only; 0 = none)
+    direct_samples: int = 0         # shadow rays per vertex (exact only; 0 under photons: not passed)
 
     @property
     def label(self) -> str:
@@ -65,6 +99,10 @@ class Point:
             parts.append("full")
         if self.sampler != DEFAULT_SAMPLER:  # the default's names are those points had before samplers
             parts.append(self.sampler.replace(":", "-"))
+        if self.direct != DEFAULT_DIRECT or self.gather != DEFAULT_GATHER:  # likewise before the lighting
+            parts.append(f"{self.direct}-s{self.direct_samples}" if self.direct == "exact" else self.direct)
+            if self.gather:
+                parts.append(f"g{self.gather}")
         return "_".join(parts)
 
     def qsgi_options(self, diagonal: float) -> list:
@@ -81,6 +119,10 @@ class Point:
         options += ["--sampler", sampler]
         if bounces:
             options += ["--qmc-bounces", bounces]
+        # Always explicit, the paper's lighting too: qsgi's defaults may change, a point may not.
+        options += ["--direct", self.direct, "--gather", str(self.gather)]
+        if self.direct == "exact":
+            options += ["--direct-samples", str(self.direct_samples)]
         return options
 
 
@@ -148,6 +190,36 @@ def _sampler(path, where, value):
     return f"sobol:{bounces}"
 
 
+def _direct(path, where, value):
+    if value not in DIRECT_LIGHTING:
+        _fail(path, where, f"unknown direct lighting {json.dumps(value)} (known: \"photons\", \"exact\")")
+    return value
+
+
+def _lightings(path, grid):
+    """The grid's (direct, gather, direct_samples) triples in the config's order: direct x gather
+    (x direct_samples under exact), less the pairs qsgi refuses (a gather under direct light from
+    the photons: skipped, not an error, unless no pair is left); direct_samples 0 under photons."""
+    directs = list(dict.fromkeys(_list(path, "grid.direct", grid.get("direct", [DEFAULT_DIRECT]), _direct)))
+    gathers = list(dict.fromkeys(_list(path, "grid.gather", grid.get("gather", [DEFAULT_GATHER]),
+                                       lambda p, w, v: _count(p, w, v, 0, MAX_GATHER))))
+    samples = grid.get("direct_samples", DEFAULT_DIRECT_SAMPLES)
+
+    def one_count(p, w, v):
+        return _count(p, w, v, 1, MAX_DIRECT_SAMPLES)
+
+    samples = list(dict.fromkeys(_list(path, "grid.direct_samples", samples, one_count) if isinstance(samples, list)
+                                 else [one_count(path, "grid.direct_samples", samples)]))
+    lightings = [(d, g, s) for d in directs for g in gathers for s in (samples if d == "exact" else [0])
+                 if d == "exact" or g == 0]
+    if not lightings:
+        _fail(path, "grid.gather", f"no valid lighting in grid.direct {json.dumps(directs)} x grid.gather "
+                                   f"{json.dumps(gathers)}: a gather > 0 needs direct \"exact\" (qsgi render "
+                                   "--gather M needs --direct exact); add \"exact\" to grid.direct or 0 to "
+                                   "grid.gather")
+    return lightings
+
+
 def _frames(path, where, value):
     try:
         a, b = (int(x) for x in str(value).split(":"))
@@ -174,18 +246,21 @@ def _grid_points(path, grid, frames):
     full_radius = _fraction(path, "grid.full_recompute_radius_fraction",
                             grid.get("full_recompute_radius_fraction", DEFAULT_RADIUS_FRACTION))
     samplers = list(dict.fromkeys(_list(path, "grid.samplers", grid.get("samplers", [DEFAULT_SAMPLER]), _sampler)))
-    first = samplers[0]  # the full and extreme families' sampler
+    lightings = _lightings(path, grid)
+    first = samplers[0]  # the full and extreme families' sampler (and the paper's lighting: Point's default)
     points = []
     for name, rule in estimators:
         for n in photons:
             if name == "impact-count":
-                points += [Point("accuracy", name, rule, n, 0.0, 0, False, frames, s) for s in samplers]
+                points += [Point("accuracy", name, rule, n, 0.0, 0, False, frames, s, *lighting)
+                           for s in samplers for lighting in lightings]
                 points.append(Point("full", name, rule, n, 0.0, 0, True, frames, first))
                 continue
             for s in samplers:
-                for r in radii:
-                    for k in (ks if name == "photon-map" else [0]):
-                        points.append(Point("accuracy", name, rule, n, r, k, False, frames, s))
+                for lighting in lightings:
+                    for r in radii:
+                        for k in (ks if name == "photon-map" else [0]):
+                            points.append(Point("accuracy", name, rule, n, r, k, False, frames, s, *lighting))
             k = DEFAULT_K if name == "photon-map" else 0
             points.append(Point("full", name, rule, n, full_radius, k, True, frames, first))
     return points, first

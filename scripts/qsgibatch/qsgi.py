@@ -59,6 +59,8 @@ class Qsgi:
 
     def animation_diagonal(self, scratch: str) -> float:
         """The diagonal of the whole animation's bounds, from a one-photon impact-count probe (the
-        radius grid is in fractions of it, as qsgi's default radius is)."""
-        timing = self.render(scratch, ["--estimator", "impact-count", "--photons", "1", "--frames", "0:0"], 1, 1)
+        radius grid is in fractions of it, as qsgi's default radius is). Direct light from the photons
+        and no gather, explicitly: whatever qsgi's default lighting, the probe stays a moment's work."""
+        timing = self.render(scratch, ["--estimator", "impact-count", "--photons", "1", "--frames", "0:0",
+                                       "--direct", "photons", "--gather", "0"], 1, 1)
         return float(timing["scene"]["animation_diagonal"])

@@ -2,8 +2,10 @@
 
 Either the committed PLY the config names (an independent renderer's), or one built once and
 cached in OUT/reference/: the per-vertex mean of several seeds of DETP `linear` at the smallest
-radius of the accuracy grid, each at the photon count the config states (reference_build). The
-recipe is written beside it (reference.json) and into every CSV row."""
+radius of the accuracy grid, each at the photon count the config states (reference_build), with
+all light from the photons and no gather (the paper's method, given explicitly: a cached
+reference keeps its meaning whatever qsgi's defaults become). The recipe is written beside it
+(reference.json) and into every CSV row."""
 import json
 import os
 
@@ -32,7 +34,8 @@ def prepare(config, qsgi, out: str, diagonal: float, threads: int) -> tuple:
     # A real folder, never a link planted at OUT/reference; its files written as every output is.
     output_folder.make_subfolder(out, "reference")
     options = ["--estimator", "detp", "--detp-boundary", "linear", "--photons", str(build["photons"]),
-               "--radius", repr(build["radius_fraction"] * diagonal), "--frames", "0:0"]
+               "--radius", repr(build["radius_fraction"] * diagonal), "--frames", "0:0", "--direct", "photons",
+               "--gather", "0"]
     runs = []
     for seed in build["seeds"]:
         run = os.path.join(folder, f"seed_{seed}")

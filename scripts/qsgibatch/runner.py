@@ -91,17 +91,33 @@ class MachineLoad:
         return max(0.0, ((busy1 - busy0) - (_own_cpu_seconds() - own0)) / wall)
 
 
+def _second_pass_s(frame: dict) -> float:
+    """The frame's exact direct light and final gather (--direct exact; 0 under photons, and absent
+    from the timing.json of a qsgi before them), which qsgi times apart from the estimation."""
+    return frame.get("direct_s", 0.0) + frame.get("gather_s", 0.0)
+
+
 def _frame_seconds(timing: dict) -> dict:
+    """A frame's time is the photon update + the density estimation + the second pass (exact
+    direct light and the gather): the whole solution of the frame, whatever its lighting."""
     frames = timing["frames"]
     first, later = frames[0], frames[1:]
-    per_frame = [f["photon_update_s"] + f["estimation_s"] for f in later]
+    per_frame = [f["photon_update_s"] + f["estimation_s"] + _second_pass_s(f) for f in later]
+
+    def median(key):
+        return statistics.median(f.get(key, 0.0) for f in later) if later else math.nan
+
     return {
-        "initial_s": first["photon_update_s"] + first["estimation_s"],
+        "initial_s": first["photon_update_s"] + first["estimation_s"] + _second_pass_s(first),
         "initial_photon_s": first["photon_update_s"],
         "initial_estimation_s": first["estimation_s"],
+        "initial_direct_s": first.get("direct_s", 0.0),
+        "initial_gather_s": first.get("gather_s", 0.0),
         "median_frame_s": statistics.median(per_frame) if per_frame else math.nan,
-        "median_photon_update_s": statistics.median(f["photon_update_s"] for f in later) if later else math.nan,
-        "median_estimation_s": statistics.median(f["estimation_s"] for f in later) if later else math.nan,
+        "median_photon_update_s": median("photon_update_s"),
+        "median_estimation_s": median("estimation_s"),
+        "median_direct_s": median("direct_s"),
+        "median_gather_s": median("gather_s"),
         "segments": first["segments"],
         "photons_missing_scene": first["photons_missing_scene"],
         "tracked_bytes_per_segment": (later[-1]["tracked_bytes"] / later[-1]["tracked_segments"]
@@ -132,12 +148,22 @@ def open_point_folder(out, name) -> int:
         os.close(points_fd)
 
 
+def _other_lighting(config: dict, point) -> bool:
+    """Whether a run's timing.json config had another lighting than the point's, or none: a qsgi
+    before the lighting options, whose folders `--resume` refuses (a fingerprinted option added
+    changes every earlier run's fingerprint)."""
+    if config.get("direct") != point.direct:
+        return True
+    return point.direct == "exact" and (config.get("gather") != point.gather or
+                                        config.get("direct_samples") != point.direct_samples)
+
+
 def _discard_other_sampler(point_fd, name, where, point):
-    """Removes the render folder `name` of the point's folder when another sampler (or qsgi before
-    samplers: no "sampler" in its timing.json) left it, which `qsgi render --resume` would refuse
-    as rendered from other settings. A link or file standing at `name` (`where`, its path) is
-    refused (FolderError) rather than followed, by qsgi's render or by the removal; the removal
-    (relative to the point's folder, fd-based) follows no link inside it."""
+    """Removes the render folder `name` of the point's folder when another sampler or lighting (or
+    qsgi before samplers or lightings: no "sampler" or "direct" in its timing.json) left it, which
+    `qsgi render --resume` would refuse as rendered from other settings. A link or file standing at
+    `name` (`where`, its path) is refused (FolderError) rather than followed, by qsgi's render or by
+    the removal; the removal (relative to the point's folder, fd-based) follows no link inside it."""
     run_fd = open_subfolder(point_fd, name, where, create=False)
     if run_fd is None:
         return
@@ -151,14 +177,28 @@ def _discard_other_sampler(point_fd, name, where, point):
     finally:
         os.close(run_fd)
     sampler, _, bounces = point.sampler.partition(":")
-    if config.get("sampler") != sampler or bounces and config.get("qmc_bounces") != int(bounces):
+    if config.get("sampler") != sampler or bounces and config.get("qmc_bounces") != int(bounces) or \
+            _other_lighting(config, point):
         shutil.rmtree(name, dir_fd=point_fd)  # refuses a link at `name`, follows none inside (Linux)
 
 
+def _lighting_columns(point) -> dict:
+    return {"direct": point.direct, "gather": point.gather,
+            "direct_samples": point.direct_samples if point.direct == "exact" else math.nan}
+
+
+def _same_lighting(result: dict, point) -> bool:
+    """Whether a result.json was rendered with the point's lighting. Results from before the
+    lighting columns name none: their light was the photons' alone (the name says so too)."""
+    if result.get("direct", "photons") != point.direct or result.get("gather", 0) != point.gather:
+        return False
+    return point.direct != "exact" or result.get("direct_samples") == point.direct_samples
+
+
 def finished(out, point):
-    """The point's result.json if there is one of this result version and the point's sampler, else
-    None (whatever its reference: Sweep.cached checks that too). A link or other non-file planted at
-    the name is no result (computing the point replaces it)."""
+    """The point's result.json if there is one of this result version and the point's sampler and
+    lighting, else None (whatever its reference: Sweep.cached checks that too). A link or other
+    non-file planted at the name is no result (computing the point replaces it)."""
     path = os.path.join(out, "points", point.name, "result.json")
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
@@ -170,7 +210,8 @@ def finished(out, point):
         if not stat.S_ISREG(os.fstat(fd).st_mode):
             return None
         result = json.load(f)
-    same = result.get("result_version") == RESULT_VERSION and result.get("sampler") == point.sampler
+    same = result.get("result_version") == RESULT_VERSION and result.get("sampler") == point.sampler \
+        and _same_lighting(result, point)
     return result if same else None
 
 
@@ -195,6 +236,7 @@ class Sweep:
     def run(self, point) -> dict:
         result = self.cached(point)
         if result is not None:
+            result.update(_lighting_columns(point))  # a result from before the columns: its point's (photons)
             return result
         self.occupancy.start(point.name)
         load = MachineLoad()
@@ -205,7 +247,7 @@ class Sweep:
             overlapped = self.occupancy.finish(point.name)
         other = load.other_cores()
         result.update(shared_cores=overlapped or other > OTHER_CORES_SHARED, other_cores=other,
-                      wall_s=time.monotonic() - began)
+                      wall_s=time.monotonic() - began, **_lighting_columns(point))
         with self._computed_lock:
             self.computed += 1
         folder_fd = open_point_folder(self.out, point.name)
@@ -245,6 +287,7 @@ class Sweep:
         bounces = timing["config"].get("qmc_bounces")  # qsgi's K (its default for plain "sobol"); null: random
         result = {"result_version": RESULT_VERSION, "family": point.family, "estimator": point.label,
                   "sampler": point.sampler, "qmc_bounces": math.nan if bounces is None else bounces,
+                  **_lighting_columns(point),
                   "photons": point.photons, "radius_fraction": point.radius_fraction,
                   "radius": point.radius_fraction * self.diagonal if point.radius_fraction else math.nan,
                   "k": point.k or math.nan, "full_recompute": point.full_recompute, "frames": point.frames,

@@ -8,17 +8,19 @@ from .output_folder import open_folder, write_file
 
 COLUMNS = [
     # parameters
-    "family", "estimator", "sampler", "qmc_bounces", "photons", "radius_fraction", "radius", "k", "full_recompute", "frames", "seed",
-    "noise_seed",
+    "family", "estimator", "sampler", "qmc_bounces", "direct", "gather", "direct_samples", "photons", "radius_fraction",
+    "radius", "k", "full_recompute", "frames", "seed", "noise_seed",
     # error against the reference at frame 0 (relative to the reference's mean; bias signed)
     "rms_all", "bias_all", "rms_edge", "bias_edge", "rms_near_edge", "bias_near_edge", "rms_interior",
     "bias_interior", "noise", "edge_radius", "vertices_all", "vertices_edge", "vertices_near_edge",
     "vertices_interior",
     # stability
     "nan_count", "inf_count",
-    # time (seconds; frame = photon update + density estimation, from timing.json)
-    "initial_s", "initial_photon_s", "initial_estimation_s", "median_frame_s", "median_photon_update_s",
-    "median_estimation_s", "wall_s",
+    # time (seconds, from timing.json; frame = photon update + density estimation + the second pass:
+    # exact direct light and the gather, 0 under direct light from the photons)
+    "initial_s", "initial_photon_s", "initial_estimation_s", "initial_direct_s", "initial_gather_s",
+    "median_frame_s", "median_photon_update_s", "median_estimation_s", "median_direct_s", "median_gather_s",
+    "wall_s",
     # work
     "segments", "photons_missing_scene", "tracked_bytes_per_segment",
     # how the figures were taken

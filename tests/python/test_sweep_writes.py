@@ -213,8 +213,8 @@ class PlantedLinksTest(unittest.TestCase):
     def test_a_run_of_the_same_sampler_is_kept(self):
         run = os.path.join(self.out, "points", POINT.name, "run")
         os.makedirs(run)
-        with open(os.path.join(run, "timing.json"), "w") as f:
-            json.dump({"config": {"sampler": "sobol"}}, f)
+        with open(os.path.join(run, "timing.json"), "w") as f:  # and the same lighting (POINT's: the paper's)
+            json.dump({"config": {"sampler": "sobol", "direct": "photons", "gather": None}}, f)
         with self.assertRaises(Stop):
             self.make_sweep(FakeQsgi())._compute(POINT)
         self.assertEqual(os.listdir(run), ["timing.json"])
