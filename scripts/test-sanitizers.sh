@@ -26,6 +26,6 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cd build-asan
 statistical='DetpBoundary\.(InsideCorner|OpenEdgeOfAFloor|OutsideOfASphere|FloorBesideABox|CeilingAboveALightPanel)'
 statistical+='|Estimators\.(PaperRuleMatches|PlaneUnderPointLight|ClosedSphereGives|DetpAndPhotonMapAreIndependentOfTessellation)'
-statistical+='|Incremental\.(NoDriftOverTenThousandFrames|RememberedCrossingsLeaveNoTraceAfterAThousandFrames)|Sweep\.TinyGrid|ReferenceAccuracy'
+statistical+='|Incremental\.(NoDriftOverTenThousandFrames|RememberedCrossingsLeaveNoTraceAfterAThousandFrames)|Sweep\.TinyGrid|ReferenceAccuracy|GatherAccuracy|FinalGather\.ClosedSphere'
 statistical+='|Sobol\.AgreesWith'
 ctest --output-on-failure -j 2 -E "$statistical|ValidatorCorpus" "$@"
