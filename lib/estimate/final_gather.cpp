@@ -14,6 +14,31 @@ namespace qsgi {
 namespace {
 constexpr float kBarycentricScale = 65535.0f;
 uint16_t quantised(float b) { return uint16_t(std::lround(std::clamp(b, 0.0f, 1.0f) * kBarycentricScale)); }
+
+// Octahedral encoding of a unit direction (Meyer et al. 2010), 16 bits a coordinate, and its
+// decoding: the decoded direction is the one cast, whenever the ray is cast.
+float signNotZero(float x) { return x < 0 ? -1.0f : 1.0f; }
+void encodeOctahedral(const Vec3f& d, uint16_t& u, uint16_t& v) {
+    const float l1 = std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z);
+    float px = d.x / l1, py = d.y / l1;
+    if (d.z < 0) {
+        const float qx = (1 - std::fabs(py)) * signNotZero(px), qy = (1 - std::fabs(px)) * signNotZero(py);
+        px = qx;
+        py = qy;
+    }
+    u = uint16_t(std::lround((std::clamp(px, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f));
+    v = uint16_t(std::lround((std::clamp(py, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f));
+}
+Vec3f decodeOctahedral(uint16_t u, uint16_t v) {
+    float px = float(u) / 65535.0f * 2 - 1, py = float(v) / 65535.0f * 2 - 1;
+    const float z = 1 - std::fabs(px) - std::fabs(py);
+    if (z < 0) {
+        const float qx = (1 - std::fabs(py)) * signNotZero(px), qy = (1 - std::fabs(px)) * signNotZero(py);
+        px = qx;
+        py = qy;
+    }
+    return normalize(Vec3f(px, py, z));
+}
 }  // namespace
 
 // A vertex's gather directions: its frame and its numbers, made once for all its rays (the scan
@@ -62,7 +87,13 @@ void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const Vert
         return;
     }
     const Directions direction(starts, v, seed_);
-    for (uint32_t j = 0; j < rays_; ++j) hits[j] = castRay(bvh, frontNormals, starts.point(v), direction(j));
+    for (uint32_t j = 0; j < rays_; ++j) {
+        uint16_t u, w;
+        encodeOctahedral(direction(j), u, w);
+        hits[j] = castRay(bvh, frontNormals, starts.point(v), decodeOctahedral(u, w));
+        hits[j].octU = u;
+        hits[j].octV = w;
+    }
 }
 
 void FinalGather::castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
@@ -110,16 +141,18 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
                 }
                 if (ahead.empty()) continue;
                 GatherHit* hits = &hits_[size_t(v) * rays_];
-                const Directions direction(starts, v, seed_);
                 for (uint32_t j = 0; j < rays_; ++j) {
-                    const Vec3f d = direction(j);
+                    const Vec3f d = decodeOctahedral(hits[j].octU, hits[j].octV);
                     bool meets = false;
                     for (const Bounds3f* box : ahead) {
                         double t0 = 0, t1 = double(hits[j].t);
                         if ((meets = box->clip(origin, d, t0, t1))) break;
                     }
                     if (!meets) continue;
+                    const uint16_t u = hits[j].octU, w = hits[j].octV;
                     hits[j] = castRay(bvh, frontNormals, origin, d);
+                    hits[j].octU = u;
+                    hits[j].octV = w;
                     ++count;
                 }
             }
