@@ -100,7 +100,7 @@ TEST(Cli, ProgressIsDrawnOnATerminalOnlyAndEveryRunEndsWithASummary) {
 TEST(Cli, OutputBytesAreIdenticalForOneAndTwoThreadsAndRepeatedRuns) {
     const fs::path dir = testScratchDir("determinism");
     const std::string common = cornell() + " --animation " + cornellAnimation() +
-                               " --frames 0:2 --photons 60000 --seed 3 --width 160 --height 120 --spp 2 --png";
+                               " --frames 0:2 --photons 60000 --seed 3 --width 160 --height 120 --spp 2 --png" + kCheapSecondPass;
     for (const char* run : {"t1", "t2", "t2again"}) {
         const std::string threads = std::string(run) == "t1" ? "1" : "2";
         const CommandResult r = runQsgi("render " + common + " --threads " + threads + " --out " + (fs::path(dir) / run).string());
@@ -122,7 +122,7 @@ TEST(Cli, OutputBytesAreIdenticalForOneAndTwoThreadsAndRepeatedRuns) {
 TEST(Cli, RenderWritesOnePlyPerFrameAndATimingLog) {
     const fs::path dir = testScratchDir("frames");
     const CommandResult r = runQsgi("render " + cornell() + " --animation " + cornellAnimation() +
-                                    " --frames 5:7 --photons 20000 --quiet --out " + dir.string());
+                                    " --frames 5:7 --photons 20000 --quiet" + kCheapSecondPass + " --out " + dir.string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_TRUE(r.output.empty()) << r.output;
     for (int f : {5, 6, 7}) EXPECT_TRUE(fs::exists(dir / ("frame_000" + std::to_string(f) + ".ply")));
@@ -248,7 +248,7 @@ TEST(Cli, EveryEstimatorRendersEndToEnd) {
     for (const char* estimator : {"detp", "photon-map", "impact-count"}) {
         const fs::path out = testScratchDir(std::string("estimator_") + estimator);
         const CommandResult r = runQsgi("render " + cornell() + " --estimator " + estimator +
-                                        " --radius 0.07 --k 30 --photons 20000 --width 80 --height 60 --out " + out.string());
+                                        " --radius 0.07 --k 30 --photons 20000 --width 80 --height 60" + kCheapSecondPass + " --out " + out.string());
         ASSERT_EQ(r.exitCode, 0) << estimator << "\n" << r.output;
         EXPECT_TRUE(fs::exists(out / "frame_0000.ply"));
         const std::string info = readFileBytes(out / "frame_0000.exr");
@@ -285,10 +285,10 @@ TEST(Cli, EveryEstimatorRendersEndToEnd) {
 // data/cornell (timing.json aside: it records how each frame was computed).
 TEST(Cli, IncrementalRunWritesTheBytesOfAFullRecomputation) {
     const fs::path dir = testScratchDir("incremental");
-    // With exact direct light and a gather of 64 rays (a quarter of the defaults': the update's
-    // work is the same kind, re-cast rays and kept hits).
+    // With exact direct light and a gather (fewer rays than the defaults': the update's work is
+    // the same kind, re-cast rays and kept hits).
     const std::string common = cornell() + " --animation " + cornellAnimation() +
-                               " --frames 0:3 --photons 30000 --gather 64 --direct-samples 16 --quiet --no-exr";
+                               " --frames 0:3 --photons 30000 --quiet --no-exr" + kCheapSecondPass;
     for (const char* estimator : {"impact-count", "photon-map", "detp --detp-boundary clip", "detp --detp-boundary linear",
                                   "detp --detp-boundary paper"}) {
         SCOPED_TRACE(estimator);
@@ -314,7 +314,7 @@ TEST(Cli, IncrementalRunWritesTheBytesOfAFullRecomputation) {
 TEST(Cli, FrameRangeStartingMidAnimationWritesTheSequentialBytes) {
     const fs::path dir = testScratchDir("midrange");
     const std::string common = cornell() + " --animation " + cornellAnimation() +
-                               " --photons 30000 --estimator detp --width 96 --height 72 --png --quiet";
+                               " --photons 30000 --estimator detp --width 96 --height 72 --png --quiet" + kCheapSecondPass;
     ASSERT_EQ(runQsgi("render " + common + " --frames 0:5 --out " + (dir / "all").string()).exitCode, 0);
     ASSERT_EQ(runQsgi("render " + common + " --frames 3:5 --out " + (dir / "late").string()).exitCode, 0);
     for (int f = 3; f <= 5; ++f)

@@ -36,7 +36,7 @@ TEST(GltfOut, FramesPassTheKhronosValidatorAndCarryThePlysGeometryAndRadiance) {
     const fs::path out = testScratchDir("gltf-out");
     const std::string common = (sourceDir() / "data/cornell/cornell.gltf").string() + " --animation " +
                                (sourceDir() / "data/cornell/animation.json").string() +
-                               " --frames 0:2 --photons 20000 --no-exr --gltf-out --quiet";
+                               " --frames 0:2 --photons 20000 --no-exr --gltf-out --quiet" + kCheapSecondPass;
     const CommandResult r = runQsgi("render " + common + " --threads 2 --out " + (out / "a").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
 

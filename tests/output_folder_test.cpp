@@ -21,7 +21,7 @@ namespace {
 std::string cornellRender(const std::string& frames, const std::string& options, bool quiet = true) {
     const fs::path cornell = sourceDir() / "data" / "cornell";
     return "render " + (cornell / "cornell.gltf").string() + " --animation " + (cornell / "animation.json").string() +
-           " --frames " + frames + " --width 20 --height 15 " + (quiet ? "--quiet " : "") + options;
+           " --frames " + frames + " --width 20 --height 15 " + (quiet ? "--quiet " : "") + options + kCheapSecondPass;
 }
 
 std::set<std::string> namesIn(const fs::path& dir) {

@@ -17,12 +17,11 @@ namespace fs = std::filesystem;
 namespace {
 
 // 30 frames of data/cornell with PLY, EXR and PNG, exact direct light and a final gather (fewer
-// rays than the defaults' 256: what resuming must reproduce is the same, at an eighth of the
-// gather's cost): about 3 s on 2 cores.
+// rays than the defaults': what resuming must reproduce is the same): about 2 s on 2 cores.
 std::string renderArguments() {
     const fs::path cornell = sourceDir() / "data" / "cornell";
     return "render " + (cornell / "cornell.gltf").string() + " --animation " + (cornell / "animation.json").string() +
-           " --frames 0:29 --photons 100000 --gather 32 --direct-samples 8 --width 80 --height 60 --png --quiet";
+           " --frames 0:29 --photons 100000 --width 80 --height 60 --png --quiet" + kCheapSecondPass;
 }
 
 struct SignalledRun {
@@ -130,13 +129,13 @@ TEST(Resume, SigintAndSigtermStopAfterTheCurrentFrameWithAConsistentFolder) {
 TEST(Resume, FolderFromOtherInputsIsRefusedAndLeftUntouched) {
     const fs::path dir = testScratchDir("resume-refuse");
     const fs::path out = dir / "out";
-    const std::string few = " --frames 0:2 --photons 20000 --gather 32 --direct-samples 8 --width 40 --height 30 --estimator detp --quiet";
+    const std::string few = " --frames 0:2 --photons 20000 --width 40 --height 30 --estimator detp --quiet" + std::string(kCheapSecondPass);
     const fs::path cornell = sourceDir() / "data" / "cornell";
     const std::string scene = (cornell / "cornell.gltf").string() + " --animation " + (cornell / "animation.json").string();
     ASSERT_EQ(runQsgi("render " + scene + few + " --out " + out.string()).exitCode, 0);
     const std::string before = readFileBytes(out / "frame_0001.ply") + readFileBytes(out / "timing.json");
     for (const char* change : {" --seed 7", " --estimator photon-map", " --radius 0.02", " --spp 2", " --png",
-                               " --sampler random", " --qmc-bounces 1", " --gather 16", " --direct-samples 4",
+                               " --sampler random", " --qmc-bounces 1", " --gather 8", " --direct-samples 2",
                                " --direct photons --gather 0"}) {
         SCOPED_TRACE(change);
         const CommandResult r = runQsgi("render " + scene + few + change + " --resume --out " + out.string());

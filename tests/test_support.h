@@ -29,6 +29,12 @@ inline constexpr bool kSanitized = false;
 inline constexpr bool kSanitized = false;
 #endif
 
+// For tests whose subject is not the light (files, folders, resuming, the CLI): the second pass
+// stays on (exact direct light and a gather, the defaults' kind of render), at a sixteenth of the
+// defaults' gather rays and direct samples, which a frame of data/cornell otherwise spends most of
+// its time on.
+inline constexpr const char* kCheapSecondPass = " --gather 16 --direct-samples 4";
+
 std::filesystem::path sourceDir();  // the repository root
 std::filesystem::path sharedDir();  // ../shared beside the repository (may be absent)
 std::string testScratchDir(const std::string& name);
