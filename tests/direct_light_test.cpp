@@ -20,18 +20,7 @@ using namespace qsgi;
 
 namespace {
 
-// The scene's BVH, its disc regions (the rays' start points) and the starts as the second pass
-// reads them.
-struct Rig {
-    EmbreeDevice device;
-    SceneBvh bvh;
-    DiscRegions regions;
-    VertexStarts starts;
-    Rig(const Scene& scene, float radius = 0.05f) : bvh(device, scene), regions(radius, false) {
-        regions.computeAll(scene, bvh);
-        starts.refreshAll(scene, regions);
-    }
-};
+using Rig = SecondPassRig;
 
 std::vector<Vec3f> directLight(const Scene& scene, const Rig& rig, uint32_t samples, uint64_t seed = 7) {
     DirectLight direct(samples, seed);

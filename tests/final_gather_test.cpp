@@ -24,16 +24,7 @@ using namespace qsgi;
 
 namespace {
 
-struct Rig {
-    EmbreeDevice device;
-    SceneBvh bvh;
-    DiscRegions regions;
-    VertexStarts starts;
-    Rig(const Scene& scene, float radius = 0.05f) : bvh(device, scene), regions(radius, false) {
-        regions.computeAll(scene, bvh);
-        starts.refreshAll(scene, regions);
-    }
-};
+using Rig = SecondPassRig;
 
 double seconds(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();

@@ -17,7 +17,8 @@
 //    at 10^6 photons, and from 10^5 to 10^6 photons at M = 256 — each fall required to exceed
 //    minus twice the seed-to-seed spread of the two errors (a region whose error has reached the
 //    reference's own noise may stay level, not rise).
-// QSGI_REFERENCE_SEED=2 runs the bounds' cases at seed 2, to measure the spread they rest on.
+// QSGI_REFERENCE_SEED=2 runs the bounds' cases at seed 2, to measure the spread they rest on. The
+// sanitizer run (scripts/test-sanitizers.sh) leaves these statistical tests out, as ReferenceAccuracy.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -110,12 +111,11 @@ TEST_P(GatherAccuracy, EveryEstimatorWithTheGatherStaysWithinItsMeasuredError) {
     const VertexRadiosityPly reference = readReference(c.reference);
     const char* seedText = std::getenv("QSGI_REFERENCE_SEED");
     const uint64_t seed = seedText ? std::strtoull(seedText, nullptr, 10) : 1;
-    const uint64_t photons = kSanitized ? 100000 : 1000000;
+    const uint64_t photons = 1000000;
     for (int i = 0; i < 4; ++i) {
         const Bound& b = c.bounds[i];
         const Errors e = measure(c.scene, reference, kEstimators[i].first, kEstimators[i].second, photons, 256, seed);
         print(c.scene, b.estimator, seed, e);
-        if (kSanitized) continue;  // the bounds are for 10^6 photons; under ASan the question is memory
         EXPECT_LE(e.report.all.relativeRms, b.allRms) << b.estimator;
         EXPECT_LE(e.report.edge.relativeRms, b.edgeRms) << b.estimator;
         if (e.report.nearEdge.vertices > 0) {
@@ -159,7 +159,6 @@ INSTANTIATE_TEST_SUITE_P(
 // The error falls with M and with the photons (impact count, the default estimator), region by
 // region, within twice the seed-to-seed spread.
 TEST(GatherAccuracy, ErrorFallsWithGatherRaysAndPhotonsInEveryRegion) {
-    if (kSanitized) GTEST_SKIP() << "statistics at 10^6 photons; under ASan the question is memory";
     for (const auto& [scene, file] : {std::pair<const char*, const char*>{"data/cornell/cornell.gltf", "cornell_f0000.ply"},
                                       {"tests/scenes/ceiling_panel/ceiling_panel.gltf", "ceiling_panel_f0000.ply"}}) {
         const VertexRadiosityPly reference = readReference(file);

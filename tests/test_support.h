@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "estimate/estimator.h"
+#include "estimate/vertex_starts.h"
 #include "scene/scene.h"
 #include "trace/photon_numbers.h"
 #include "trace/ray_cache.h"
+#include "trace/scene_bvh.h"
 
 // Whether this build runs under AddressSanitizer (scripts/test-sanitizers.sh), where every
 // instruction costs several times more. There the question is memory safety, not statistics: a
@@ -129,3 +131,16 @@ qsgi::Scene floorUnderEmitter(int cells, qsgi::Vec3f centre, float halfX, float 
 qsgi::Scene plateUnderSheet(float plateHalf, int plateCells, float sheetHalf, int sheetCells, float gap,
                             bool sheetFacesUp, qsgi::Vec3f albedo);
 }  // namespace testscenes
+
+// What the second pass's tests read (tests/direct_light_test.cpp, tests/final_gather_test.cpp): the
+// scene's BVH, its disc regions (the rays' start points) and the starts as the second pass reads them.
+struct SecondPassRig {
+    qsgi::EmbreeDevice device;
+    qsgi::SceneBvh bvh;
+    qsgi::DiscRegions regions;
+    qsgi::VertexStarts starts;
+    SecondPassRig(const qsgi::Scene& scene, float radius = 0.05f) : bvh(device, scene), regions(radius, false) {
+        regions.computeAll(scene, bvh);
+        starts.refreshAll(scene, regions);
+    }
+};
