@@ -57,6 +57,9 @@ def cases(quick):
         ("cornell, block flies, turns, pauses", cornell[:1] + ["--animation", os.path.join(SCENES, "flying-block.json"),
                                                                 "--estimator", "detp", "--radius", "0.05",
                                                                 "--photons", photons, "--frames", "0:4" if quick else "0:24"]),
+        ("sweeping panel (fallback)", [os.path.join(SCENES, "sweeping-panel", "panel.gltf"), "--animation",
+                                       os.path.join(SCENES, "sweeping-panel", "animation.json"), "--estimator", "detp",
+                                       "--radius", "0.05", "--photons", photons, "--frames", "0:4" if quick else "0:12"]),
     ]
     # The renderer's defaults: exact direct light and the final gather over the photon solution
     # (docs/design.md §5.1), whose update re-casts only the rays a move can change.

@@ -6,7 +6,11 @@ deterministic bytes):
   waves all of it (every vertex moves every frame), animated 0 -> 1 over 2 s: the case where
   updating costs more than recomputing, so frames fall back to scratch.
 - flying-block.json: a transform file for data/cornell in which the block flies across the box,
-  turns, lifts and pauses (a large mover: about a quarter of the paths change per frame).
+  turns, lifts and pauses (a large mover: about a quarter of the paths change per frame), where
+  updating must win.
+- sweeping-panel/: data/cornell's box with a wall-sized panel (1.8 x 1.8 m, 2 cm thick) that sweeps
+  from the back wall to the open front, 8 cm a frame: nearly every path meets it, so every frame
+  should be computed from scratch (the fallback's case, issue 34).
 
 Run: python3 scripts/make_bench_scenes.py OUT_DIR
 """
@@ -17,7 +21,7 @@ import struct
 import sys
 
 sys.path.insert(0, os.path.dirname(__file__))
-from make_cornell import GltfBuilder, grid  # noqa: E402
+from make_cornell import GltfBuilder, box_faces, build, grid  # noqa: E402
 
 CELLS = 80
 
@@ -74,11 +78,30 @@ def flying_block(folder):
         out.write("\n")
 
 
+PANEL_FRAMES = 24
+
+
+def sweeping_panel(folder):
+    def add_panel(g, white):
+        p, n, i = box_faces([0.9, 0.9, 0.01], 24)
+        g.node({"name": "Panel", "mesh": g.mesh("Panel", p, n, i, white), "translation": [0, 0.05, -0.9]})
+
+    out = os.path.join(folder, "sweeping-panel")
+    os.makedirs(out, exist_ok=True)
+    build(out, "panel", wall_cells=64, light="panel", animate=False, add_nodes=add_panel)
+    frames = [{"frame": f, "nodes": {"Panel": {"translation": [0, 0.05, round(-0.9 + 1.8 * f / (PANEL_FRAMES - 1), 6)]}}}
+              for f in range(PANEL_FRAMES)]
+    with open(os.path.join(out, "animation.json"), "w") as f:
+        json.dump({"format": "qsgi-animation", "version": 1, "fps": 24, "frames": frames}, f, indent=1)
+        f.write("\n")
+
+
 def main():
     folder = sys.argv[1] if len(sys.argv) > 1 else "out/bench/scenes"
     os.makedirs(folder, exist_ok=True)
     sheet(folder)
     flying_block(folder)
+    sweeping_panel(folder)
 
 
 if __name__ == "__main__":

@@ -160,7 +160,9 @@ def main():
         build(folder, "cornell", wall_cells=WALL_CELLS, light="panel", animate=True)
 
 
-def build(folder, stem, wall_cells, light, animate):
+def build(folder, stem, wall_cells, light, animate, add_nodes=None):
+    """The box; add_nodes(builder, white), if given, adds nodes of its own before the camera
+    (scripts/make_bench_scenes.py adds its movers so)."""
     g = GltfBuilder()
     white = g.material("White", WHITE)
     red = g.material("Red", RED)
@@ -201,6 +203,8 @@ def build(folder, stem, wall_cells, light, animate):
         g.node({"name": "LightHousing", "mesh": g.mesh("LightHousing", positions, normals, indices, white)})
     p, n, i = box_faces([0.25, 0.3, 0.25], BLOCK_CELLS)
     g.node({"name": "Block", "mesh": g.mesh("Block", p, n, i, block), "translation": [-0.5, 0, 0.1]})
+    if add_nodes:
+        add_nodes(g, white)
     g.doc["cameras"].append({"name": "Front", "type": "perspective",
                              "perspective": {"yfov": 0.7, "aspectRatio": 4 / 3, "znear": 0.05}})
     g.node({"name": "Camera", "camera": 0, "translation": [0, 1, 4.0]})

@@ -73,10 +73,11 @@ public:
         stats.verticesUpdated = scene_.vertexCount();
     }
 
-    bool canUpdate(std::string& why) const override {
-        const bool flann = settings_.useIndex && settings_.detpIndex == DetpIndex::Flann;
-        why = flann ? "estimator" : "";
-        return !flann;
+    bool canUpdate() const override { return !(settings_.useIndex && settings_.detpIndex == DetpIndex::Flann); }
+    // The paper's rule reads no disc regions: only a moved vertex counts differently.
+    std::vector<uint32_t> verticesToRecompute(const std::vector<uint32_t>& changed,
+                                              const std::vector<uint8_t>& vertexMoved) const override {
+        return regions_ ? changed : movedOnly(changed, vertexMoved);
     }
     float reach() const override { return settings_.radius; }
 

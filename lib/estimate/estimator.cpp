@@ -8,6 +8,13 @@ bool needsDiscRegions(const EstimatorSettings& s) {
     return s.kind != EstimatorKind::ImpactCount && s.boundary != DetpBoundary::Paper;
 }
 
+std::vector<uint32_t> movedOnly(const std::vector<uint32_t>& vertices, const std::vector<uint8_t>& vertexMoved) {
+    std::vector<uint32_t> moved;
+    for (uint32_t v : vertices)
+        if (vertexMoved[v]) moved.push_back(v);
+    return moved;
+}
+
 DiscRegions makeDiscRegions(const EstimatorSettings& s) { return DiscRegions(s.radius, s.kind == EstimatorKind::PhotonMap); }
 
 std::unique_ptr<Estimator> Estimator::create(const EstimatorSettings& settings, const EstimatorContext& context) {

@@ -42,6 +42,9 @@ struct EstimatorSettings {
 
 // Whether the estimator needs disc regions, and whether with the photon map's coverage.
 bool needsDiscRegions(const EstimatorSettings& settings);
+// The moved ones among `vertices` (in their order): what an estimator that reads no disc regions
+// recomputes.
+std::vector<uint32_t> movedOnly(const std::vector<uint32_t>& vertices, const std::vector<uint8_t>& vertexMoved);
 DiscRegions makeDiscRegions(const EstimatorSettings& settings);
 inline const char* estimatorName(EstimatorKind kind) { return nameOf(kEstimatorNames, kind); }
 
@@ -85,10 +88,16 @@ public:
     virtual void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) = 0;
 
     // Incremental updates. Whether this estimator has one (otherwise every frame is solved from
-    // scratch, and `why` names the reason for timing.json).
-    virtual bool canUpdate(std::string& why) const {
-        why.clear();
-        return true;
+    // scratch, and timing.json says "estimator").
+    virtual bool canUpdate() const { return true; }
+    // Of the vertices a pose change left different (moved, or their disc regions may now decide
+    // differently: VertexGeometry::update; sorted), those this estimator recomputes from scratch;
+    // every other vertex is updated from the segments that changed. All of them by default; an
+    // estimator that reads no disc regions recomputes the moved ones only.
+    virtual std::vector<uint32_t> verticesToRecompute(const std::vector<uint32_t>& changed,
+                                                      const std::vector<uint8_t>& vertexMoved) const {
+        (void)vertexMoved;
+        return changed;
     }
     // How far past its impact a segment counts (DETP: r; the others count impacts only): the
     // envelope's margin and the tracked-segment grid follow from it. Paths that never meet the

@@ -24,6 +24,11 @@ public:
     }
 
     float reach() const override { return 0.0f; }  // an impact counts where it lands
+    // Reads no disc regions: only a moved vertex counts differently.
+    std::vector<uint32_t> verticesToRecompute(const std::vector<uint32_t>& changed,
+                                              const std::vector<uint8_t>& vertexMoved) const override {
+        return movedOnly(changed, vertexMoved);
+    }
     void prepareUpdates(const TrackedPaths&, FrameTiming&) override {}
 
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {

@@ -26,10 +26,11 @@ void returnFreedMemory() {
 
 namespace {
 
-// Photons are aimed at what the estimator can count: DETP's discs reach r beside the geometry
-// (segments passing an open edge cross them); the other estimators count impacts only.
-TraceSettings aimedAtEstimator(TraceSettings trace, const EstimatorSettings& e) {
-    trace.aim.margin = e.kind == EstimatorKind::Detp ? e.radius : 0.0f;
+// Photons are aimed at what the estimator can count: as far past the geometry as a segment
+// counts (Estimator::reach: DETP's discs reach r beside it, so segments passing an open edge
+// cross them; the other estimators count impacts only).
+TraceSettings aimedAt(TraceSettings trace, float reach) {
+    trace.aim.margin = reach;
     return trace;
 }
 
@@ -48,22 +49,21 @@ constexpr double kWorthUpdatingBelow = 0.8;
 FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings)
     : scene_(scene), settings_(settings),
       work_([this](const char* name, uint64_t done, uint64_t total) { stage(name, done, total); }),
-      bvh_(device, scene), tracer_(scene, bvh_, aimedAtEstimator(settings.trace, settings.estimator)) {
-    // The second pass's rays start where the disc regions say, whatever the estimator (docs/design.md
-    // §5.1): impact count and DETP's paper rule, which read no regions, get their start points only.
-    const bool exactDirect = settings_.lighting.exactDirect();
-    if (needsDiscRegions(settings_.estimator)) regions_.emplace(makeDiscRegions(settings_.estimator));
-    else if (exactDirect) regions_.emplace(DiscRegions::startsOnly(settings_.estimator.radius));
-    const DiscRegions* estimatorRegions = needsDiscRegions(settings_.estimator) ? regions() : nullptr;
-    estimator_ = Estimator::create(settings_.estimator, EstimatorContext{scene_, bvh_, device, estimatorRegions,
-                                                                         !settings_.fullRecompute, &work_, exactDirect});
-    if (exactDirect) lighting_.emplace(settings_.lighting, settings_.trace.seed);
+      bvh_(device, scene),
+      // The second pass's rays start where the disc regions say, whatever the estimator
+      // (docs/design.md §5.1).
+      geometry_(settings.estimator, settings.lighting.exactDirect()),
+      estimator_(Estimator::create(settings.estimator,
+                                   EstimatorContext{scene_, bvh_, device, geometry_.estimatorRegions(), !settings.fullRecompute,
+                                                    &work_, settings.lighting.exactDirect()})),
+      tracer_(scene, bvh_, aimedAt(settings.trace, estimator_->reach())) {
+    if (settings_.lighting.exactDirect()) lighting_.emplace(settings_.lighting, settings_.trace.seed);
 }
 
 FrameSolver::~FrameSolver() = default;
 
 void FrameSolver::reset() {
-    solved_ = regionsValid_ = false;
+    mode_ = Mode::Fresh;
     if (lighting_) lighting_->reset();
     tracked_.reset();
     lastCache_.reset();
@@ -114,38 +114,11 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     return change;
 }
 
-std::vector<uint32_t> FrameSolver::touchedVertices(const PoseChange& change) const {
-    if (regions_) return regions_->touchedBy(scene_, change.bounds, change.vertexMoved);
-    std::vector<uint32_t> moved;
-    for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
-        if (change.vertexMoved[v]) moved.push_back(v);
-    return moved;
-}
-
-std::vector<uint32_t> FrameSolver::updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats) {
-    if (!regions_) {
-        regionsValid_ = true;  // nothing to compute
-        return touched ? *touched : std::vector<uint32_t>();
-    }
-    std::vector<uint32_t> redecided;
-    Stopwatch clock;
-    if (!regionsValid_) {
-        regions_->computeAll(scene_, bvh_, &work_);
-        stats.discRegionsUpdated = scene_.vertexCount();
-        regionsValid_ = true;
-    } else if (touched) {
-        redecided = regions_->recompute(scene_, bvh_, *touched, &work_);
-        stats.discRegionsUpdated = touched->size();
-    }
-    stats.discRegionsSeconds = clock.seconds();
-    return redecided;
-}
-
-bool FrameSolver::changeTooLarge(const PoseChange& change, size_t touched) const {
+bool FrameSolver::changeTooLarge(const PoseChange& change, size_t recomputed) const {
     // Segments that impacted a moved triangle: listed per triangle once tracking, counted in the
     // last frame's cache before (a scan, far cheaper than either way of computing the frame).
     uint64_t listed = 0, segments = 0;
-    if (tracked_) {
+    if (mode_ == Mode::Tracking) {
         listed = tracked_->segmentsListedOn(change.movedTriangles);
         segments = foldedSegments_ + tracked_->trackedSegments();
     } else {
@@ -160,73 +133,62 @@ bool FrameSolver::changeTooLarge(const PoseChange& change, size_t touched) const
         listed = onMoved.load();
     }
     const double segmentShare = double(listed) * kSegmentsPerListedImpact * kRemoveAndAdd / double(std::max<uint64_t>(segments, 1));
-    const double vertexShare = double(touched) * kRecomputedVertex / double(std::max<size_t>(scene_.vertexCount(), 1));
+    const double vertexShare = double(recomputed) * kRecomputedVertex / double(std::max<size_t>(scene_.vertexCount(), 1));
     return segmentShare + vertexShare > kWorthUpdatingBelow;
+}
+
+FromScratchReason FrameSolver::fromScratchReason(const PoseChange& change, size_t recomputed) const {
+    if (settings_.fullRecompute) return FromScratchReason::FullRecompute;
+    if (!estimator_->canUpdate()) return FromScratchReason::EstimatorHasNoUpdate;
+    if (mode_ == Mode::FromScratch && !lastCache_) return FromScratchReason::NoKeptState;
+    if (change.any && !settings_.alwaysUpdate && changeTooLarge(change, recomputed)) return FromScratchReason::ChangeTooLarge;
+    return FromScratchReason::None;
 }
 
 const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats, bool updateFollows) {
     stats = FrameTiming();
     const PoseChange change = pose(target);
     Stopwatch clock;
-    const bool firstTime = !regionsValid_;
-    std::vector<uint32_t> touched = !firstTime && change.any ? touchedVertices(change) : std::vector<uint32_t>();
-    // The estimators recompute the moved vertices and those whose disc now decides crossings
-    // differently; the regions' conservative test touched more (most keep their disc).
     work_.start("regions", 0);
-    std::vector<uint32_t> redecided = updateRegions(firstTime ? nullptr : &touched, stats);
-    for (uint32_t v : touched)
-        if (change.vertexMoved[v]) redecided.push_back(v);
-    std::sort(redecided.begin(), redecided.end());
-    redecided.erase(std::unique(redecided.begin(), redecided.end()), redecided.end());
-    touched.swap(redecided);
-    // The second pass re-casts from every vertex whose start may have moved; an estimator that
-    // reads no regions (they are the second pass's alone) recomputes the moved vertices only.
-    const std::vector<uint32_t> newStarts = touched;
-    if (!needsDiscRegions(settings_.estimator))
-        touched.erase(std::remove_if(touched.begin(), touched.end(), [&](uint32_t v) { return !change.vertexMoved[v]; }),
-                      touched.end());
+    const bool firstFrame = mode_ == Mode::Fresh;
+    std::vector<uint32_t> changed;  // vertices the pose change left different
+    if (firstFrame) geometry_.computeAll(scene_, bvh_, &work_, stats);
+    else if (change.any) changed = geometry_.update(scene_, bvh_, change.bounds, change.vertexMoved, &work_, stats);
+    const std::vector<uint32_t> recomputed = estimator_->verticesToRecompute(changed, change.vertexMoved);
     const double regionSeconds = clock.seconds();
 
-    std::string why;
-    if (!solved_) why = "first-frame";
-    else if (settings_.fullRecompute) why = "full-recompute";
-    else if (!estimator_->canUpdate(why)) {
-    } else if (change.any && !settings_.alwaysUpdate && changeTooLarge(change, touched.size())) why = "change-too-large";
-    if (!why.empty()) {
-        solveFromScratch(stats);
+    const FromScratchReason why = firstFrame ? FromScratchReason::None : fromScratchReason(change, recomputed.size());
+    if (firstFrame || why != FromScratchReason::None) {
+        // A frame may update from this one only if one follows and could.
+        const bool updatesMayFollow = updateFollows && !settings_.fullRecompute && estimator_->canUpdate();
+        solveFromScratch(updatesMayFollow, stats);
+        stats.fromScratchReason = nameOf(kFromScratchReasonNames, why);
         // After the first frame the tracking state is made at once, so that the frames after it
         // pay only their updates; after a fallback, only once a frame updates again.
-        std::string noUpdate;
-        if (why == "first-frame" && updateFollows && !settings_.fullRecompute && estimator_->canUpdate(noUpdate))
-            startTracking(stats);
-        stats.fromScratchReason = solved_ ? why : "";
-        solved_ = true;
+        if (firstFrame && updatesMayFollow) startTracking(stats);
     } else {
         stats.fromScratch = false;
-        if (!tracked_) startTracking(stats);
+        if (mode_ == Mode::FromScratch) startTracking(stats);
         // Nothing moved: no path changes, no vertex changes.
-        if (change.any) solveIncrementally(change, touched, stats);
+        if (change.any) solveIncrementally(change, recomputed, stats);
     }
     stats.estimationSeconds += regionSeconds;
-    if (lighting_) secondPass(change, newStarts, stats);
-    if (tracked_) {
+    if (lighting_) secondPass(change, changed, stats);
+    if (mode_ == Mode::Tracking) {
         stats.trackedPaths = tracked_->trackedPaths();
         stats.trackedSegments = tracked_->trackedSegments();
         stats.trackedBytes = tracked_->bytes();
         stats.segments = foldedSegments_ + tracked_->trackedSegments();
     }
-    // The regions' kept static answers are incremental state too.
-    stats.estimatorStateBytes = estimator_->stateBytes() + (regions_ ? regions_->keptAnswerBytes() : 0) +
-                                (lighting_ ? lighting_->stateBytes() : 0);
-    if (regions_) {
-        stats.ownSurfaceFallbacks = regions_->fallbackVertices();
-        stats.buriedVertices = regions_->buriedVertices();
-    }
+    // The per-vertex geometry's kept static answers are incremental state too.
+    stats.estimatorStateBytes = estimator_->stateBytes() + geometry_.stateBytes() + (lighting_ ? lighting_->stateBytes() : 0);
+    geometry_.report(stats);
     return result_;
 }
 
-void FrameSolver::solveFromScratch(FrameTiming& stats) {
+void FrameSolver::solveFromScratch(bool keepCache, FrameTiming& stats) {
     stats.fromScratch = true;
+    mode_ = Mode::FromScratch;
     tracked_.reset();
     lastCache_.reset();
     Stopwatch clock;
@@ -242,7 +204,7 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
     work_.start("estimating", 0);
     estimator_->solve(cache, estimate(), stats);
     stats.estimationSeconds = clock.seconds();
-    if (!settings_.fullRecompute) lastCache_ = std::move(cache);
+    if (keepCache) lastCache_ = std::move(cache);
 }
 
 void FrameSolver::startTracking(FrameTiming& stats) {
@@ -268,10 +230,11 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     estimator_->prepareUpdates(*tracked_, stats);
     stats.estimationSeconds += clock.seconds();
     lastCache_.reset();
+    mode_ = Mode::Tracking;
     returnFreedMemory();
 }
 
-void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats) {
+void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& stats) {
     Stopwatch clock;
     stage("retracing");
     const std::vector<AffectedPath> affected =
@@ -282,7 +245,7 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
 
     clock.restart();
     const FrameChange frameChange{changes.removed,         changes.added, change.vertexMoved, change.triangleMoved,
-                                  change.movedTriangles, touched,       *tracked_};
+                                  change.movedTriangles, recomputed,    *tracked_};
     stage("updating");
     estimator_->update(frameChange, estimate(), stats);
     stats.estimationSeconds += clock.seconds();
@@ -292,13 +255,13 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
 
 namespace qsgi {
 
-void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats) {
+void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, FrameTiming& stats) {
     if (!lighting_->solved() || settings_.fullRecompute) {
-        lighting_->solve(scene_, bvh_, *regions_, photons_, result_, stats, &work_);
+        lighting_->solve(scene_, bvh_, *geometry_.regions(), photons_, result_, stats, &work_);
         return;
     }
     stage("gathering");
-    lighting_->update(scene_, bvh_, *regions_, MovedGeometry{change.bounds, touched}, photons_, result_, stats);
+    lighting_->update(scene_, bvh_, *geometry_.regions(), MovedGeometry{change.bounds, changed}, photons_, result_, stats);
 }
 
 }  // namespace qsgi

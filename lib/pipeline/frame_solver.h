@@ -14,11 +14,13 @@
 #include "estimate/estimator.h"
 #include "estimate/lighting_settings.h"
 #include "estimate/two_pass_lighting.h"
+#include "estimate/vertex_geometry.h"
 #include "scene/scene.h"
 #include "trace/envelope.h"
 #include "trace/photon_tracer.h"
 #include "trace/scene_bvh.h"
 #include "trace/tracked_paths.h"
+#include "util/enum_names.h"
 #include "util/frame_timing.h"
 #include "util/work_counter.h"
 
@@ -35,6 +37,17 @@ struct FrameSolverSettings {
     bool gridForBlocking = true; // false: test every tracked segment for blocking (benchmark baseline)
     // Retraces of one path before every tracked path is renumbered (TrackedPaths; tests lower it).
     uint32_t trackedGenerations = TrackedPaths::kGenerations;
+};
+
+// Why a frame after a run's first was computed from scratch, as timing.json's from_scratch_reason
+// names it ("" for an updated frame and for the first frame, which is always from scratch).
+enum class FromScratchReason { None, FullRecompute, EstimatorHasNoUpdate, ChangeTooLarge, NoKeptState };
+inline constexpr NamedValue<FromScratchReason> kFromScratchReasonNames[] = {
+    {FromScratchReason::None, ""},
+    {FromScratchReason::FullRecompute, "full-recompute"},
+    {FromScratchReason::EstimatorHasNoUpdate, "estimator"},  // e.g. --detp-index flann
+    {FromScratchReason::ChangeTooLarge, "change-too-large"},  // judged from counts (FrameSolver::changeTooLarge)
+    {FromScratchReason::NoKeptState, "no-kept-state"},  // the frame before kept nothing to update from
 };
 
 class FrameSolver {
@@ -63,14 +76,23 @@ public:
     const SceneBvh& bvh() const { return bvh_; }
     // The share of the lights' power that emission sends toward the scene (LightSampler).
     double emittedFraction() const { return tracer_.lights().emittedFraction(); }
-    const DiscRegions* regions() const { return regions_ ? &*regions_ : nullptr; }
-    // The paths an incremental frame keeps (null until the first update): what tests compare with
-    // a fresh trace of the same pose.
+    const DiscRegions* regions() const { return geometry_.regions(); }
+    // The paths an incremental frame keeps (null unless tracking): what tests compare with a
+    // fresh trace of the same pose.
     const TrackedPaths* trackedPaths() const { return tracked_.get(); }
     // The tracer, with the settings the solver gave it (emission aimed at the estimator's reach).
     const PhotonTracer& tracer() const { return tracer_; }
 
 private:
+    // What the solver holds between frames: one of these, never a mix.
+    enum class Mode {
+        Fresh,        // nothing solved since construction or reset(): the next frame computes
+                      // everything, the per-vertex geometry included
+        FromScratch,  // the last frame was computed from scratch; its ray cache is kept
+                      // (lastCache_) when a frame may update from it
+        Tracking,     // tracked paths and the estimator's incremental state hold the last frame
+    };
+
     void stage(const char* name, uint64_t done = 0, uint64_t total = 0) const {
         if (reportStage_) reportStage_(name, done, total);
     }
@@ -82,44 +104,42 @@ private:
         bool any = false;
     };
     PoseChange pose(const Pose& target);
-    // Vertices whose disc moved or whose regions the move touched (the moved ones without regions).
-    std::vector<uint32_t> touchedVertices(const PoseChange& change) const;
-    // Computes every vertex's regions the first time, afterwards only the touched ones (if given).
-    // Returns those of the touched ones whose disc may now decide crossings differently.
-    std::vector<uint32_t> updateRegions(const std::vector<uint32_t>* touched, FrameTiming& stats);
+    // Why this frame cannot or should not be updated (None: update it). `recomputed`: the
+    // vertices the estimator would recompute.
+    FromScratchReason fromScratchReason(const PoseChange& change, size_t recomputed) const;
     // Whether updating would cost more than solving the frame from scratch, from counts alone.
-    bool changeTooLarge(const PoseChange& change, size_t touched) const;
-    void solveFromScratch(FrameTiming& stats);
+    bool changeTooLarge(const PoseChange& change, size_t recomputed) const;
+    // keepCache: a frame may update from this one (its cache is kept for the tracked paths).
+    void solveFromScratch(bool keepCache, FrameTiming& stats);
     // The incremental state from the last frame's cache: tracked paths and the estimator's own.
     void startTracking(FrameTiming& stats);
-    void solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats);
+    void solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& stats);
     // Where the estimator's answer goes: result_ itself, or photons_ under a second pass.
     VertexRadiosity& estimate() { return lighting_ ? photons_ : result_; }
     // The second pass for this frame: from scratch the first time and under --full-recompute,
-    // else brought from the last frame's.
-    void secondPass(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats);
+    // else brought from the last frame's. `changed`: the vertices whose rays may start elsewhere.
+    void secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, FrameTiming& stats);
 
     Scene& scene_;
     FrameSolverSettings settings_;
     StageReporter reportStage_;
     WorkCounter work_;  // the stage in progress and how far it is, for reportStage_
     SceneBvh bvh_;
-    PhotonTracer tracer_;
-    std::optional<DiscRegions> regions_;
+    VertexGeometry geometry_;
     std::unique_ptr<Estimator> estimator_;
+    PhotonTracer tracer_;  // aimed at what the estimator can count (its reach)
     // With exact direct light: the second pass, and the estimator's answer it reads (the
     // estimator updates that in place frame after frame; result_ is the combination).
     std::optional<TwoPassLighting> lighting_;
     VertexRadiosity photons_;
-    bool regionsValid_ = false;
-    bool solved_ = false;
+    Mode mode_ = Mode::Fresh;
     std::vector<Vec3f> previousPositions_;  // the moving instances' vertices before a pose
     std::vector<uint8_t> previousHidden_;   // and whether they were hidden
-    // After a frame solved from scratch, its cache; the tracked paths are made from it only when
-    // the next frame updates (a frame that falls back to scratch again needs none).
+    // Mode::FromScratch: that frame's cache, when a frame may update from it; the tracked paths
+    // are made from it only when one does (a frame that falls back to scratch again needs none).
     std::optional<RayCache> lastCache_;
-    std::unique_ptr<TrackedPaths> tracked_;
-    uint64_t foldedSegments_ = 0;
+    std::unique_ptr<TrackedPaths> tracked_;  // Mode::Tracking
+    uint64_t foldedSegments_ = 0;            // Mode::Tracking: the cache's segments not tracked
     VertexRadiosity result_;
 };
 

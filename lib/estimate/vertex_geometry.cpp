@@ -1,0 +1,51 @@
+#include "estimate/vertex_geometry.h"
+
+#include <algorithm>
+
+#include "util/stopwatch.h"
+
+namespace qsgi {
+
+VertexGeometry::VertexGeometry(const EstimatorSettings& estimator, bool secondPassReadsStarts)
+    : estimatorReadsRegions_(needsDiscRegions(estimator)) {
+    if (estimatorReadsRegions_) regions_.emplace(makeDiscRegions(estimator));
+    else if (secondPassReadsStarts) regions_.emplace(DiscRegions::startsOnly(estimator.radius));
+}
+
+void VertexGeometry::computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounter* progress, FrameTiming& stats) {
+    if (!regions_) return;
+    Stopwatch clock;
+    regions_->computeAll(scene, bvh, progress);
+    stats.discRegionsUpdated = scene.vertexCount();
+    stats.discRegionsSeconds = clock.seconds();
+}
+
+std::vector<uint32_t> VertexGeometry::update(const Scene& scene, const SceneBvh& bvh, const std::vector<Bounds3f>& movedBounds,
+                                             const std::vector<uint8_t>& vertexMoved, WorkCounter* progress,
+                                             FrameTiming& stats) {
+    std::vector<uint32_t> changed;
+    if (!regions_) {
+        for (uint32_t v = 0; v < vertexMoved.size(); ++v)
+            if (vertexMoved[v]) changed.push_back(v);
+        return changed;
+    }
+    Stopwatch clock;
+    // The conservative test touches more than change: most touched vertices keep their disc.
+    const std::vector<uint32_t> touched = regions_->touchedBy(scene, movedBounds, vertexMoved);
+    changed = regions_->recompute(scene, bvh, touched, progress);
+    for (uint32_t v : touched)
+        if (vertexMoved[v]) changed.push_back(v);
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    stats.discRegionsUpdated = touched.size();
+    stats.discRegionsSeconds = clock.seconds();
+    return changed;
+}
+
+void VertexGeometry::report(FrameTiming& stats) const {
+    if (!regions_) return;
+    stats.ownSurfaceFallbacks = regions_->fallbackVertices();
+    stats.buriedVertices = regions_->buriedVertices();
+}
+
+}  // namespace qsgi

@@ -1,0 +1,53 @@
+// The per-vertex geometry that every estimator and the second pass share (docs/design.md §5, §5.1):
+// each vertex's own surface, start point s_v and disc regions, for the scene's current pose. It has
+// one owner, this class, which computes it for the first frame and brings it to each new pose,
+// and says which vertices the pose change left different. Estimators and the second pass only
+// read it; what each estimator keeps besides (DETP's sums, the photon map's lists) is its own.
+//
+// What it holds follows from who reads it: full disc regions when the estimator reads them (the
+// photon map with coverage), start points only when only the second pass does (impact count and
+// DETP's paper rule under exact direct light), nothing when nobody does.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "estimate/disc_regions.h"
+#include "estimate/estimator.h"
+#include "scene/scene.h"
+#include "trace/scene_bvh.h"
+#include "util/frame_timing.h"
+#include "util/work_counter.h"
+
+namespace qsgi {
+
+class VertexGeometry {
+public:
+    // secondPassReadsStarts: exact direct light will cast rays from each vertex's s_v.
+    VertexGeometry(const EstimatorSettings& estimator, bool secondPassReadsStarts);
+
+    // Every vertex, for the scene's current pose (bvh holds it).
+    void computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounter* progress, FrameTiming& stats);
+    // After a pose change: recomputes the vertices whose test region the moved objects' old or
+    // new bounds (`movedBounds`) touch, and the moved vertices. Returns, sorted, the moved
+    // vertices and those whose regions may now decide differently: what estimators recompute
+    // (Estimator::verticesToRecompute) and where the second pass's rays may now start elsewhere.
+    std::vector<uint32_t> update(const Scene& scene, const SceneBvh& bvh, const std::vector<Bounds3f>& movedBounds,
+                                 const std::vector<uint8_t>& vertexMoved, WorkCounter* progress, FrameTiming& stats);
+
+    // The regions for whoever reads them (null when nobody does), and for the estimator (null
+    // when it reads none: the regions, if any, are then the second pass's start points only).
+    const DiscRegions* regions() const { return regions_ ? &*regions_ : nullptr; }
+    const DiscRegions* estimatorRegions() const { return estimatorReadsRegions_ ? regions() : nullptr; }
+
+    // Bytes of incremental state (the static answers kept for recomputed vertices), and the
+    // counts timing.json reports.
+    size_t stateBytes() const { return regions_ ? regions_->keptAnswerBytes() : 0; }
+    void report(FrameTiming& stats) const;
+
+private:
+    bool estimatorReadsRegions_;
+    std::optional<DiscRegions> regions_;
+};
+
+}  // namespace qsgi
