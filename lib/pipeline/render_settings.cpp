@@ -7,7 +7,6 @@
 #include <filesystem>
 
 #include "util/error.h"
-#include "trace/ray_cache.h"
 #include "util/json_file.h"
 #include "util/memory.h"
 #include "pipeline/render_options.h"
@@ -26,8 +25,8 @@ int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string&
 
 uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place) {
     const uint64_t photons = uint64_t(checkedInteger(value, 1, kMaxPhotons, source, place, " (2^32: the path index is 32 bits)"));
-    refuseBeyondMemory(photons * RayCache::kBytesPerPath, source, place,
-                       std::to_string(photons) + " photons (at least " + std::to_string(RayCache::kBytesPerPath) +
+    refuseBeyondMemory(photons * kLeastBytesPerPhoton, source, place,
+                       std::to_string(photons) + " photons (at least " + std::to_string(kLeastBytesPerPhoton) +
                            " bytes each in the ray cache)");
     return photons;
 }
