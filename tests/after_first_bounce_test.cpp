@@ -57,9 +57,9 @@ struct Case {
     EstimatorSettings settings(float radius) const {
         EstimatorSettings s;
         s.kind = kind;
-        s.boundary = rule;
+        s.detp.boundary = rule;
         s.radius = radius;
-        s.k = 30;
+        s.photonMap.k = 30;
         s.useIndex = index;
         return s;
     }
@@ -253,7 +253,7 @@ TEST(AfterFirstBounce, EqualsTheSameEstimateOverTheLaterBouncesAlone) {
         EXPECT_FALSE(sameBits(after, fixture.estimate(cache, e, false)));
         if (c.kind == EstimatorKind::Detp) {
             EstimatorSettings flann = e;
-            flann.detpIndex = DetpIndex::Flann;
+            flann.detp.index = DetpIndex::Flann;
             EXPECT_TRUE(sameBits(fixture.estimate(cache, flann, true), fixture.estimate(later, flann, false))) << "flann";
         }
     }

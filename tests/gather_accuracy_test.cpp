@@ -51,9 +51,9 @@ Errors measure(const std::string& scenePath, const VertexRadiosityPly& reference
     const EmbreeDevice device;
     FrameSolverSettings s;
     s.estimator.kind = kind;
-    s.estimator.boundary = rule;
+    s.estimator.detp.boundary = rule;
     s.estimator.radius = 0.05f;
-    s.estimator.k = 50;
+    s.estimator.photonMap.k = 50;
     s.trace.photons = photons;
     s.trace.seed = seed;
     s.lighting.direct = DirectLighting::Exact;

@@ -80,9 +80,9 @@ const EstimatorCase kEstimators[] = {
 FrameSolverSettings solverSettings(const EstimatorCase& e, float radius, uint64_t photons) {
     FrameSolverSettings s;
     s.estimator.kind = e.kind;
-    s.estimator.boundary = e.rule;
+    s.estimator.detp.boundary = e.rule;
     s.estimator.radius = radius;
-    s.estimator.k = 20;
+    s.estimator.photonMap.k = 20;
     s.estimator.useIndex = e.index;
     s.trace.photons = photons;
     s.trace.seed = 7;
@@ -469,7 +469,7 @@ TEST(Incremental, AnEstimatorWithoutAnUpdateLogsItsFramesAsFromScratch) {
     Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
     EmbreeDevice device;
     FrameSolverSettings flann = solverSettings(e, 0.12f, 3000);
-    flann.estimator.detpIndex = DetpIndex::Flann;
+    flann.estimator.detp.index = DetpIndex::Flann;
     FrameSolverSettings full = flann;
     full.fullRecompute = true;
     FrameSolver inc(incScene, device, flann), ref(fullScene, device, full);
@@ -501,7 +501,7 @@ TEST(PhotonMapOrder, KNearestDoNotDependOnTheCacheOrder) {
     EstimatorSettings settings;
     settings.kind = EstimatorKind::PhotonMap;
     settings.radius = 0.3f;
-    settings.k = 16;  // 15 summed: one of a tied pair is in, the other out
+    settings.photonMap.k = 16;  // 15 summed: one of a tied pair is in, the other out
     const std::vector<Vec3f> forward = estimateWith(s, cache(), settings).irradiance;
     std::reverse(segments.begin(), segments.end());
     EXPECT_TRUE(sameBits(forward, estimateWith(s, cache(), settings).irradiance));

@@ -162,7 +162,7 @@ TEST(RenderOptions, ExactlyTheFingerprintedOptionsChangeTheFingerprint) {
         // k means nothing to DETP: a folder made with another k may be resumed.
         if (kind == EstimatorKind::Detp) {
             RenderSettings otherK = base;
-            otherK.estimator.k = 7;
+            otherK.estimator.photonMap.k = 7;
             EXPECT_EQ(runFingerprint(otherK, scene, "", camera).digest, reference);
         }
     }

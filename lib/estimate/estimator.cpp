@@ -5,7 +5,7 @@
 namespace qsgi {
 
 bool needsDiscRegions(const EstimatorSettings& s) {
-    return s.kind != EstimatorKind::ImpactCount && s.boundary != DetpBoundary::Paper;
+    return s.kind != EstimatorKind::ImpactCount && s.detp.boundary != DetpBoundary::Paper;
 }
 
 DiscRegions makeDiscRegions(const EstimatorSettings& s) { return DiscRegions(s.radius, s.kind == EstimatorKind::PhotonMap); }

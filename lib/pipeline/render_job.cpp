@@ -265,7 +265,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
                   {"qsgi:spp", settings_.samplesPerPixel}};
         // 0: the estimator has no radius (impact count)
         m.floats = {{"qsgi:radius", settings_.estimator.kind == EstimatorKind::ImpactCount ? 0.0f : settings_.estimator.radius}};
-        m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.k : 0);
+        m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.photonMap.k : 0);
         return m;
     };
     FrameSolverSettings solverSettings;

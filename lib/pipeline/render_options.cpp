@@ -113,7 +113,9 @@ json getCamera(const RenderSettings& s) {
 // framesSource). A field added without an option fails here; add its option (and count it).
 static_assert(fieldCount<RenderSettings>() == 38, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<LightingSettings>() == 3, "a LightingSettings field was added or removed: give it an option");
-static_assert(fieldCount<EstimatorSettings>() == 7, "an EstimatorSettings field was added or removed: give it an option");
+static_assert(fieldCount<EstimatorSettings>() == 6, "an EstimatorSettings field was added or removed: give it an option");
+static_assert(fieldCount<PhotonMapSettings>() == 1, "a PhotonMapSettings field was added or removed: give it an option");
+static_assert(fieldCount<DetpSettings>() == 2, "a DetpSettings field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
 
 std::vector<RenderOption> declareOptions() {
@@ -162,26 +164,26 @@ std::vector<RenderOption> declareOptions() {
                  }});
     o.push_back({"k", "--k", T::Integer, 1, double(kMaxK), "", {}, true, "K", "50",
                  "photon map: the nearest impacts per vertex", true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.k = v.get<int>(); },
-                 [](const RenderSettings& s) { return orNull(s.estimator.kind == EstimatorKind::PhotonMap, json(s.estimator.k)); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.photonMap.k = v.get<int>(); },
+                 [](const RenderSettings& s) { return orNull(s.estimator.kind == EstimatorKind::PhotonMap, json(s.estimator.photonMap.k)); }});
     o.push_back({"detp_boundary", "--detp-boundary", T::Choice, 0, 0, "", namesOf(kDetpBoundaryNames), true, "", "clip",
                  "where a disc meets other geometry: clip (only the parts of the disc light can reach from the vertex's "
                  "side count: no leaks through thin occluders), linear (clip plus a linear fit that removes the "
                  "first-order bias at edges) or paper (the published rule, and the textbook photon map: for ablations)",
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) {
-                     s.estimator.boundary = choiceValue(kDetpBoundaryNames, v);
+                     s.estimator.detp.boundary = choiceValue(kDetpBoundaryNames, v);
                  },
                  [](const RenderSettings& s) {
-                     return orNull(s.estimator.kind != EstimatorKind::ImpactCount, json(detpBoundaryName(s.estimator.boundary)));
+                     return orNull(s.estimator.kind != EstimatorKind::ImpactCount, json(detpBoundaryName(s.estimator.detp.boundary)));
                  }});
     o.push_back({"detp_index", "--detp-index", T::Choice, 0, 0, "", namesOf(kDetpIndexNames), true, "", "embree",
                  "DETP's index: embree (exact) or flann (approximate candidates: it misses segments that cross a disc "
                  "but land far away)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.detpIndex = choiceValue(kDetpIndexNames, v); },
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.detp.index = choiceValue(kDetpIndexNames, v); },
                  [](const RenderSettings& s) {
-                     return orNull(s.estimator.kind == EstimatorKind::Detp, json(nameOf(kDetpIndexNames, s.estimator.detpIndex)));
+                     return orNull(s.estimator.kind == EstimatorKind::Detp, json(nameOf(kDetpIndexNames, s.estimator.detp.index)));
                  }});
     o.push_back({"ray_cache", "--no-ray-cache", T::Boolean, 0, 0, "", {}, false, "", "true",
                  "no spatial index, every vertex against every segment or impact (the paper's \"No Ray Caché\"; "

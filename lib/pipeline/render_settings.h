@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "estimate/estimator.h"
+#include "estimate/estimator_settings.h"
 #include "estimate/lighting_settings.h"
 #include "scene/scene.h"
 #include "trace/photon_numbers.h"
