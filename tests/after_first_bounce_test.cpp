@@ -164,9 +164,9 @@ void expectIncrementalEqualsFull(const std::function<Animated()>& make, const Ca
     s.lighting.direct = DirectLighting::Exact;
     s.lighting.directSamples = 4;
     s.lighting.gatherRays = 0;
-    s.alwaysUpdate = true;  // the update, however large the change
+    s.update.alwaysUpdate = true;  // the update, however large the change
     FrameSolverSettings r = s;
-    r.fullRecompute = true;
+    r.update.fullRecompute = true;
     FrameSolver incremental(inc.scene, device, s), reference(full.scene, device, r);
     uint64_t retraced = 0;
     for (int f = 0; f < frames; ++f) {

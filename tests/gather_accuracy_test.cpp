@@ -59,7 +59,7 @@ Errors measure(const std::string& scenePath, const VertexRadiosityPly& reference
     s.lighting.direct = DirectLighting::Exact;
     s.lighting.directSamples = 64;
     s.lighting.gatherRays = gatherRays;
-    s.fullRecompute = true;
+    s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
     FrameTiming stats;
     const VertexRadiosity& result = solver.solve(scene.restPose(), stats, false);

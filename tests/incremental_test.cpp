@@ -86,7 +86,7 @@ FrameSolverSettings solverSettings(const EstimatorCase& e, float radius, uint64_
     s.estimator.useIndex = e.index;
     s.trace.photons = photons;
     s.trace.seed = 7;
-    s.alwaysUpdate = true;  // these tests exercise the update, however large the change
+    s.update.alwaysUpdate = true;  // these tests exercise the update, however large the change
     return s;
 }
 
@@ -100,11 +100,11 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
     Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
     EmbreeDevice device;
     FrameSolverSettings incremental = solverSettings(e, radius, photons);
-    incremental.useEnvelope = envelope;
-    incremental.trackedGenerations = generations;
+    incremental.update.useEnvelope = envelope;
+    incremental.update.trackedGenerations = generations;
     incremental.lighting = lighting;
     FrameSolverSettings full = incremental;
-    full.fullRecompute = true;
+    full.update.fullRecompute = true;
     FrameSolver inc(incScene, device, incremental), ref(fullScene, device, full);
     uint64_t retraced = 0, gatherRecast = 0, gatherFull = 0;
     for (int f = 0; f < a.frames; ++f) {
@@ -377,7 +377,7 @@ TEST(Incremental, NoDriftOverTenThousandFrames) {
         int freshMover = -1;
         Scene fresh = prepare(a, freshMover);
         FrameSolverSettings s = solverSettings(e, 0.15f, 400);
-        s.fullRecompute = true;
+        s.update.fullRecompute = true;
         FrameSolver reference(fresh, device, s);
         EXPECT_TRUE(sameBits(last, reference.solve(a.localsAt(fresh, freshMover, a.frames - 1), w).radiosity));
     }
@@ -412,7 +412,7 @@ TEST(Incremental, RememberedCrossingsLeaveNoTraceAfterAThousandFrames) {
         int freshMover = -1;
         Scene fresh = prepare(a, freshMover);
         FrameSolverSettings s = solverSettings(e, 0.12f, 2000);
-        s.fullRecompute = true;
+        s.update.fullRecompute = true;
         FrameSolver reference(fresh, device, s);
         FrameTiming w;
         const std::vector<Vec3f> expected = reference.solve(a.localsAt(fresh, freshMover, a.frames - 1), w).irradiance;
@@ -437,9 +437,9 @@ TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
         Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
         EmbreeDevice device;
         FrameSolverSettings automatic = solverSettings(e, 0.12f, 3000);
-        automatic.alwaysUpdate = false;
+        automatic.update.alwaysUpdate = false;
         FrameSolverSettings full = automatic;
-        full.fullRecompute = true;
+        full.update.fullRecompute = true;
         FrameSolver inc(incScene, device, automatic), ref(fullScene, device, full);
         for (int f = 0; f < a.frames; ++f) {
             FrameTiming wi, wf;
@@ -471,7 +471,7 @@ TEST(Incremental, AnEstimatorWithoutAnUpdateLogsItsFramesAsFromScratch) {
     FrameSolverSettings flann = solverSettings(e, 0.12f, 3000);
     flann.estimator.detp.index = DetpIndex::Flann;
     FrameSolverSettings full = flann;
-    full.fullRecompute = true;
+    full.update.fullRecompute = true;
     FrameSolver inc(incScene, device, flann), ref(fullScene, device, full);
     for (int f = 0; f < 3; ++f) {
         FrameTiming wi, wf;

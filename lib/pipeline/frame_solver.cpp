@@ -56,7 +56,7 @@ FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSo
     else if (exactDirect) regions_.emplace(DiscRegions::startsOnly(settings_.estimator.radius));
     const DiscRegions* estimatorRegions = needsDiscRegions(settings_.estimator) ? regions() : nullptr;
     estimator_ = Estimator::create(settings_.estimator, EstimatorContext{scene_, bvh_, device, estimatorRegions,
-                                                                         !settings_.fullRecompute, &work_, exactDirect});
+                                                                         !settings_.update.fullRecompute, &work_, exactDirect});
     if (exactDirect) lighting_.emplace(settings_.lighting, settings_.trace.seed);
 }
 
@@ -189,15 +189,15 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
 
     std::string why;
     if (!solved_) why = "first-frame";
-    else if (settings_.fullRecompute) why = "full-recompute";
+    else if (settings_.update.fullRecompute) why = "full-recompute";
     else if (!estimator_->canUpdate(why)) {
-    } else if (change.any && !settings_.alwaysUpdate && changeTooLarge(change, touched.size())) why = "change-too-large";
+    } else if (change.any && !settings_.update.alwaysUpdate && changeTooLarge(change, touched.size())) why = "change-too-large";
     if (!why.empty()) {
         solveFromScratch(stats);
         // After the first frame the tracking state is made at once, so that the frames after it
         // pay only their updates; after a fallback, only once a frame updates again.
         std::string noUpdate;
-        if (why == "first-frame" && updateFollows && !settings_.fullRecompute && estimator_->canUpdate(noUpdate))
+        if (why == "first-frame" && updateFollows && !settings_.update.fullRecompute && estimator_->canUpdate(noUpdate))
             startTracking(stats);
         stats.fromScratchReason = solved_ ? why : "";
         solved_ = true;
@@ -242,7 +242,7 @@ void FrameSolver::solveFromScratch(FrameTiming& stats) {
     work_.start("estimating", 0);
     estimator_->solve(cache, estimate(), stats);
     stats.estimationSeconds = clock.seconds();
-    if (!settings_.fullRecompute) lastCache_ = std::move(cache);
+    if (!settings_.update.fullRecompute) lastCache_ = std::move(cache);
 }
 
 void FrameSolver::startTracking(FrameTiming& stats) {
@@ -252,7 +252,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     const RayCache& cache = *lastCache_;
     const float reach = estimator_->reach();
     const float margin = envelopeMargin(reach > 0, reach, scene_.sceneEpsilon());
-    const Envelope envelope = settings_.useEnvelope ? Envelope::ofAnimation(scene_, margin) : Envelope::everything();
+    const Envelope envelope = settings_.update.useEnvelope ? Envelope::ofAnimation(scene_, margin) : Envelope::everything();
     const Bounds3f gridBounds = envelope.isEverything() ? scene_.animationBounds.expanded(margin) : envelope.bounds();
     // The grid answers two kinds of query: the movers' new bounds (rule (b)) and, for DETP, the
     // discs a frame recomputes. For the first, cells an eighth of the envelope across are fine
@@ -261,7 +261,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     // whole scene (no envelope) gets half as many.
     const float divisions = (reach > 0 ? 32.0f : 8.0f) / (envelope.isEverything() ? 2.0f : 1.0f);
     const float cellSize = std::max(4 * reach, gridBounds.extent() / divisions);
-    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize, settings_.trackedGenerations);
+    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize, settings_.update.trackedGenerations);
     foldedSegments_ = cache.segmentCount() - tracked_->trackedSegments();
     stats.photonSimulationSeconds += clock.seconds();
     clock.restart();
@@ -275,7 +275,7 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
     Stopwatch clock;
     stage("retracing");
     const std::vector<AffectedPath> affected =
-        tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.gridForBlocking, stats);
+        tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.update.gridForBlocking, stats);
     PathChanges changes;
     tracked_->retrace(affected, tracer_, changes, stats);
     stats.photonSimulationSeconds += clock.seconds();
@@ -293,7 +293,7 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
 namespace qsgi {
 
 void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& touched, FrameTiming& stats) {
-    if (!lighting_->solved() || settings_.fullRecompute) {
+    if (!lighting_->solved() || settings_.update.fullRecompute) {
         lighting_->solve(scene_, bvh_, *regions_, photons_, result_, stats, &work_);
         return;
     }

@@ -85,10 +85,11 @@ void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderS
     }
 }
 
-PhotonSampling effectiveSampling(const RenderSettings& s) {
-    PhotonSampling sampling = s.sampling;
-    sampling.qmcBounces = sampling.kind == SamplerKind::Random ? 0 : std::min({sampling.qmcBounces, s.maxBounces, kMaxQmcBounces});
-    return sampling;
+TraceSettings effectiveTrace(const TraceSettings& trace) {
+    TraceSettings t = trace;
+    PhotonSampling& sampling = t.sampling;
+    sampling.qmcBounces = sampling.kind == SamplerKind::Random ? 0 : std::min({sampling.qmcBounces, t.maxBounces, kMaxQmcBounces});
+    return t;
 }
 
 void validateSettings(const RenderSettings& s) {
@@ -103,8 +104,8 @@ void validateSettings(const RenderSettings& s) {
     }
     if (s.scenePath.empty()) throw InputError("command line", "SCENE", "no scene given");
     // Checked after the config and the command line are merged: the bound is max_bounces.
-    if (s.qmcBouncesGiven && s.sampling.kind == SamplerKind::Sobol)  // K means nothing under random
-        checkedInteger(s.sampling.qmcBounces, 0, std::min<int64_t>(s.maxBounces, kMaxQmcBounces),
+    if (s.qmcBouncesGiven && s.trace.sampling.kind == SamplerKind::Sobol)  // K means nothing under random
+        checkedInteger(s.trace.sampling.qmcBounces, 0, std::min<int64_t>(s.trace.maxBounces, kMaxQmcBounces),
                        s.configPath.empty() ? "command line" : s.configPath + " or the command line", "qmc_bounces",
                        " (at most max_bounces, and the Sobol table covers 32 scatterings)");
     // The gather replaces the estimate of indirect light only; with direct light from the photons
