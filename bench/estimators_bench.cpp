@@ -92,11 +92,11 @@ void BM_Estimate(benchmark::State& state) {
     EstimatorSettings s;
     s.kind = kind;
     s.radius = radiusMm / 1000.0f;
-    s.k = 50;
+    s.photonMap.k = 50;
     s.useIndex = mode != kBruteForce;
     s.sortQueries = mode != kIndexedUnsorted;
-    s.detpIndex = mode == kFlannCandidates ? DetpIndex::Flann : DetpIndex::Embree;
-    s.boundary = rule;
+    s.detp.index = mode == kFlannCandidates ? DetpIndex::Flann : DetpIndex::Embree;
+    s.detp.boundary = rule;
     // Regions are made once (BM_DiscRegions times them): this measures the estimate alone.
     const DiscRegions* regions = needsDiscRegions(s) ? &f.discRegions(radiusMm, kind == EstimatorKind::PhotonMap) : nullptr;
     VertexRadiosity result;

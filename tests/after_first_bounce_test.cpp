@@ -57,9 +57,9 @@ struct Case {
     EstimatorSettings settings(float radius) const {
         EstimatorSettings s;
         s.kind = kind;
-        s.boundary = rule;
+        s.detp.boundary = rule;
         s.radius = radius;
-        s.k = 30;
+        s.photonMap.k = 30;
         s.useIndex = index;
         return s;
     }
@@ -164,9 +164,9 @@ void expectIncrementalEqualsFull(const std::function<Animated()>& make, const Ca
     s.lighting.direct = DirectLighting::Exact;
     s.lighting.directSamples = 4;
     s.lighting.gatherRays = 0;
-    s.alwaysUpdate = true;  // the update, however large the change
+    s.update.alwaysUpdate = true;  // the update, however large the change
     FrameSolverSettings r = s;
-    r.fullRecompute = true;
+    r.update.fullRecompute = true;
     FrameSolver incremental(inc.scene, device, s), reference(full.scene, device, r);
     uint64_t retraced = 0;
     for (int f = 0; f < frames; ++f) {
@@ -253,7 +253,7 @@ TEST(AfterFirstBounce, EqualsTheSameEstimateOverTheLaterBouncesAlone) {
         EXPECT_FALSE(sameBits(after, fixture.estimate(cache, e, false)));
         if (c.kind == EstimatorKind::Detp) {
             EstimatorSettings flann = e;
-            flann.detpIndex = DetpIndex::Flann;
+            flann.detp.index = DetpIndex::Flann;
             EXPECT_TRUE(sameBits(fixture.estimate(cache, flann, true), fixture.estimate(later, flann, false))) << "flann";
         }
     }

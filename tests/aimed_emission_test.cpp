@@ -36,7 +36,7 @@ Solved solveDetp(const Scene& source, uint64_t photons, bool aim, float radius) 
     s.estimator.kind = EstimatorKind::Detp;
     s.estimator.radius = radius;
     s.trace = TraceSettings{photons, 3, 32, EmissionAim{aim, 0}, PhotonSampling{}};
-    s.fullRecompute = true;
+    s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
     FrameTiming work;
     Solved out;

@@ -27,11 +27,11 @@ std::vector<Vec3f> estimate(const Scene& scene, const RayCache& cache, Estimator
     EstimatorSettings s;
     s.kind = kind;
     s.radius = radius;
-    s.k = k;
+    s.photonMap.k = k;
     s.useIndex = useIndex;
     s.sortQueries = sortQueries;
-    s.detpIndex = detpIndex;
-    s.boundary = boundary;
+    s.detp.index = detpIndex;
+    s.detp.boundary = boundary;
     return estimateWith(scene, cache, s).irradiance;
 }
 
@@ -98,12 +98,12 @@ TEST(Estimators, IndexedPhotonMapAndDetpEqualBruteForce) {
                            DetpIndex index = DetpIndex::Embree) {
                 EstimatorSettings s;
                 s.kind = kind;
-                s.boundary = rule;
+                s.detp.boundary = rule;
                 s.radius = radius;
-                s.k = 20;
+                s.photonMap.k = 20;
                 s.useIndex = useIndex;
                 s.sortQueries = sortQueries;
-                s.detpIndex = index;
+                s.detp.index = index;
                 return estimateVertexRadiosity(scene, bvh, cache, s, device,
                                                kind == EstimatorKind::PhotonMap ? &covered : &discs).irradiance;
             };

@@ -96,7 +96,7 @@ TEST(FinalGather, ClosedSphereTwoPassGivesTheAnalyticIrradiance) {
     s.trace = TraceSettings{1000000, 5, 32, EmissionAim{}, PhotonSampling{}};
     s.lighting.direct = DirectLighting::Exact;
     s.lighting.gatherRays = 256;
-    s.fullRecompute = true;
+    s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
     FrameTiming stats;
     const std::vector<Vec3f> E = solver.solve(scene.restPose(), stats).irradiance;

@@ -51,15 +51,15 @@ Errors measure(const std::string& scenePath, const VertexRadiosityPly& reference
     const EmbreeDevice device;
     FrameSolverSettings s;
     s.estimator.kind = kind;
-    s.estimator.boundary = rule;
+    s.estimator.detp.boundary = rule;
     s.estimator.radius = 0.05f;
-    s.estimator.k = 50;
+    s.estimator.photonMap.k = 50;
     s.trace.photons = photons;
     s.trace.seed = seed;
     s.lighting.direct = DirectLighting::Exact;
     s.lighting.directSamples = 64;
     s.lighting.gatherRays = gatherRays;
-    s.fullRecompute = true;
+    s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
     FrameTiming stats;
     const VertexRadiosity& result = solver.solve(scene.restPose(), stats, false);

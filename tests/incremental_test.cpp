@@ -80,13 +80,13 @@ const EstimatorCase kEstimators[] = {
 FrameSolverSettings solverSettings(const EstimatorCase& e, float radius, uint64_t photons) {
     FrameSolverSettings s;
     s.estimator.kind = e.kind;
-    s.estimator.boundary = e.rule;
+    s.estimator.detp.boundary = e.rule;
     s.estimator.radius = radius;
-    s.estimator.k = 20;
+    s.estimator.photonMap.k = 20;
     s.estimator.useIndex = e.index;
     s.trace.photons = photons;
     s.trace.seed = 7;
-    s.alwaysUpdate = true;  // these tests exercise the update, however large the change
+    s.update.alwaysUpdate = true;  // these tests exercise the update, however large the change
     return s;
 }
 
@@ -100,11 +100,11 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
     Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
     EmbreeDevice device;
     FrameSolverSettings incremental = solverSettings(e, radius, photons);
-    incremental.useEnvelope = envelope;
-    incremental.trackedGenerations = generations;
+    incremental.update.useEnvelope = envelope;
+    incremental.update.trackedGenerations = generations;
     incremental.lighting = lighting;
     FrameSolverSettings full = incremental;
-    full.fullRecompute = true;
+    full.update.fullRecompute = true;
     FrameSolver inc(incScene, device, incremental), ref(fullScene, device, full);
     uint64_t retraced = 0, gatherRecast = 0, gatherFull = 0;
     for (int f = 0; f < a.frames; ++f) {
@@ -377,7 +377,7 @@ TEST(Incremental, NoDriftOverTenThousandFrames) {
         int freshMover = -1;
         Scene fresh = prepare(a, freshMover);
         FrameSolverSettings s = solverSettings(e, 0.15f, 400);
-        s.fullRecompute = true;
+        s.update.fullRecompute = true;
         FrameSolver reference(fresh, device, s);
         EXPECT_TRUE(sameBits(last, reference.solve(a.localsAt(fresh, freshMover, a.frames - 1), w).radiosity));
     }
@@ -412,7 +412,7 @@ TEST(Incremental, RememberedCrossingsLeaveNoTraceAfterAThousandFrames) {
         int freshMover = -1;
         Scene fresh = prepare(a, freshMover);
         FrameSolverSettings s = solverSettings(e, 0.12f, 2000);
-        s.fullRecompute = true;
+        s.update.fullRecompute = true;
         FrameSolver reference(fresh, device, s);
         FrameTiming w;
         const std::vector<Vec3f> expected = reference.solve(a.localsAt(fresh, freshMover, a.frames - 1), w).irradiance;
@@ -437,9 +437,9 @@ TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
         Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
         EmbreeDevice device;
         FrameSolverSettings automatic = solverSettings(e, 0.12f, 3000);
-        automatic.alwaysUpdate = false;
+        automatic.update.alwaysUpdate = false;
         FrameSolverSettings full = automatic;
-        full.fullRecompute = true;
+        full.update.fullRecompute = true;
         FrameSolver inc(incScene, device, automatic), ref(fullScene, device, full);
         for (int f = 0; f < a.frames; ++f) {
             FrameTiming wi, wf;
@@ -477,9 +477,9 @@ TEST(Incremental, APanelSweepingUnderTheLightFallsBackEveryFrameFromCountsAlone)
         Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
         EmbreeDevice device;
         FrameSolverSettings automatic = solverSettings(e, 0.12f, 3000);
-        automatic.alwaysUpdate = false;
+        automatic.update.alwaysUpdate = false;
         FrameSolverSettings full = automatic;
-        full.fullRecompute = true;
+        full.update.fullRecompute = true;
         FrameSolver inc(incScene, device, automatic), ref(fullScene, device, full);
         for (int f = 0; f < a.frames; ++f) {
             FrameTiming wi, wf;
@@ -504,9 +504,9 @@ TEST(Incremental, AnEstimatorWithoutAnUpdateLogsItsFramesAsFromScratch) {
     Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
     EmbreeDevice device;
     FrameSolverSettings flann = solverSettings(e, 0.12f, 3000);
-    flann.estimator.detpIndex = DetpIndex::Flann;
+    flann.estimator.detp.index = DetpIndex::Flann;
     FrameSolverSettings full = flann;
-    full.fullRecompute = true;
+    full.update.fullRecompute = true;
     FrameSolver inc(incScene, device, flann), ref(fullScene, device, full);
     for (int f = 0; f < 3; ++f) {
         FrameTiming wi, wf;
@@ -536,7 +536,7 @@ TEST(PhotonMapOrder, KNearestDoNotDependOnTheCacheOrder) {
     EstimatorSettings settings;
     settings.kind = EstimatorKind::PhotonMap;
     settings.radius = 0.3f;
-    settings.k = 16;  // 15 summed: one of a tied pair is in, the other out
+    settings.photonMap.k = 16;  // 15 summed: one of a tied pair is in, the other out
     const std::vector<Vec3f> forward = estimateWith(s, cache(), settings).irradiance;
     std::reverse(segments.begin(), segments.end());
     EXPECT_TRUE(sameBits(forward, estimateWith(s, cache(), settings).irradiance));

@@ -47,9 +47,9 @@ Figures measure(const Scene& scene, const RayCache& cache, const VertexRadiosity
                 DetpBoundary rule, float radius) {
     EstimatorSettings s;
     s.kind = kind;
-    s.boundary = rule;
+    s.detp.boundary = rule;
     s.radius = radius;
-    s.k = 50;
+    s.photonMap.k = 50;
     const VertexRadiosity result = estimateWith(scene, cache, s);
     Figures f;
     f.report = compareSolutions(reference.positions, reference.normals, reference.triangles, result.radiosity,

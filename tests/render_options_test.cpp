@@ -162,7 +162,7 @@ TEST(RenderOptions, ExactlyTheFingerprintedOptionsChangeTheFingerprint) {
         // k means nothing to DETP: a folder made with another k may be resumed.
         if (kind == EstimatorKind::Detp) {
             RenderSettings otherK = base;
-            otherK.estimator.k = 7;
+            otherK.estimator.photonMap.k = 7;
             EXPECT_EQ(runFingerprint(otherK, scene, "", camera).digest, reference);
         }
     }
@@ -280,9 +280,9 @@ TEST(RenderOptions, EverySettingIsReachableAndTheFieldCountItRestsOnIsExact) {
     RenderSettings fromFlag, fromConfig;
     applyCommandLineOption(*aim, "", fromFlag);
     applyOption(*aim, false, {"test", "aim_emission", {}}, fromConfig);
-    EXPECT_FALSE(fromFlag.aimEmission);
-    EXPECT_FALSE(fromConfig.aimEmission);
-    EXPECT_TRUE(RenderSettings().aimEmission);
+    EXPECT_FALSE(fromFlag.trace.aim.enabled);
+    EXPECT_FALSE(fromConfig.trace.aim.enabled);
+    EXPECT_TRUE(RenderSettings().trace.aim.enabled);
     EXPECT_TRUE(aim->fingerprinted);
     const CommandResult r = runQsgi("render " + (sourceDir() / "data/cornell/cornell.gltf").string() +
                                     " --no-aim --photons 2000 --no-exr --quiet --out " +

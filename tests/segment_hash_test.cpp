@@ -92,7 +92,7 @@ TEST(SegmentHash, CornellSegmentsKeepTheirBitsAtFrameZeroAndAfterFiveIncremental
         settings.trace.photons = 100000;
         settings.trace.seed = 1;
         settings.trace.sampling = PhotonSampling{expected.sampler, 2};
-        settings.alwaysUpdate = true;
+        settings.update.alwaysUpdate = true;
         EmbreeDevice device;
         FrameSolver solver(scene, device, settings);
 

@@ -65,9 +65,9 @@ std::string readFileBytes(const std::filesystem::path& path) {
 EstimatorSettings NamedEstimator::settings(float radius, int k) const {
     EstimatorSettings s;
     s.kind = kind;
-    s.boundary = rule;
+    s.detp.boundary = rule;
     s.radius = radius;
-    s.k = k;
+    s.photonMap.k = k;
     return s;
 }
 

@@ -29,6 +29,7 @@
 #include <utility>
 #include <vector>
 
+#include "estimate/detp_settings.h"
 #include "estimate/disc_regions.h"
 #include "estimate/fixed_point_power.h"
 #include "scene/scene.h"
@@ -38,11 +39,6 @@
 #include "util/work_counter.h"
 
 namespace qsgi {
-
-enum class DetpBoundary { Clip, Linear, Paper };
-inline constexpr NamedValue<DetpBoundary> kDetpBoundaryNames[] = {
-    {DetpBoundary::Clip, "clip"}, {DetpBoundary::Linear, "linear"}, {DetpBoundary::Paper, "paper"}};
-inline const char* detpBoundaryName(DetpBoundary rule) { return nameOf(kDetpBoundaryNames, rule); }
 
 // Where a segment crosses a disc: (x, y) in units of r in the disc's frame, and the cell there.
 struct DiscCrossing {

@@ -34,7 +34,7 @@ class DetpEstimator final : public Estimator {
 public:
     DetpEstimator(const EstimatorSettings& settings, const EstimatorContext& context)
         : settings_(settings), scene_(context.scene), bvh_(context.bvh), device_(context.device),
-          regions_(context.regions), progress_(context.progress), moments_(settings.boundary == DetpBoundary::Linear),
+          regions_(context.regions), progress_(context.progress), moments_(settings.detp.boundary == DetpBoundary::Linear),
           afterFirstBounce_(context.afterFirstBounce) {
         mayBeTouched_ = context.scene.vertexDynamic;
         mayBeTouched_.resize(scene_.vertexCount(), 0);
@@ -57,9 +57,9 @@ public:
             for (size_t i = 0; i < all.size(); ++i) all[i] = &segments[i];
             sums_.assign(scene_.vertexCount(), DetpVertexSums());
             bruteForceSums(allVertices(), all);
-        } else if (e.detpIndex == DetpIndex::Flann) {
+        } else if (e.detp.index == DetpIndex::Flann) {
             const auto order = e.sortQueries ? mortonOrder(scene_.positions) : inputOrder(scene_.vertexCount());
-            out.irradiance = detpFlannCandidates(scene_, cache, e.radius, e.boundary, regions_, &bvh_, order, afterFirstBounce_);
+            out.irradiance = detpFlannCandidates(scene_, cache, e.radius, e.detp.boundary, regions_, &bvh_, order, afterFirstBounce_);
             computeRadiosity(scene_, out);
             stats.verticesUpdated = scene_.vertexCount();
             return;
@@ -73,7 +73,7 @@ public:
         stats.verticesUpdated = scene_.vertexCount();
     }
 
-    bool canUpdate() const override { return !(settings_.useIndex && settings_.detpIndex == DetpIndex::Flann); }
+    bool canUpdate() const override { return !(settings_.useIndex && settings_.detp.index == DetpIndex::Flann); }
     // The paper's rule reads no disc regions: only a moved vertex counts differently.
     std::vector<uint32_t> verticesToRecompute(const std::vector<uint32_t>& changed,
                                               const std::vector<uint8_t>& vertexMoved) const override {
@@ -158,13 +158,13 @@ private:
 
     DetpDiscs& discs() {
         if (!discs_)
-            discs_ = std::make_unique<DetpDiscs>(device_, scene_, settings_.radius, settings_.boundary, regions_, &bvh_,
+            discs_ = std::make_unique<DetpDiscs>(device_, scene_, settings_.radius, settings_.detp.boundary, regions_, &bvh_,
                                                  &mayBeTouched_, afterFirstBounce_);
         return *discs_;
     }
     std::vector<uint32_t> allVertices() const { return inputOrder(scene_.vertexCount()); }
     Vec3f irradianceAt(uint32_t v) const {
-        return detpVertexIrradiance(sums_[v], regions_ ? &(*regions_)[v] : nullptr, settings_.radius, settings_.boundary,
+        return detpVertexIrradiance(sums_[v], regions_ ? &(*regions_)[v] : nullptr, settings_.radius, settings_.detp.boundary,
                                     quantizer_);
     }
     void remember(uint32_t bounce, const SegmentCrossing& c) {
@@ -349,7 +349,7 @@ private:
     }
 
     DetpVertexSums vertexSums(uint32_t v, const std::vector<const Segment*>& segments) const {
-        return detpVertexSums(scene_, v, segments, settings_.radius, settings_.boundary, regions_, &bvh_, quantizer_,
+        return detpVertexSums(scene_, v, segments, settings_.radius, settings_.detp.boundary, regions_, &bvh_, quantizer_,
                               afterFirstBounce_);
     }
     void bruteForceSums(const std::vector<uint32_t>& vertices, const std::vector<const Segment*>& segments) {

@@ -5,7 +5,7 @@
 namespace qsgi {
 
 bool needsDiscRegions(const EstimatorSettings& s) {
-    return s.kind != EstimatorKind::ImpactCount && s.boundary != DetpBoundary::Paper;
+    return s.kind != EstimatorKind::ImpactCount && s.detp.boundary != DetpBoundary::Paper;
 }
 
 std::vector<uint32_t> movedOnly(const std::vector<uint32_t>& vertices, const std::vector<uint8_t>& vertexMoved) {

@@ -11,34 +11,16 @@
 
 #include "estimate/detp.h"
 #include "estimate/disc_regions.h"
+#include "estimate/estimator_settings.h"
 #include "estimate/vertex_radiosity.h"
 #include "scene/scene.h"
 #include "trace/embree_device.h"
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
 #include "trace/tracked_paths.h"
-#include "util/enum_names.h"
 #include "util/frame_timing.h"
 
 namespace qsgi {
-
-enum class EstimatorKind { ImpactCount, PhotonMap, Detp };
-enum class DetpIndex { Embree, Flann };
-inline constexpr NamedValue<EstimatorKind> kEstimatorNames[] = {
-    {EstimatorKind::ImpactCount, "impact-count"}, {EstimatorKind::PhotonMap, "photon-map"}, {EstimatorKind::Detp, "detp"}};
-inline constexpr NamedValue<DetpIndex> kDetpIndexNames[] = {{DetpIndex::Embree, "embree"}, {DetpIndex::Flann, "flann"}};
-
-struct EstimatorSettings {
-    EstimatorKind kind = EstimatorKind::ImpactCount;
-    float radius = 0.05f;     // photon map: search radius; DETP: disc radius (scene units)
-    int k = 50;               // photon map: neighbours
-    bool useIndex = true;     // false: brute force, the paper's "No Ray Caché" (reference for tests)
-    bool sortQueries = true;  // Morton-ordered queries; false: input order
-    DetpIndex detpIndex = DetpIndex::Embree;
-    // Where a disc meets other geometry (docs/design.md §5): clip (default) or linear; paper is the
-    // published rule (and the textbook photon map), for ablations.
-    DetpBoundary boundary = DetpBoundary::Clip;
-};
 
 // Whether the estimator needs disc regions, and whether with the photon map's coverage.
 bool needsDiscRegions(const EstimatorSettings& settings);
@@ -46,7 +28,6 @@ bool needsDiscRegions(const EstimatorSettings& settings);
 // recomputes.
 std::vector<uint32_t> movedOnly(const std::vector<uint32_t>& vertices, const std::vector<uint8_t>& vertexMoved);
 DiscRegions makeDiscRegions(const EstimatorSettings& settings);
-inline const char* estimatorName(EstimatorKind kind) { return nameOf(kEstimatorNames, kind); }
 
 // What one frame changed, as an update reads it (docs/design.md §6 steps 2–4). The scene, its BVH and
 // the disc regions already hold the new pose.

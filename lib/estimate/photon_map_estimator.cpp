@@ -32,10 +32,10 @@ public:
         const EstimatorSettings& e = settings_;
         if (e.useIndex) {
             out.irradiance.assign(scene_.vertexCount(), Vec3f(0.0f));
-            map_->irradianceAt(scene_, regions_, e.radius, e.k, queryOrder(inputOrder(scene_.vertexCount())), out.irradiance,
+            map_->irradianceAt(scene_, regions_, e.radius, e.photonMap.k, queryOrder(inputOrder(scene_.vertexCount())), out.irradiance,
                                progress_);
         } else {
-            out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.k);
+            out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.photonMap.k);
         }
         computeRadiosity(scene_, out);
         stats.verticesUpdated = scene_.vertexCount();
@@ -54,9 +54,9 @@ public:
         if (keepLists_) {
             // First: a touched vertex's filter changed, its list no longer matches it.
             map_->forget(change.touched);
-            vertices = map_->editLists(scene_, regions_, change.removed, false, e.k);
+            vertices = map_->editLists(scene_, regions_, change.removed, false, e.photonMap.k);
             map_->update(change.removed, change.added, scene_);
-            entered = map_->editLists(scene_, regions_, change.added, true, e.k);
+            entered = map_->editLists(scene_, regions_, change.added, true, e.photonMap.k);
         } else if (e.useIndex) {
             vertices = map_->ballsHolding(scene_, regions_, change.removed);
             map_->update(change.removed, change.added, scene_);
@@ -71,9 +71,9 @@ public:
         stats.estimatorUpdateSeconds = clock.seconds();
         clock.restart();
         if (e.useIndex) {
-            map_->irradianceAt(scene_, regions_, e.radius, e.k, queryOrder(vertices), out.irradiance);
+            map_->irradianceAt(scene_, regions_, e.radius, e.photonMap.k, queryOrder(vertices), out.irradiance);
         } else {
-            out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.k);
+            out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.photonMap.k);
             vertices = inputOrder(scene_.vertexCount());
         }
         computeRadiosity(scene_, out);

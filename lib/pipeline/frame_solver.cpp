@@ -54,7 +54,7 @@ FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSo
       // (docs/design.md §5.1).
       geometry_(settings.estimator, settings.lighting.exactDirect()),
       estimator_(Estimator::create(settings.estimator,
-                                   EstimatorContext{scene_, bvh_, device, geometry_.estimatorRegions(), !settings.fullRecompute,
+                                   EstimatorContext{scene_, bvh_, device, geometry_.estimatorRegions(), !settings.update.fullRecompute,
                                                     &work_, settings.lighting.exactDirect()})),
       tracer_(scene, bvh_, aimedAt(settings.trace, estimator_->reach())) {
     if (settings_.lighting.exactDirect()) lighting_.emplace(settings_.lighting, settings_.trace.seed);
@@ -138,10 +138,10 @@ bool FrameSolver::changeTooLarge(const PoseChange& change, size_t recomputed) co
 }
 
 FromScratchReason FrameSolver::fromScratchReason(const PoseChange& change, size_t recomputed) const {
-    if (settings_.fullRecompute) return FromScratchReason::FullRecompute;
+    if (settings_.update.fullRecompute) return FromScratchReason::FullRecompute;
     if (!estimator_->canUpdate()) return FromScratchReason::EstimatorHasNoUpdate;
     if (mode_ == Mode::FromScratch && !lastCache_) return FromScratchReason::NoKeptState;
-    if (change.any && !settings_.alwaysUpdate && changeTooLarge(change, recomputed)) return FromScratchReason::ChangeTooLarge;
+    if (change.any && !settings_.update.alwaysUpdate && changeTooLarge(change, recomputed)) return FromScratchReason::ChangeTooLarge;
     return FromScratchReason::None;
 }
 
@@ -160,7 +160,7 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     const FromScratchReason why = firstFrame ? FromScratchReason::None : fromScratchReason(change, recomputed.size());
     if (firstFrame || why != FromScratchReason::None) {
         // A frame may update from this one only if one follows and could.
-        const bool updatesMayFollow = updateFollows && !settings_.fullRecompute && estimator_->canUpdate();
+        const bool updatesMayFollow = updateFollows && !settings_.update.fullRecompute && estimator_->canUpdate();
         solveFromScratch(updatesMayFollow, stats);
         stats.fromScratchReason = nameOf(kFromScratchReasonNames, why);
         // After the first frame the tracking state is made at once, so that the frames after it
@@ -214,7 +214,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     const RayCache& cache = *lastCache_;
     const float reach = estimator_->reach();
     const float margin = envelopeMargin(reach > 0, reach, scene_.sceneEpsilon());
-    const Envelope envelope = settings_.useEnvelope ? Envelope::ofAnimation(scene_, margin) : Envelope::everything();
+    const Envelope envelope = settings_.update.useEnvelope ? Envelope::ofAnimation(scene_, margin) : Envelope::everything();
     const Bounds3f gridBounds = envelope.isEverything() ? scene_.animationBounds.expanded(margin) : envelope.bounds();
     // The grid answers two kinds of query: the movers' new bounds (rule (b)) and, for DETP, the
     // discs a frame recomputes. For the first, cells an eighth of the envelope across are fine
@@ -223,7 +223,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     // whole scene (no envelope) gets half as many.
     const float divisions = (reach > 0 ? 32.0f : 8.0f) / (envelope.isEverything() ? 2.0f : 1.0f);
     const float cellSize = std::max(4 * reach, gridBounds.extent() / divisions);
-    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize, settings_.trackedGenerations);
+    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize, settings_.update.trackedGenerations);
     foldedSegments_ = cache.segmentCount() - tracked_->trackedSegments();
     stats.photonSimulationSeconds += clock.seconds();
     clock.restart();
@@ -238,7 +238,7 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
     Stopwatch clock;
     stage("retracing");
     const std::vector<AffectedPath> affected =
-        tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.gridForBlocking, stats);
+        tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.update.gridForBlocking, stats);
     PathChanges changes;
     tracked_->retrace(affected, tracer_, changes, stats);
     stats.photonSimulationSeconds += clock.seconds();
@@ -256,7 +256,7 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
 namespace qsgi {
 
 void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, FrameTiming& stats) {
-    if (!lighting_->solved() || settings_.fullRecompute) {
+    if (!lighting_->solved() || settings_.update.fullRecompute) {
         lighting_->solve(scene_, bvh_, *geometry_.regions(), photons_, result_, stats, &work_);
         return;
     }

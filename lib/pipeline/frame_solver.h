@@ -15,6 +15,7 @@
 #include "estimate/lighting_settings.h"
 #include "estimate/two_pass_lighting.h"
 #include "estimate/vertex_geometry.h"
+#include "pipeline/update_settings.h"
 #include "scene/scene.h"
 #include "trace/envelope.h"
 #include "trace/photon_tracer.h"
@@ -26,17 +27,14 @@
 
 namespace qsgi {
 
+// Each stage's own settings, as RenderSettings holds them.
 struct FrameSolverSettings {
     EstimatorSettings estimator;
     TraceSettings trace;
     // Direct light from the photons or exact, and the final gather (TwoPassLighting).
     LightingSettings lighting;
-    bool fullRecompute = false;  // every frame from scratch
-    bool alwaysUpdate = false;   // never fall back to scratch for a large change (tests, measurements)
-    bool useEnvelope = true;     // false: track every path (for tests and the memory comparison)
-    bool gridForBlocking = true; // false: test every tracked segment for blocking (benchmark baseline)
-    // Retraces of one path before every tracked path is renumbered (TrackedPaths; tests lower it).
-    uint32_t trackedGenerations = TrackedPaths::kGenerations;
+    UpdateSettings update;  // frames after the first: updated or from scratch
+    static_assert(kTrackedGenerations == TrackedPaths::kGenerations, "update_settings.h's default is TrackedPaths' most");
 };
 
 // Why a frame after a run's first was computed from scratch, as timing.json's from_scratch_reason

@@ -215,7 +215,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     TimingLog log;
     log.config = optionValues(settings_, OptionSelection::Logged);
     log.degenerateTriangles = ImpactCount(scene_).degenerateTriangles();
-    log.photons = settings_.photons;
+    log.photons = settings_.trace.photons;
     log.config["threads"] = settings_.threads > 0 ? settings_.threads
                                                   : int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     log.scene = settings_.scenePath;
@@ -260,27 +260,20 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         ImageMetadata m;
         m.strings = {{"qsgi:estimator", estimatorName(settings_.estimator.kind)}, {"qsgi:version", QSGI_VERSION},
                      {"qsgi:scene", settings_.scenePath},
-                     {"qsgi:seed", std::to_string(settings_.seed)}, {"Software", std::string("qsgi ") + QSGI_VERSION}};
-        m.ints = {{"qsgi:frame", frame}, {"qsgi:photons", int(std::min<uint64_t>(settings_.photons, INT32_MAX))},
+                     {"qsgi:seed", std::to_string(settings_.trace.seed)}, {"Software", std::string("qsgi ") + QSGI_VERSION}};
+        m.ints = {{"qsgi:frame", frame}, {"qsgi:photons", int(std::min<uint64_t>(settings_.trace.photons, INT32_MAX))},
                   {"qsgi:spp", settings_.samplesPerPixel}};
         // 0: the estimator has no radius (impact count)
         m.floats = {{"qsgi:radius", settings_.estimator.kind == EstimatorKind::ImpactCount ? 0.0f : settings_.estimator.radius}};
-        m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.k : 0);
+        m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.photonMap.k : 0);
         return m;
     };
-    FrameSolverSettings solverSettings;
-    solverSettings.estimator = settings_.estimator;
-    solverSettings.lighting = settings_.lighting;
-    solverSettings.trace = TraceSettings{settings_.photons, settings_.seed, settings_.maxBounces, EmissionAim{settings_.aimEmission, 0},
-                                         effectiveSampling(settings_)};
-    solverSettings.fullRecompute = settings_.fullRecompute;
-    solverSettings.alwaysUpdate = settings_.alwaysUpdate;
-    solverSettings.useEnvelope = settings_.useEnvelope;
-    solverSettings.gridForBlocking = settings_.blockingGrid;
+    const FrameSolverSettings solverSettings{settings_.estimator, effectiveTrace(settings_.trace), settings_.lighting,
+                                             settings_.update};
     // Built in the rest pose, before any frame: every run refits the same BVHs (docs/design.md §6.0).
     scene_.applyPose(scene_.restPose());
     FrameSolver solver(scene_, device, solverSettings);
-    const ImageSettings imageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.seed};
+    const ImageSettings imageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.trace.seed};
 
     // Previews are tonemapped as frame 0 of the animation is (docs/design.md §6.0), so that any frame
     // range writes the bytes one sequential run would. A run that starts later computes frame 0
@@ -380,7 +373,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         ++outcome.framesWritten;
         if (observer.onFrame)
             observer.onFrame(FrameReport{frame, frame - start, count, frameClock.seconds(),
-                                double(log.photonsMissingScene) / double(std::max<uint64_t>(settings_.photons, 1))});
+                                double(log.photonsMissingScene) / double(std::max<uint64_t>(settings_.trace.photons, 1))});
         if (frame < last_ && observer.stopRequested && observer.stopRequested()) {
             outcome.interrupted = true;
             return outcome;

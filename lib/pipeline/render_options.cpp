@@ -108,13 +108,20 @@ json getCamera(const RenderSettings& s) {
     return s.cameraIndex ? json(*s.cameraIndex) : json(nullptr);
 }
 
-// Every setting is reachable: each field of RenderSettings is set by an option below, except the
-// five that record where values came from (configPath, radiusGiven, qmcBouncesGiven, gatherGiven,
-// framesSource). A field added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 38, "a RenderSettings field was added or removed: give it an option below");
-static_assert(fieldCount<LightingSettings>() == 3, "a LightingSettings field was added or removed: give it an option");
-static_assert(fieldCount<EstimatorSettings>() == 7, "an EstimatorSettings field was added or removed: give it an option");
+// Every setting is reachable: each field of RenderSettings and of the stage settings it holds is
+// set by an option below, except the five that record where values came from (configPath,
+// radiusGiven, qmcBouncesGiven, gatherGiven, framesSource), EmissionAim's margin (FrameSolver
+// sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
+// added without an option fails here; add its option (and count it).
+static_assert(fieldCount<RenderSettings>() == 31, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
+static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
+static_assert(fieldCount<EstimatorSettings>() == 6, "an EstimatorSettings field was added or removed: give it an option");
+static_assert(fieldCount<PhotonMapSettings>() == 1, "a PhotonMapSettings field was added or removed: give it an option");
+static_assert(fieldCount<DetpSettings>() == 2, "a DetpSettings field was added or removed: give it an option");
+static_assert(fieldCount<LightingSettings>() == 3, "a LightingSettings field was added or removed: give it an option");
+static_assert(fieldCount<UpdateSettings>() == 5, "an UpdateSettings field was added or removed: give it an option");
 
 std::vector<RenderOption> declareOptions() {
     using T = OptionType;
@@ -162,26 +169,26 @@ std::vector<RenderOption> declareOptions() {
                  }});
     o.push_back({"k", "--k", T::Integer, 1, double(kMaxK), "", {}, true, "K", "50",
                  "photon map: the nearest impacts per vertex", true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.k = v.get<int>(); },
-                 [](const RenderSettings& s) { return orNull(s.estimator.kind == EstimatorKind::PhotonMap, json(s.estimator.k)); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.photonMap.k = v.get<int>(); },
+                 [](const RenderSettings& s) { return orNull(s.estimator.kind == EstimatorKind::PhotonMap, json(s.estimator.photonMap.k)); }});
     o.push_back({"detp_boundary", "--detp-boundary", T::Choice, 0, 0, "", namesOf(kDetpBoundaryNames), true, "", "clip",
                  "where a disc meets other geometry: clip (only the parts of the disc light can reach from the vertex's "
                  "side count: no leaks through thin occluders), linear (clip plus a linear fit that removes the "
                  "first-order bias at edges) or paper (the published rule, and the textbook photon map: for ablations)",
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) {
-                     s.estimator.boundary = choiceValue(kDetpBoundaryNames, v);
+                     s.estimator.detp.boundary = choiceValue(kDetpBoundaryNames, v);
                  },
                  [](const RenderSettings& s) {
-                     return orNull(s.estimator.kind != EstimatorKind::ImpactCount, json(detpBoundaryName(s.estimator.boundary)));
+                     return orNull(s.estimator.kind != EstimatorKind::ImpactCount, json(detpBoundaryName(s.estimator.detp.boundary)));
                  }});
     o.push_back({"detp_index", "--detp-index", T::Choice, 0, 0, "", namesOf(kDetpIndexNames), true, "", "embree",
                  "DETP's index: embree (exact) or flann (approximate candidates: it misses segments that cross a disc "
                  "but land far away)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.detpIndex = choiceValue(kDetpIndexNames, v); },
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.estimator.detp.index = choiceValue(kDetpIndexNames, v); },
                  [](const RenderSettings& s) {
-                     return orNull(s.estimator.kind == EstimatorKind::Detp, json(nameOf(kDetpIndexNames, s.estimator.detpIndex)));
+                     return orNull(s.estimator.kind == EstimatorKind::Detp, json(nameOf(kDetpIndexNames, s.estimator.detp.index)));
                  }});
     o.push_back({"ray_cache", "--no-ray-cache", T::Boolean, 0, 0, "", {}, false, "", "true",
                  "no spatial index, every vertex against every segment or impact (the paper's \"No Ray Caché\"; "
@@ -222,66 +229,66 @@ std::vector<RenderOption> declareOptions() {
                  "compute every frame from scratch instead of updating the previous one (the same bytes; the "
                  "baseline of the update's speed)",
                  false, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.fullRecompute = v; },
-                 [](const RenderSettings& s) { return json(s.fullRecompute); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.update.fullRecompute = v; },
+                 [](const RenderSettings& s) { return json(s.update.fullRecompute); }});
     o.push_back({"always_update", "--always-update", T::Boolean, 0, 0, "", {}, true, "", "false",
                  "update every frame after the first, even one whose change would cost more to update than to "
                  "recompute (the same bytes; for measuring the update)",
                  false, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.alwaysUpdate = v; },
-                 [](const RenderSettings& s) { return json(s.alwaysUpdate); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.update.alwaysUpdate = v; },
+                 [](const RenderSettings& s) { return json(s.update.alwaysUpdate); }});
     o.push_back({"envelope", "--no-envelope", T::Boolean, 0, 0, "", {}, false, "", "true",
                  "track every light path instead of only those meeting the moving geometry's envelope (the same "
                  "bytes; more memory and work per frame)",
                  false, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.useEnvelope = v; },
-                 [](const RenderSettings& s) { return json(s.useEnvelope); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.update.useEnvelope = v; },
+                 [](const RenderSettings& s) { return json(s.update.useEnvelope); }});
     o.push_back({"blocking_grid", nullptr, T::Boolean, 0, 0, "", {}, true, "", "true",
                  "test every tracked segment against the moved geometry instead of those the grid finds (the "
                  "same bytes; for measuring the grid)",
                  false, false,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.blockingGrid = v; },
-                 [](const RenderSettings& s) { return json(s.blockingGrid); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.update.gridForBlocking = v; },
+                 [](const RenderSettings& s) { return json(s.update.gridForBlocking); }});
     // Photons
     o.push_back({"aim_emission", "--no-aim", T::Boolean, 0, 0, "", {}, false, "", "true",
                  "point, spot and directional lights emit in every direction instead of only toward what photons can "
                  "reach (projection maps; docs/command-line.md)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.aimEmission = v; },
-                 [](const RenderSettings& s) { return json(s.aimEmission); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.trace.aim.enabled = v; },
+                 [](const RenderSettings& s) { return json(s.trace.aim.enabled); }});
     o.push_back({"photons", "--photons", T::Integer, 1, double(kMaxPhotons), " (2^32: the path index is 32 bits)", {},
                  true, "N", "1000000", "photons traced per frame", true, true,
                  [](RenderSettings& s, const json& v, const OptionSource& src) {
-                     s.photons = checkedPhotons(v.get<int64_t>(), src.file, src.place);
+                     s.trace.photons = checkedPhotons(v.get<int64_t>(), src.file, src.place);
                  },
-                 [](const RenderSettings& s) { return json(s.photons); }});
+                 [](const RenderSettings& s) { return json(s.trace.photons); }});
     o.push_back({"seed", "--seed", T::Integer, 0, double(kMaxSeed), "", {}, true, "S", "1",
                  "the random seed: the same inputs and seed give the same bytes for any thread count", true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.seed = v.get<uint64_t>(); },
-                 [](const RenderSettings& s) { return json(s.seed); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.trace.seed = v.get<uint64_t>(); },
+                 [](const RenderSettings& s) { return json(s.trace.seed); }});
     o.push_back({"max_bounces", "--max-bounces", T::Integer, 1, double(kMaxBounces),
                  " (the bounce field of a segment is 16 bits)", {}, true, "B", "32",
                  "the most scatterings a photon's path may have (Russian roulette ends most paths long before)", true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.maxBounces = v.get<uint32_t>(); },
-                 [](const RenderSettings& s) { return json(s.maxBounces); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.trace.maxBounces = v.get<uint32_t>(); },
+                 [](const RenderSettings& s) { return json(s.trace.maxBounces); }});
     o.push_back({"sampler", "--sampler", T::Choice, 0, 0, "", namesOf(kSamplerNames), true, "", "sobol",
                  "where each photon's numbers come from: sobol (an Owen-scrambled Sobol point per photon, each light its "
                  "own sequence; docs/photons-and-radius.md) or random (hashed, independent: the paper's kind)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.sampling.kind = choiceValue(kSamplerNames, v); },
-                 [](const RenderSettings& s) { return json(samplerName(s.sampling.kind)); }});
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.trace.sampling.kind = choiceValue(kSamplerNames, v); },
+                 [](const RenderSettings& s) { return json(samplerName(s.trace.sampling.kind)); }});
     o.push_back({"qmc_bounces", "--qmc-bounces", T::Integer, 0, double(kMaxQmcBounces),
                  " (the Sobol table covers that many scatterings)", {}, true, "K", "2",
                  "sobol only: the first K scatterings take their survival and direction from the Sobol point too (at "
                  "most max_bounces); later ones are hashed",
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) {
-                     s.sampling.qmcBounces = v.get<uint32_t>();
+                     s.trace.sampling.qmcBounces = v.get<uint32_t>();
                      s.qmcBouncesGiven = true;
                  },
                  // The K that shapes the bytes: none under random, capped at max_bounces.
                  [](const RenderSettings& s) {
-                     return orNull(s.sampling.kind == SamplerKind::Sobol, json(effectiveSampling(s).qmcBounces));
+                     return orNull(s.trace.sampling.kind == SamplerKind::Sobol, json(effectiveTrace(s.trace).sampling.qmcBounces));
                  }});
     // Running
     o.push_back({"threads", "--threads", T::Integer, 0, double(kMaxThreads), " (0: all cores)", {}, true, "T", "0",

@@ -3,7 +3,8 @@
 // The config reader (render_settings.cpp), the command line (cli/main.cpp), validateSettings, the
 // fingerprint (run_fingerprint.cpp), the timing log's "config" and the option table of
 // docs/command-line.md are all made from this list (tests/render_options_test.cpp checks the docs
-// and --help against it). Adding an option is one entry here and one field in RenderSettings.
+// and --help against it). Adding an option is one entry here and one field in RenderSettings or in a
+// stage's settings it holds (trace_settings.h, estimator_settings.h, ...), which the entry sets directly.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -7,7 +7,6 @@
 #include <filesystem>
 
 #include "util/error.h"
-#include "trace/ray_cache.h"
 #include "util/json_file.h"
 #include "util/memory.h"
 #include "pipeline/render_options.h"
@@ -26,8 +25,8 @@ int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string&
 
 uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place) {
     const uint64_t photons = uint64_t(checkedInteger(value, 1, kMaxPhotons, source, place, " (2^32: the path index is 32 bits)"));
-    refuseBeyondMemory(photons * RayCache::kBytesPerPath, source, place,
-                       std::to_string(photons) + " photons (at least " + std::to_string(RayCache::kBytesPerPath) +
+    refuseBeyondMemory(photons * kLeastBytesPerPhoton, source, place,
+                       std::to_string(photons) + " photons (at least " + std::to_string(kLeastBytesPerPhoton) +
                            " bytes each in the ray cache)");
     return photons;
 }
@@ -86,10 +85,11 @@ void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderS
     }
 }
 
-PhotonSampling effectiveSampling(const RenderSettings& s) {
-    PhotonSampling sampling = s.sampling;
-    sampling.qmcBounces = sampling.kind == SamplerKind::Random ? 0 : std::min({sampling.qmcBounces, s.maxBounces, kMaxQmcBounces});
-    return sampling;
+TraceSettings effectiveTrace(const TraceSettings& trace) {
+    TraceSettings t = trace;
+    PhotonSampling& sampling = t.sampling;
+    sampling.qmcBounces = sampling.kind == SamplerKind::Random ? 0 : std::min({sampling.qmcBounces, t.maxBounces, kMaxQmcBounces});
+    return t;
 }
 
 void validateSettings(const RenderSettings& s) {
@@ -104,8 +104,8 @@ void validateSettings(const RenderSettings& s) {
     }
     if (s.scenePath.empty()) throw InputError("command line", "SCENE", "no scene given");
     // Checked after the config and the command line are merged: the bound is max_bounces.
-    if (s.qmcBouncesGiven && s.sampling.kind == SamplerKind::Sobol)  // K means nothing under random
-        checkedInteger(s.sampling.qmcBounces, 0, std::min<int64_t>(s.maxBounces, kMaxQmcBounces),
+    if (s.qmcBouncesGiven && s.trace.sampling.kind == SamplerKind::Sobol)  // K means nothing under random
+        checkedInteger(s.trace.sampling.qmcBounces, 0, std::min<int64_t>(s.trace.maxBounces, kMaxQmcBounces),
                        s.configPath.empty() ? "command line" : s.configPath + " or the command line", "qmc_bounces",
                        " (at most max_bounces, and the Sobol table covers 32 scatterings)");
     // The gather replaces the estimate of indirect light only; with direct light from the photons

@@ -10,10 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "estimate/estimator.h"
+#include "estimate/estimator_settings.h"
 #include "estimate/lighting_settings.h"
+#include "pipeline/update_settings.h"
 #include "scene/scene.h"
-#include "trace/photon_numbers.h"
+#include "trace/trace_settings.h"
 
 namespace qsgi {
 
@@ -22,6 +23,8 @@ struct FrameRange {
     int last = -1;  // -1: through the animation's last frame
 };
 
+// The stages' own settings (estimator, lighting, trace, update) are held whole: the option table
+// sets their fields directly, and RenderJob hands FrameSolver the structs themselves.
 struct RenderSettings {
     std::string configPath;     // the config file read, if any (for messages)
     std::string scenePath;
@@ -35,17 +38,12 @@ struct RenderSettings {
     // (docs/photons-and-radius.md). LightingSettings' own defaults are the paper's method.
     LightingSettings lighting{DirectLighting::Exact, 64, 256};
     bool gatherGiven = false;   // gather from the config or the command line
-    uint64_t photons = 1000000;
-    uint64_t seed = 1;
-    uint32_t maxBounces = 32;
-    PhotonSampling sampling;  // sobol with K quasi-random bounces (default) or random
+    // 10^6 photons (TraceSettings' own 10^5 is for the library's callers). K as given: a run
+    // traces with effectiveTrace's, capped at max_bounces.
+    TraceSettings trace{1000000, 1, 32, EmissionAim{}, PhotonSampling{}};
     bool qmcBouncesGiven = false;  // K from the config or the command line (else the default, capped at maxBounces)
+    UpdateSettings update;  // frames after the first (trackedGenerations has no option: TrackedPaths' most)
     int threads = 0;  // 0: all cores
-    bool fullRecompute = false;  // every frame from scratch instead of the incremental update
-    bool alwaysUpdate = false;   // update even frames whose change would cost more than recomputing them
-    bool useEnvelope = true;     // fold paths that never meet the moving geometry's envelope
-    bool aimEmission = true;     // projection maps: lights emit only toward the scene
-    bool blockingGrid = true;    // find blocked segments through the grid (false: test every tracked one)
     std::optional<FrameRange> frames;
     bool resume = false;  // continue outDir after its last complete frame (same fingerprint only)
     bool overwrite = false;  // replace another run's frames and timing.json in outDir
@@ -102,9 +100,9 @@ float defaultRadius(const Scene& scene);
 constexpr float kDefaultRadiusFraction = 0.015f;  // of the animation's bounding-box diagonal
 float defaultRadius(const Bounds3f& animationBounds);
 
-// The sampling a run uses: the default K is capped at max_bounces (an explicit K above it is
-// refused by validateSettings); K means nothing under random and is 0 there.
-PhotonSampling effectiveSampling(const RenderSettings& settings);
+// The trace settings a run uses: as given, but the default K is capped at max_bounces (an
+// explicit K above it is refused by validateSettings); K means nothing under random and is 0 there.
+TraceSettings effectiveTrace(const TraceSettings& trace);
 
 // Checks every option's value by the rules its declaration gives (for settings filled by a
 // program), and what no single option can: a scene is given, K is at most max_bounces.

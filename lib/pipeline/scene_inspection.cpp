@@ -187,7 +187,7 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
     // sampler's defaults, so that choosing DETP does not list its default radius as a choice.
     RenderSettings defaults, alike;
     alike.estimator.kind = settings.estimator.kind;
-    alike.sampling.kind = settings.sampling.kind;
+    alike.trace.sampling.kind = settings.trace.sampling.kind;
     if (!settings.radiusGiven) alike.estimator.radius = settings.estimator.radius;
     const nlohmann::json chosen = optionValues(settings, OptionSelection::All);
     const nlohmann::json standard = optionValues(defaults, OptionSelection::All), standardAlike = optionValues(alike, OptionSelection::All);

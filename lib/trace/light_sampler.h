@@ -10,6 +10,7 @@
 #include "scene/scene.h"
 #include "trace/photon_numbers.h"
 #include "trace/projection_map.h"
+#include "trace/trace_settings.h"
 
 namespace qsgi {
 
@@ -18,14 +19,6 @@ struct PhotonEmission {
     Vec3f direction;
     Vec3f power;       // W per photon, RGB; zero for a photon a spot light does not send
     float originOffsetT = 0;  // tnear for the first segment (area lights: lift off the surface)
-};
-
-// How emission is aimed. margin: how far from geometry a first segment still counts (DETP's
-// disc radius: segments that pass beside an open edge cross its discs; 0 for estimators that
-// count impacts only).
-struct EmissionAim {
-    bool enabled = true;
-    float margin = 0;
 };
 
 class LightSampler {

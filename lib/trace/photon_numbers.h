@@ -19,24 +19,14 @@
 
 #include "trace/counter_rng.h"
 #include "trace/sobol.h"
-#include "util/enum_names.h"
+#include "trace/trace_settings.h"
 
 namespace qsgi {
 
-enum class SamplerKind : uint8_t { Sobol, Random };
-
 constexpr uint32_t kSobolEmissionDimensions = 4;
 constexpr uint32_t kSobolDimensionsPerBounce = 3;
-// The scatterings the shipped table can cover.
-constexpr uint32_t kMaxQmcBounces = (SobolSequence::kDimensions - kSobolEmissionDimensions) / kSobolDimensionsPerBounce;
-
-inline constexpr NamedValue<SamplerKind> kSamplerNames[] = {{SamplerKind::Sobol, "sobol"}, {SamplerKind::Random, "random"}};
-inline const char* samplerName(SamplerKind kind) { return nameOf(kSamplerNames, kind); }
-
-struct PhotonSampling {
-    SamplerKind kind = SamplerKind::Sobol;
-    uint32_t qmcBounces = 2;  // scatterings whose survival and direction come from the Sobol point
-};
+static_assert(kMaxQmcBounces == (SobolSequence::kDimensions - kSobolEmissionDimensions) / kSobolDimensionsPerBounce,
+              "kMaxQmcBounces (trace_settings.h) is the scatterings the shipped table can cover");
 
 class PathNumbers {
 public:

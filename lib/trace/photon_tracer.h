@@ -11,16 +11,11 @@
 #include "trace/photon_source.h"
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
+#include "trace/trace_settings.h"
 
 namespace qsgi {
 
-struct TraceSettings {
-    uint64_t photons = 100000;
-    uint64_t seed = 1;
-    uint32_t maxBounces = 32;
-    EmissionAim aim;  // on by default; its margin is the estimator's reach (FrameSolver sets it)
-    PhotonSampling sampling;
-};
+static_assert(RayCache::kBytesPerPath == kLeastBytesPerPhoton, "a photon's least cost (trace_settings.h) is the cache's");
 
 class PhotonTracer {
 public:
