@@ -61,6 +61,18 @@ bool clippedHeightRange(const Local tri[3], double r, double& lo, double& hi) {
         if (std::min({coord(tri[0]), coord(tri[1]), coord(tri[2])}) > r) return false;
         if (std::max({coord(tri[0]), coord(tri[1]), coord(tri[2])}) < -r) return false;
     }
+    // A triangle well inside the cylinder is its own clip: its extremes are at its corners, and
+    // nothing below adds another (its edges meet no circle in [0, 1], the gradient's points on
+    // the circle lie outside it) — the same range the general case finds, corner for corner.
+    const double inner2 = r * r * (1 - 1e-9);
+    bool inside = true;
+    for (int i = 0; i < 3; ++i)
+        inside = inside && tri[i].x * tri[i].x + tri[i].y * tri[i].y <= inner2 && std::fabs(tri[i].h) < r;
+    if (inside) {
+        lo = std::min({tri[0].h, tri[1].h, tri[2].h});
+        hi = std::max({tri[0].h, tri[1].h, tri[2].h});
+        return true;
+    }
     Polygon poly;
     for (int i = 0; i < 3; ++i) poly.push(tri[i]);
     poly = clipHeight(poly, r, +1);
@@ -113,9 +125,25 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
     Vec3d t, b;
     orthonormalBasis(n, t, b);
     const double r = radius;
+    // Each search stamps the triangles it visits and the vertices it has placed in v's frame or
+    // expanded from; a new stamp forgets the last search.
+    if (scratch.visitedStamp.size() != scene.triangleCount() || scratch.vertexStamp.size() != scene.vertexCount() ||
+        scratch.stamp == UINT32_MAX) {
+        scratch.visitedStamp.assign(scene.triangleCount(), 0);
+        scratch.vertexStamp.assign(scene.vertexCount(), 0);
+        scratch.expandedStamp.assign(scene.vertexCount(), 0);
+        scratch.local.resize(scene.vertexCount());
+        scratch.stamp = 0;
+    }
+    const uint32_t stamp = ++scratch.stamp;
     auto local = [&](uint32_t vertex) {
-        const Vec3d d = Vec3d(scene.positions[vertex]) - origin;
-        return Local{dot(d, t), dot(d, b), dot(d, n)};
+        if (scratch.vertexStamp[vertex] != stamp) {
+            const Vec3d d = Vec3d(scene.positions[vertex]) - origin;
+            scratch.local[vertex] = {dot(d, t), dot(d, b), dot(d, n)};
+            scratch.vertexStamp[vertex] = stamp;
+        }
+        const auto& l = scratch.local[vertex];
+        return Local{l[0], l[1], l[2]};
     };
     auto qualifies = [&](uint32_t tri, double& lo, double& hi) {
         if (!(dot(frontNormals[tri], scene.normals[v]) > kOwnSurfaceCos)) return false;
@@ -128,12 +156,6 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
     double lowest = 0, highest = 0;
     Vec3d centroidSum(0.0);
     double areaSum = 0;
-    // Each search stamps the triangles it visits; a new stamp forgets the last search.
-    if (scratch.visitedStamp.size() != scene.triangleCount() || scratch.stamp == UINT32_MAX) {
-        scratch.visitedStamp.assign(scene.triangleCount(), 0);
-        scratch.stamp = 0;
-    }
-    const uint32_t stamp = ++scratch.stamp;
     auto firstVisit = [&](uint32_t tri) {
         if (scratch.visitedStamp[tri] == stamp) return false;
         scratch.visitedStamp[tri] = stamp;
@@ -157,9 +179,13 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
     own.empty = frontier.empty();
     const double eps = scene.sceneEpsilon();
     if (own.empty) return own;
+    // A corner's triangles are looked at once, whichever reached triangle shares it.
     for (size_t i = 0; i < frontier.size(); ++i) {
         const Triangle& T = scene.triangles[frontier[i]];
-        for (uint32_t corner : T.v)
+        for (uint32_t corner : T.v) {
+            const uint32_t welded = topology.weldedId(corner);
+            if (scratch.expandedStamp[welded] == stamp) continue;
+            scratch.expandedStamp[welded] = stamp;
             for (const uint32_t* it = topology.trianglesBegin(corner); it != topology.trianglesEnd(corner); ++it) {
                 if (!firstVisit(*it)) continue;
                 double lo, hi;
@@ -168,6 +194,7 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
                 lowest = std::min(lowest, lo);
                 highest = std::max(highest, hi);
             }
+        }
     }
     own.epsAbove = float(std::min(highest, r) + eps);
     own.epsBelow = float(std::min(-lowest, r) + eps);

@@ -7,6 +7,7 @@
 // the ceiling's band.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -32,7 +33,10 @@ constexpr float kOwnSurfaceCos = 0.70710678f;
 
 // Reusable working memory of findOwnSurface (one per thread).
 struct OwnSurfaceScratch {
-    std::vector<uint32_t> visitedStamp;  // per triangle: the search that last visited it
+    std::vector<uint32_t> visitedStamp;   // per triangle: the search that last visited it
+    std::vector<uint32_t> vertexStamp;    // per vertex: the search that placed it in `local`
+    std::vector<uint32_t> expandedStamp;  // per welded vertex: the search that expanded from it
+    std::vector<std::array<double, 3>> local;  // per vertex: its place in v's frame (x, y, height)
     uint32_t stamp = 0;
     std::vector<uint32_t> frontier;
 };
