@@ -1,11 +1,36 @@
-#include "trace/segment_grid.h"
+#include "trace/segment_index.h"
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace qsgi {
 
-SegmentGrid::SegmentGrid(const Bounds3f& bounds, float cellSize, int maxCellsPerAxis) : bounds_(bounds) {
+namespace {
+// Bits needed for the values [0, n).
+int bitsFor(uint64_t n) {
+    int bits = 0;
+    while (bits < 64 && (uint64_t(1) << bits) < n) ++bits;
+    return bits;
+}
+}  // namespace
+
+SegmentRefLayout::SegmentRefLayout(size_t slots, uint32_t longestPath) {
+    const int slotBits = std::max(1, bitsFor(slots));
+    const int needed = bitsFor(longestPath);
+    const int placeBits = std::max(needed, std::min(std::max(needed + 1, 5), 31 - slotBits));
+    const int generationBits = std::min(8, 32 - slotBits - placeBits);
+    if (generationBits < 1)
+        throw std::length_error("tracked paths: " + std::to_string(slots) + " paths of up to " + std::to_string(longestPath) +
+                                " tracked segments do not fit the index's 32-bit references");
+    generationBits_ = uint32_t(generationBits);
+    placeMask_ = (1u << placeBits) - 1;
+    slotShift_ = uint32_t(placeBits + generationBits);
+}
+
+SegmentIndex::SegmentIndex(const Bounds3f& bounds, float cellSize, const SegmentRefLayout& layout, size_t slots,
+                           int maxCellsPerAxis)
+    : bounds_(bounds), layout_(layout), slots_(slots) {
     if (bounds.empty()) return;
     const Vec3f extent = bounds.diagonal();
     for (int a = 0; a < 3; ++a) {
@@ -17,7 +42,7 @@ SegmentGrid::SegmentGrid(const Bounds3f& bounds, float cellSize, int maxCellsPer
     cells_.resize(size_t(n_[0]) * size_t(n_[1]) * size_t(n_[2]));
 }
 
-bool SegmentGrid::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
+bool SegmentIndex::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
     if (cells_.empty() || !box.overlaps(bounds_)) return false;
     for (int a = 0; a < 3; ++a) {
         lo[a] = std::clamp(int(std::floor((box.lower[a] - bounds_.lower[a]) * inverseCellSize_[a])), 0, n_[a] - 1);
@@ -26,7 +51,7 @@ bool SegmentGrid::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
     return true;
 }
 
-void SegmentGrid::cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const {
+void SegmentIndex::cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const {
     double t0 = 0, t1 = end;
     if (cells_.empty() || !bounds_.clip(origin, direction, t0, t1)) return;
     // Pieces shorter than the smallest cell edge (so at most 2 cells along each axis, 8 in all),
@@ -67,9 +92,13 @@ void SegmentGrid::cellsOf(const Vec3f& origin, const Vec3f& direction, double en
     }
 }
 
-size_t SegmentGrid::bytes() const {
+size_t SegmentIndex::bytes() const {
     size_t total = cells_.capacity() * sizeof(cells_[0]);
-    for (const auto& c : cells_) total += c.capacity() * sizeof(SegmentRef);
+    for (const auto& c : cells_) total += c.capacity() * sizeof(PackedRef);
+    // A node of the map: its key and list, the next pointer and the cached hash.
+    total += byTriangle_.bucket_count() * sizeof(void*);
+    for (const auto& [triangle, list] : byTriangle_)
+        total += sizeof(triangle) + sizeof(list) + 2 * sizeof(void*) + list.capacity() * sizeof(PackedRef);
     return total;
 }
 
