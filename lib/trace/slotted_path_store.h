@@ -87,6 +87,7 @@ public:
     void rewrite(uint32_t s, uint32_t keep, uint32_t count) {
         Slot& slot = slots_[s];
         if (keep > slot.count || keep > count) throw std::logic_error("SlottedPathStore::rewrite: keeps more than it has");
+        if (wouldWrap(s)) throw std::logic_error("SlottedPathStore::rewrite: the generation would wrap; renumber first");
         if (count > slot.capacity) {
             // Room to grow by a few records, so that the next rewrites fit where they land.
             const uint32_t capacity = (count + 4) & ~3u;
@@ -102,7 +103,6 @@ public:
         live_ = live_ - slot.count + count;
         slot.count = count;
         if (generations_) {
-            if (wouldWrap(s)) throw std::logic_error("SlottedPathStore::rewrite: generation would wrap; renumber first");
             const uint8_t g = ++generation_[s];
             std::fill(recordGeneration_.begin() + slot.begin + keep, recordGeneration_.begin() + slot.begin + count, g);
         }
