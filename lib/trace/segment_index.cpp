@@ -16,16 +16,18 @@ int bitsFor(uint64_t n) {
 }  // namespace
 
 SegmentRefLayout::SegmentRefLayout(size_t slots, uint32_t longestPath) {
-    const int slotBits = std::max(1, bitsFor(slots));
     const int needed = bitsFor(longestPath);
-    const int placeBits = std::max(needed, std::min(std::max(needed + 1, 5), 31 - slotBits));
-    const int generationBits = std::min(8, 32 - slotBits - placeBits);
-    if (generationBits < 1)
-        throw std::length_error("tracked paths: " + std::to_string(slots) + " paths of up to " + std::to_string(longestPath) +
-                                " tracked segments do not fit the index's 32-bit references");
+    const int placeBits = std::max(needed + 1, 5);
+    const int slotBits = bitsFor(slots);
+    // The generation takes what the slot leaves, from 4 bits to 8; slots beyond that go to banks.
+    const int generationBits = std::clamp(32 - placeBits - slotBits, 4, 8);
+    const int lowSlotBits = std::min(slotBits, 32 - placeBits - generationBits);
     generationBits_ = uint32_t(generationBits);
     placeMask_ = (1u << placeBits) - 1;
     slotShift_ = uint32_t(placeBits + generationBits);
+    lowSlotBits_ = uint32_t(lowSlotBits);
+    lowSlotMask_ = uint32_t((uint64_t(1) << lowSlotBits) - 1);
+    banks_ = uint32_t(1) << (slotBits - lowSlotBits);
 }
 
 SegmentIndex::SegmentIndex(const Bounds3f& bounds, float cellSize, const SegmentRefLayout& layout, size_t slots,
@@ -39,11 +41,12 @@ SegmentIndex::SegmentIndex(const Bounds3f& bounds, float cellSize, const Segment
         cellSize_[a] = extent[a] > 0 ? extent[a] / float(n_[a]) : 1.0f;
         inverseCellSize_[a] = 1.0f / cellSize_[a];
     }
-    cells_.resize(size_t(n_[0]) * size_t(n_[1]) * size_t(n_[2]));
+    cells_ = size_t(n_[0]) * size_t(n_[1]) * size_t(n_[2]);
+    lists_.resize(cells_ * layout_.banks());
 }
 
 bool SegmentIndex::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
-    if (cells_.empty() || !box.overlaps(bounds_)) return false;
+    if (cells_ == 0 || !box.overlaps(bounds_)) return false;
     for (int a = 0; a < 3; ++a) {
         lo[a] = std::clamp(int(std::floor((box.lower[a] - bounds_.lower[a]) * inverseCellSize_[a])), 0, n_[a] - 1);
         hi[a] = std::clamp(int(std::floor((box.upper[a] - bounds_.lower[a]) * inverseCellSize_[a])), 0, n_[a] - 1);
@@ -53,7 +56,7 @@ bool SegmentIndex::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
 
 void SegmentIndex::cellsOf(const Vec3f& origin, const Vec3f& direction, double end, std::vector<uint32_t>& cells) const {
     double t0 = 0, t1 = end;
-    if (cells_.empty() || !bounds_.clip(origin, direction, t0, t1)) return;
+    if (cells_ == 0 || !bounds_.clip(origin, direction, t0, t1)) return;
     // Pieces shorter than the smallest cell edge (so at most 2 cells along each axis, 8 in all),
     // each listed in the cells its (slightly padded) box overlaps that the ray itself passes
     // (their padded box clips it): conservative, with no floating-point cell walk to get wrong.
@@ -97,13 +100,19 @@ void SegmentIndex::cellsOf(const Vec3f& origin, const Vec3f& direction, double e
     }
 }
 
+size_t SegmentIndex::countEntries() const {
+    size_t n = 0;
+    for (const auto& list : lists_) n += list.size();
+    return n;
+}
+
 size_t SegmentIndex::bytes() const {
-    size_t total = cells_.capacity() * sizeof(cells_[0]);
-    for (const auto& c : cells_) total += c.capacity() * sizeof(PackedRef);
-    // A node of the map: its key and list, the next pointer and the cached hash.
+    size_t total = lists_.capacity() * sizeof(lists_[0]);
+    for (const auto& list : lists_) total += list.capacity() * sizeof(uint32_t);
+    // A node of the map: its key and list, and the next pointer; and the buckets.
     total += byTriangle_.bucket_count() * sizeof(void*);
-    for (const auto& [triangle, list] : byTriangle_)
-        total += sizeof(triangle) + sizeof(list) + 2 * sizeof(void*) + list.capacity() * sizeof(PackedRef);
+    for (const auto& [key, list] : byTriangle_)
+        total += sizeof(key) + sizeof(list) + sizeof(void*) + list.capacity() * sizeof(uint32_t);
     return total;
 }
 

@@ -129,14 +129,13 @@ void TrackedPaths::indexSlots(uint32_t first, uint32_t last) {
                 run.cellsEnd.push_back(uint32_t(run.cells.size()));
             }
     });
-    const SegmentRefLayout& layout = index_.layout();
     index_.list([&](auto&& emit) {
         for (size_t c = 0; c < chunks; ++c) {
             const CellsOfRun& run = runs[c];
             size_t n = 0;
             for (uint32_t s = first + uint32_t(c * kChunk); s < std::min<uint32_t>(last, first + uint32_t((c + 1) * kChunk)); ++s)
                 for (uint32_t j = 0; j < store_.slot(s).count; ++j, ++n)
-                    emit(layout.pack({s, j, store_.generation(s)}), run.cells.data() + run.cellsBegin(n),
+                    emit(SegmentRef{s, j, store_.generation(s)}, run.cells.data() + run.cellsBegin(n),
                          run.cellsEnd[n] - run.cellsBegin(n));
         }
     });
@@ -144,12 +143,12 @@ void TrackedPaths::indexSlots(uint32_t first, uint32_t last) {
         for (uint32_t j = 0; j < store_.slot(s).count; ++j) {
             const uint32_t triangle = store_.at<0>(s, j).triangle;
             if (triangle != kNoTriangle && source_->surface(triangle).dynamic)
-                index_.listOnTriangle(triangle, layout.pack({s, j, store_.generation(s)}));
+                index_.listOnTriangle(triangle, SegmentRef{s, j, store_.generation(s)});
         }
 }
 
 uint64_t TrackedPaths::segmentsListedOn(const std::vector<uint32_t>& triangles) const {
-    return index_.countListedOn(triangles, [&](PackedRef p) { return isLive(p); });
+    return index_.countListedOn(triangles, [&](const SegmentRef& r) { return isLive(r); });
 }
 
 std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>& movedTriangles,
@@ -158,16 +157,12 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
                                                      bool useGrid, FrameTiming& stats) {
     Stopwatch clock;
     constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
-    const SegmentRefLayout& layout = index_.layout();
-    auto live = [&](PackedRef p) { return isLive(p); };
+    auto live = [&](const SegmentRef& r) { return isLive(r); };
     // Per affected path, the first place to retrace from: (slot, place).
     std::vector<std::pair<uint32_t, uint32_t>> byImpact;
     // (a) A segment that hit a triangle that moved: the photon would now land elsewhere.
     for (uint32_t triangle : movedTriangles)
-        stats.impactCandidates += index_.visitListedOn(triangle, live, [&](PackedRef p) {
-            const SegmentRef r = layout.unpack(p);
-            byImpact.push_back({r.slot, r.place});
-        });
+        stats.impactCandidates += index_.visitListedOn(triangle, live, [&](const SegmentRef& r) { byImpact.push_back({r.slot, r.place}); });
     auto firstPerPath = [](std::vector<std::pair<uint32_t, uint32_t>>& list) {
         std::sort(list.begin(), list.end());
         list.erase(std::unique(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
@@ -196,10 +191,7 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
     if (useGrid) {
         std::vector<Bounds3f> boxes;
         for (const Bounds3f& b : newBounds) boxes.push_back(b.expanded(eps));
-        index_.visitNear(boxes, live, [&](PackedRef p) {
-            const SegmentRef r = layout.unpack(p);
-            candidates.push_back({r.slot, r.place});
-        });
+        index_.visitNear(boxes, live, [&](const SegmentRef& r) { candidates.push_back({r.slot, r.place}); });
     } else {
         for (uint32_t s = 0; s < trackedPaths(); ++s)
             for (uint32_t j = 0; j < store_.slot(s).count; ++j) {
@@ -251,14 +243,35 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
     return affected;
 }
 
+// A retrace's new tails: per affected path (in order) its segments, and per segment the grid
+// cells it passes, held in fixed chunks of paths.
+struct TrackedPaths::NewTails {
+    std::vector<CellsOfRun> runs;
+
+    const CellsOfRun& runOf(size_t i) const { return runs[i / kChunk]; }
+    uint32_t first(size_t i) const { return runOf(i).segmentsBegin(i % kChunk); }  // into runOf(i).segments
+    uint32_t length(size_t i) const { return runOf(i).segmentsEnd[i % kChunk] - first(i); }
+};
+
 void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes,
                            FrameTiming& stats) {
     Stopwatch clock;
-    // Stage 1: the new tails and the grid cells each new segment passes, traced in parallel
-    // from the segment each path is retraced from (read, not changed: nothing is committed yet).
-    std::vector<CellsOfRun> runs((affected.size() + kChunk - 1) / kChunk);
-    tbb::parallel_for(size_t(0), runs.size(), [&](size_t c) {
-        CellsOfRun& run = runs[c];
+    const size_t removed = changes.removed.size(), added = changes.added.size();
+    commit(affected, traceTails(affected, tracer), changes);
+    stats.pathsRetraced += affected.size();
+    stats.segmentsRemoved += changes.removed.size() - removed;
+    stats.segmentsAdded += changes.added.size() - added;
+    stats.retraceSeconds += clock.seconds();
+}
+
+TrackedPaths::NewTails TrackedPaths::traceTails(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer) const {
+    // From the segment each path is retraced from, with its numbers: fixed chunks of paths in
+    // parallel, each writing its own run, so nothing depends on the schedule. The cells are
+    // found here too (the index is only read).
+    NewTails tails;
+    tails.runs.resize((affected.size() + kChunk - 1) / kChunk);
+    tbb::parallel_for(size_t(0), tails.runs.size(), [&](size_t c) {
+        CellsOfRun& run = tails.runs[c];
         Segment start;
         for (size_t i = c * kChunk; i < std::min(affected.size(), (c + 1) * kChunk); ++i) {
             const AffectedPath& a = affected[i];
@@ -272,18 +285,16 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
             run.cellsEnd.push_back(uint32_t(run.cells.size()));
         }
     });
-    auto runOf = [&](size_t i) -> const CellsOfRun& { return runs[i / kChunk]; };
-    auto tailLength = [&](size_t i) {
-        const CellsOfRun& run = runOf(i);
-        return run.segmentsEnd[i % kChunk] - run.segmentsBegin(i % kChunk);
-    };
+    return tails;
+}
 
-    // Stage 2: commit, in path order (so the store's layout is the same for any thread count).
+void TrackedPaths::commit(const std::vector<AffectedPath>& affected, const NewTails& tails, PathChanges& changes) {
+    auto keepOf = [&](size_t i) { return affected[i].bounce - firstBounce_[affected[i].slot]; };
     // Renumber first if a path would outgrow the references' places or a generation would wrap.
     uint32_t longest = 0;
     bool wraps = false;
     for (size_t i = 0; i < affected.size(); ++i) {
-        longest = std::max(longest, affected[i].bounce - firstBounce_[affected[i].slot] + tailLength(i));
+        longest = std::max(longest, keepOf(i) + tails.length(i));
         wraps = wraps || store_.wouldWrap(affected[i].slot);
     }
     if (!index_.layout().holds(longest)) renumber(SegmentRefLayout(trackedPaths(), longest));
@@ -292,87 +303,62 @@ void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const Phot
     // The old tails out, decoded before the new ones overwrite them.
     std::vector<uint64_t> removedAt(affected.size() + 1, changes.removed.size()), addedAt(affected.size() + 1, changes.added.size());
     for (size_t i = 0; i < affected.size(); ++i) {
-        const AffectedPath& a = affected[i];
-        removedAt[i + 1] = removedAt[i] + store_.slot(a.slot).count - (a.bounce - firstBounce_[a.slot]);
-        addedAt[i + 1] = addedAt[i] + tailLength(i);
+        removedAt[i + 1] = removedAt[i] + store_.slot(affected[i].slot).count - keepOf(i);
+        addedAt[i + 1] = addedAt[i] + tails.length(i);
     }
     changes.removed.resize(removedAt.back());
     changes.added.resize(addedAt.back());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, affected.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i)
-            decode(affected[i].slot, affected[i].bounce - firstBounce_[affected[i].slot], store_.slot(affected[i].slot).count,
-                   changes.removed.data() + removedAt[i]);
+            decode(affected[i].slot, keepOf(i), store_.slot(affected[i].slot).count, changes.removed.data() + removedAt[i]);
     });
-    // Each path's place in the store (the store moves a path that outgrew its room), then each
-    // writes only its own records: in parallel.
+    // Each path's place in the store, in path order (so the layout is the same for any thread
+    // count; the store moves a path that outgrew its room); then each path writes only its own
+    // records: in parallel.
     for (size_t i = 0; i < affected.size(); ++i) {
-        const AffectedPath& a = affected[i];
-        const uint32_t keep = a.bounce - firstBounce_[a.slot];
-        store_.rewrite(a.slot, keep, keep + tailLength(i));
-        retracedSinceSweep_[a.slot >> 6] |= uint64_t(1) << (a.slot & 63);
+        store_.rewrite(affected[i].slot, keepOf(i), keepOf(i) + tails.length(i));
+        retracedSinceSweep_[affected[i].slot >> 6] |= uint64_t(1) << (affected[i].slot & 63);
     }
     tbb::parallel_for(tbb::blocked_range<size_t>(0, affected.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            const AffectedPath& a = affected[i];
-            const CellsOfRun& run = runOf(i);
-            const auto tail = run.segments.begin() + run.segmentsBegin(i % kChunk);
-            Record* records = &store_.at<0>(a.slot, a.bounce - firstBounce_[a.slot]);
-            for (uint32_t j = 0; j < tailLength(i); ++j) records[j] = recordOf(tail[j]);
-            std::copy_n(tail, tailLength(i), changes.added.begin() + int64_t(addedAt[i]));
+            const auto tail = tails.runOf(i).segments.begin() + tails.first(i);
+            Record* records = &store_.at<0>(affected[i].slot, keepOf(i));
+            for (uint32_t j = 0; j < tails.length(i); ++j) records[j] = recordOf(tail[j]);
+            std::copy_n(tail, tails.length(i), changes.added.begin() + int64_t(addedAt[i]));
         }
     });
     // The new segments listed: in the grid's cells (filled in parallel, each in path order), and
     // on the dynamic triangles they hit.
-    const SegmentRefLayout& layout = index_.layout();
     auto forEachNew = [&](auto&& visit) {
-        for (size_t i = 0; i < affected.size(); ++i) {
-            const AffectedPath& a = affected[i];
-            const uint32_t keep = a.bounce - firstBounce_[a.slot];
-            const CellsOfRun& run = runOf(i);
-            const uint32_t first = run.segmentsBegin(i % kChunk);
-            for (uint32_t j = 0; j < tailLength(i); ++j)
-                visit(run, first + j, layout.pack({a.slot, keep + j, store_.generation(a.slot)}));
-        }
+        for (size_t i = 0; i < affected.size(); ++i)
+            for (uint32_t j = 0; j < tails.length(i); ++j)
+                visit(tails.runOf(i), tails.first(i) + j, SegmentRef{affected[i].slot, keepOf(i) + j, store_.generation(affected[i].slot)});
     };
     index_.list([&](auto&& emit) {
-        forEachNew([&](const CellsOfRun& run, uint32_t n, PackedRef ref) {
+        forEachNew([&](const CellsOfRun& run, uint32_t n, const SegmentRef& ref) {
             emit(ref, run.cells.data() + run.cellsBegin(n), run.cellsEnd[n] - run.cellsBegin(n));
         });
     });
-    forEachNew([&](const CellsOfRun& run, uint32_t n, PackedRef ref) {
+    forEachNew([&](const CellsOfRun& run, uint32_t n, const SegmentRef& ref) {
         const Segment& x = run.segments[n];
         if (x.hasImpact() && x.impactDynamic) index_.listOnTriangle(x.triangle, ref);
     });
-    stats.pathsRetraced += affected.size();
-    stats.segmentsRemoved += removedAt.back() - removedAt.front();
-    stats.segmentsAdded += addedAt.back() - addedAt.front();
     sweepIfStale();
-    stats.retraceSeconds += clock.seconds();
 }
 
 void TrackedPaths::sweepIfStale() {
     // Only entries of paths retraced since the last sweep can be stale: the rest are kept on a
     // look at a bitmap that stays in cache, not at scattered records.
     if (index_.wantsSweep()) {
-        const SegmentRefLayout& layout = index_.layout();
-        index_.sweep([&](PackedRef p) {
-            const SegmentRef r = layout.unpack(p);
-            return !(retracedSinceSweep_[r.slot >> 6] >> (r.slot & 63) & 1) || store_.isLive(r.slot, r.place, r.generation);
-        });
+        index_.sweep([&](const SegmentRef& r) { return !(retracedSinceSweep_[r.slot >> 6] >> (r.slot & 63) & 1) || isLive(r); });
         std::fill(retracedSinceSweep_.begin(), retracedSinceSweep_.end(), uint64_t(0));
     }
     // References name slots and places, not positions: compacting the store keeps them.
     store_.compactIfWasteful();
 }
 
-void TrackedPaths::renumber(const SegmentRefLayout& layout) {
-    const SegmentRefLayout old = index_.layout();
-    index_.rewriteAll(layout, [&](PackedRef p, PackedRef& out) {
-        const SegmentRef r = old.unpack(p);
-        if (!store_.isLive(r.slot, r.place, r.generation)) return false;
-        out = layout.pack({r.slot, r.place, 0});
-        return true;
-    });
+void TrackedPaths::renumber(SegmentRefLayout layout) {
+    index_.renumber(layout, [&](const SegmentRef& r) { return isLive(r); });
     store_.renumber(std::min(generations_, layout.generations()));
     std::fill(retracedSinceSweep_.begin(), retracedSinceSweep_.end(), uint64_t(0));
 }
@@ -380,11 +366,7 @@ void TrackedPaths::renumber(const SegmentRefLayout& layout) {
 void TrackedPaths::segmentsNear(const std::vector<Bounds3f>& boxes, std::vector<Segment>& out) const {
     out.clear();
     std::vector<std::pair<uint32_t, uint32_t>> refs;  // (slot, place)
-    const SegmentRefLayout& layout = index_.layout();
-    index_.visitNear(boxes, [&](PackedRef p) { return isLive(p); }, [&](PackedRef p) {
-        const SegmentRef r = layout.unpack(p);
-        refs.push_back({r.slot, r.place});
-    });
+    index_.visitNear(boxes, [&](const SegmentRef& r) { return isLive(r); }, [&](const SegmentRef& r) { refs.push_back({r.slot, r.place}); });
     out.resize(refs.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, refs.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) decode(refs[i].first, refs[i].second, refs[i].second + 1, &out[i]);

@@ -94,16 +94,18 @@ private:
     static Record recordOf(const Segment& s) { return {s.origin, s.direction, s.length, s.triangle}; }
     // Slot s's segments at places [from, to), decoded into out[0, to − from).
     void decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) const;
-    bool isLive(PackedRef p) const {
-        const SegmentRef r = index_.layout().unpack(p);
-        return store_.isLive(r.slot, r.place, r.generation);
-    }
+    bool isLive(const SegmentRef& r) const { return store_.isLive(r.slot, r.place, r.generation); }
     double reach(const Record& r) const;  // how far along the ray the grid lists it
+    // The retrace's two stages: the new tails traced (in parallel; nothing changes), then
+    // committed to the store and the index (the old tails decoded into changes.removed first).
+    struct NewTails;
+    NewTails traceTails(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer) const;
+    void commit(const std::vector<AffectedPath>& affected, const NewTails& tails, PathChanges& changes);
     // Lists every segment of slots [first, last), cells found in parallel.
     void indexSlots(uint32_t first, uint32_t last);
     // Every generation back to 0, the index's references rewritten (in `layout`): before a
     // generation would wrap around, or a path outgrow the references' places.
-    void renumber(const SegmentRefLayout& layout);
+    void renumber(SegmentRefLayout layout);
     // Drops stale index entries once they are worth a sweep, and compacts the store once
     // relocated paths left a quarter of it as garbage.
     void sweepIfStale();
