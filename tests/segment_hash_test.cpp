@@ -110,22 +110,22 @@ TEST(SegmentHash, CornellSegmentsKeepTheirBitsAtFrameZeroAndAfterFiveIncremental
             ASSERT_FALSE(t.fromScratch) << "frame " << f;
         }
         ASSERT_NE(solver.trackedPaths(), nullptr);
-        std::vector<const Segment*> kept;
+        std::vector<Segment> kept;
         solver.trackedPaths()->allSegments(kept);
         ASSERT_GT(kept.size(), 1000u);
         SegmentHash h5;
         const RayCache fresh = solver.tracer().traceAll();  // frame 5's pose, the solver's BVH
         std::vector<Segment> path;
-        for (const Segment* s : kept) {
-            h5.add(*s);
-            ASSERT_LT(s->path, fresh.pathCount());
+        for (const Segment& s : kept) {
+            h5.add(s);
+            ASSERT_LT(s.path, fresh.pathCount());
             path.clear();
-            fresh.appendPath(s->path, path);
-            ASSERT_LT(s->bounce, path.size()) << "path " << s->path << " bounce " << s->bounce;
+            fresh.appendPath(s.path, path);
+            ASSERT_LT(s.bounce, path.size()) << "path " << s.path << " bounce " << s.bounce;
             SegmentHash one, other;
-            one.add(path[s->bounce]);
-            other.add(*s);
-            ASSERT_EQ(one.value(), other.value()) << "path " << s->path << " bounce " << s->bounce;
+            one.add(path[s.bounce]);
+            other.add(s);
+            ASSERT_EQ(one.value(), other.value()) << "path " << s.path << " bounce " << s.bounce;
         }
         std::printf("%s: frame 0 %zu segments, hash 0x%016llx; after five frames %zu kept segments, hash 0x%016llx\n",
                     samplerName(expected.sampler), size_t(frame0.segmentCount()), static_cast<unsigned long long>(h0.value()),

@@ -23,7 +23,8 @@
 
 #include "estimate/estimator.h"
 #include "estimate/morton_order.h"
-#include "util/modest_growth.h"
+#include "trace/path_groups.h"
+#include "trace/slotted_path_store.h"
 #include "util/stopwatch.h"
 
 namespace qsgi {
@@ -82,31 +83,28 @@ public:
     float reach() const override { return settings_.radius; }
 
     void prepareUpdates(const TrackedPaths& tracked, FrameTiming&) override {
-        bySlot_.assign(tracked.trackedPaths(), PathCrossings());
-        remembered_.clear();
-        rememberedMoments_.clear();
-        liveRemembered_ = 0;
+        const uint32_t slots = uint32_t(tracked.trackedPaths());
+        remembered_ = RememberedStore(slots, {true, moments_});
         if (!settings_.useIndex) return;  // brute force remembers nothing: it is the reference
-        // In blocks, so that the crossings found wait in a bounded buffer, not all at once.
-        std::vector<const Segment*> all;
-        tracked.allSegments(all);
-        constexpr size_t kBlock = 1 << 16;
+        // In blocks of paths, so that the crossings found wait in a bounded buffer, not all at once.
+        constexpr uint32_t kBlock = 1 << 15;
         std::vector<Segment> block;
         std::vector<SegmentCrossing> found;
-        for (size_t first = 0; first < all.size(); first += kBlock) {
+        for (uint32_t first = 0; first < slots; first += kBlock) {
             block.clear();
-            for (size_t i = first; i < std::min(all.size(), first + kBlock); ++i) block.push_back(*all[i]);
+            tracked.segmentsOfSlots(first, std::min(slots, first + kBlock), block);
             discs_->findCrossings(block, DetpDiscs::Discs::Fixed, found);
+            // The block holds slots first, first + 1, … in order, one group of segments each.
+            uint32_t slot = first;
             size_t next = 0;
-            for (size_t i = 0; i < block.size(); ++i) {
-                const Segment& s = block[i];
-                PathCrossings& record = bySlot_[size_t(tracked.slotOf(s.path))];
-                if (record.count == 0) record.begin = remembered_.size();
-                for (; next < found.size() && found[next].segment == i; ++next) remember(s.bounce, found[next]);
-                record.count = uint32_t(remembered_.size() - record.begin);
-            }
+            forEachPathGroup(block, [&](size_t, size_t end) {
+                const size_t begin = next;
+                while (next < found.size() && found[next].segment < end) ++next;
+                remembered_.append(slot, uint32_t(next - begin));
+                for (size_t c = begin; c < next; ++c) remember(slot, uint32_t(c - begin), block[found[c].segment].bounce, found[c]);
+                ++slot;
+            });
         }
-        liveRemembered_ = remembered_.size();
     }
 
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
@@ -140,21 +138,19 @@ public:
     }
 
     size_t stateBytes() const override {
-        return bySlot_.capacity() * sizeof(PathCrossings) + remembered_.capacity() * sizeof(Remembered) +
-               rememberedMoments_.capacity() * sizeof(rememberedMoments_[0]) + sums_.capacity() * sizeof(DetpVertexSums) +
-               mayBeTouched_.capacity();
+        return remembered_.bytes() + sums_.capacity() * sizeof(DetpVertexSums) + mayBeTouched_.capacity();
     }
 
 private:
     // A crossing of a tracked segment at a vertex no move touches: enough to subtract it again.
+    // Per tracked path (TrackedPaths::slotOf), its crossings in bounce order; `linear` also keeps
+    // each crossing's quantised (x, y).
     struct Remembered {
         uint32_t vertex;
         uint32_t bounce;  // of the segment, within its path
     };
-    struct PathCrossings {
-        uint64_t begin = 0;  // into remembered_
-        uint32_t count = 0;  // in bounce order
-    };
+    using Moments = std::array<int32_t, 2>;
+    using RememberedStore = SlottedPathStore<Remembered, Moments>;
 
     DetpDiscs& discs() {
         if (!discs_)
@@ -167,10 +163,10 @@ private:
         return detpVertexIrradiance(sums_[v], regions_ ? &(*regions_)[v] : nullptr, settings_.radius, settings_.detp.boundary,
                                     quantizer_);
     }
-    void remember(uint32_t bounce, const SegmentCrossing& c) {
-        pushBackModestly(remembered_, Remembered{c.vertex, bounce});
-        if (moments_)
-            pushBackModestly(rememberedMoments_, std::array<int32_t, 2>{DetpVertexSums::momentOf(c.at.x), DetpVertexSums::momentOf(c.at.y)});
+    // Crossing j of the slot's record.
+    void remember(uint32_t slot, uint32_t j, uint32_t bounce, const SegmentCrossing& c) {
+        remembered_.at<0>(slot, j) = Remembered{c.vertex, bounce};
+        if (moments_) remembered_.at<1>(slot, j) = Moments{DetpVertexSums::momentOf(c.at.x), DetpVertexSums::momentOf(c.at.y)};
     }
     void add(uint32_t v, const Vec3f& power, const DiscCrossing& at, int sign) {
         sums_[v].add(power, at, quantizer_, moments_, sign);
@@ -184,24 +180,20 @@ private:
         const std::vector<Segment>& removed = change.removed;
         const std::vector<Segment>& added = change.added;
         // Removed, at the discs no move touches: by their remembered crossings.
-        for (size_t i = 0; i < removed.size();) {
-            const uint32_t path = removed[i].path, from = removed[i].bounce;
-            size_t end = i;
-            while (end < removed.size() && removed[end].path == path) ++end;
-            if (const int32_t slot = change.tracked.slotOf(path); slot >= 0) {
-                const PathCrossings& record = bySlot_[size_t(slot)];
-                for (uint64_t c = record.begin; c < record.begin + record.count; ++c) {
-                    const Remembered& r = remembered_[c];
-                    if (r.bounce < from) continue;
-                    const Segment& s = removed[i + (r.bounce - from)];
-                    const int32_t qx = moments_ ? rememberedMoments_[c][0] : 0, qy = moments_ ? rememberedMoments_[c][1] : 0;
-                    sums_[r.vertex].add(s.power, qx, qy, quantizer_, moments_, -1);
-                    ++forgotten;
-                    changed[r.vertex] = 1;
-                }
+        forEachPathGroup(removed, [&](size_t i, size_t) {
+            const uint32_t from = removed[i].bounce;
+            const int32_t slot = change.tracked.slotOf(removed[i].path);
+            if (slot < 0) return;
+            for (uint32_t c = 0; c < remembered_.slot(uint32_t(slot)).count; ++c) {
+                const Remembered& r = remembered_.at<0>(uint32_t(slot), c);
+                if (r.bounce < from) continue;
+                const Segment& s = removed[i + (r.bounce - from)];
+                const Moments q = moments_ ? remembered_.at<1>(uint32_t(slot), c) : Moments{0, 0};
+                sums_[r.vertex].add(s.power, q[0], q[1], quantizer_, moments_, -1);
+                ++forgotten;
+                changed[r.vertex] = 1;
             }
-            i = end;
-        }
+        });
         // Removed, at the discs a move can touch: traced through those (few) again.
         std::vector<SegmentCrossing> found;
         discs_->findCrossings(removed, DetpDiscs::Discs::Refitted, found);
@@ -217,8 +209,7 @@ private:
         // First retraced bounce per path, in path order (both lists are in path order).
         std::vector<std::pair<uint32_t, uint32_t>> retraced;
         for (const auto* list : {&removed, &added})
-            for (const Segment& s : *list)
-                if (retraced.empty() || retraced.back().first != s.path) retraced.push_back({s.path, s.bounce});
+            forEachPathGroup(*list, [&](size_t i, size_t) { retraced.push_back({(*list)[i].path, (*list)[i].bounce}); });
         std::sort(retraced.begin(), retraced.end());
         retraced.erase(std::unique(retraced.begin(), retraced.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
                        retraced.end());
@@ -226,8 +217,7 @@ private:
         std::vector<Segment> block;
         size_t nextPath = 0;
         for (size_t first = 0; first < added.size();) {
-            size_t end = std::min(added.size(), first + kBlock);
-            while (end < added.size() && added[end].path == added[end - 1].path) ++end;
+            const size_t end = pathGroupEnd(added, std::min(added.size(), first + kBlock) - 1);
             block.assign(added.begin() + int64_t(first), added.begin() + int64_t(end));
             discs_->findCrossings(block, DetpDiscs::Discs::All, found);
             for (const SegmentCrossing& c : found) {
@@ -243,7 +233,7 @@ private:
         block.clear();
         found.clear();
         rememberRetraced(change.tracked, retraced, nextPath, retraced.size(), block, found);
-        compactIfStale();
+        remembered_.compactIfWasteful();
         return forgotten;
     }
 
@@ -254,51 +244,21 @@ private:
         size_t a = 0, next = 0;
         for (size_t i = begin; i < end; ++i) {
             const auto [path, from] = retraced[i];
-            PathCrossings& record = bySlot_[size_t(tracked.slotOf(path))];
-            const uint64_t recordBegin = remembered_.size();
-            for (uint64_t c = record.begin; c < record.begin + record.count && remembered_[c].bounce < from; ++c) {
-                pushBackModestly(remembered_, remembered_[c]);
-                if (moments_) pushBackModestly(rememberedMoments_, rememberedMoments_[c]);
-            }
-            while (a < added.size() && added[a].path < path) ++a;
-            for (; a < added.size() && added[a].path == path; ++a) {
-                while (next < found.size() && found[next].segment < a) ++next;
-                for (; next < found.size() && found[next].segment == a; ++next)
-                    if (!mayBeTouched_[found[next].vertex]) remember(added[a].bounce, found[next]);
-            }
-            liveRemembered_ += remembered_.size() - recordBegin;
-            liveRemembered_ -= record.count;
-            record.begin = recordBegin;
-            record.count = uint32_t(remembered_.size() - recordBegin);
+            const uint32_t slot = uint32_t(tracked.slotOf(path));
+            uint32_t keep = 0;
+            while (keep < remembered_.slot(slot).count && remembered_.at<0>(slot, keep).bounce < from) ++keep;
+            // The path's new segments [a, pathEnd) and their crossings [next, stop).
+            while (a < added.size() && added[a].path < path) a = pathGroupEnd(added, a);
+            const size_t pathEnd = a < added.size() && added[a].path == path ? pathGroupEnd(added, a) : a;
+            while (next < found.size() && found[next].segment < a) ++next;
+            size_t stop = next;
+            uint32_t fresh = 0;
+            for (; stop < found.size() && found[stop].segment < pathEnd; ++stop) fresh += !mayBeTouched_[found[stop].vertex];
+            remembered_.rewrite(slot, keep, keep + fresh);
+            for (uint32_t j = keep; next < stop; ++next)
+                if (!mayBeTouched_[found[next].vertex]) remember(slot, j++, added[found[next].segment].bounce, found[next]);
+            a = pathEnd;
         }
-    }
-
-    void compactIfStale() {
-        // Retraced paths leave their old records behind; compact once they are a fifth of the
-        // store (the store is most of DETP's state).
-        if (4 * remembered_.size() > 5 * liveRemembered_ + 4096) compactRemembered();
-    }
-
-    // In place, taking the records in the order they sit in the store: each moves down or stays,
-    // so nothing is overwritten before it has moved, and no second store is needed.
-    void compactRemembered() {
-        std::vector<uint32_t> byPlace;
-        for (uint32_t slot = 0; slot < bySlot_.size(); ++slot)
-            if (bySlot_[slot].count) byPlace.push_back(slot);
-        std::sort(byPlace.begin(), byPlace.end(), [&](uint32_t a, uint32_t b) { return bySlot_[a].begin < bySlot_[b].begin; });
-        uint64_t end = 0;
-        for (uint32_t slot : byPlace) {
-            PathCrossings& record = bySlot_[slot];
-            const auto from = int64_t(record.begin), to = int64_t(end), count = int64_t(record.count);
-            std::copy(remembered_.begin() + from, remembered_.begin() + from + count, remembered_.begin() + to);
-            if (moments_)
-                std::copy(rememberedMoments_.begin() + from, rememberedMoments_.begin() + from + count,
-                          rememberedMoments_.begin() + to);
-            record.begin = end;
-            end += record.count;
-        }
-        remembered_.resize(end);
-        if (moments_) rememberedMoments_.resize(end);
     }
 
     // Index-free (--no-ray-cache): every changed segment against every disc.
@@ -324,8 +284,10 @@ private:
     void recompute(const std::vector<uint32_t>& vertices, const TrackedPaths& tracked, FrameTiming& stats) {
         if (vertices.empty()) return;
         if (!settings_.useIndex) {
-            std::vector<const Segment*> all;
-            tracked.allSegments(all);
+            std::vector<Segment> segments;
+            tracked.allSegments(segments);
+            std::vector<const Segment*> all(segments.size());
+            for (size_t i = 0; i < all.size(); ++i) all[i] = &segments[i];
             for (uint32_t v : vertices) sums_[v] = DetpVertexSums();
             bruteForceSums(vertices, all);
             stats.recomputeCandidates += uint64_t(all.size()) * vertices.size();
@@ -340,10 +302,10 @@ private:
             boxes[i].extend(scene_.positions[vertices[i]]);
             boxes[i] = boxes[i].expanded(pad);
         }
-        std::vector<SegmentRef> near;
-        tracked.refsNear(boxes, near);
+        std::vector<Segment> near;
+        tracked.segmentsNear(boxes, near);
         std::vector<const Segment*> segments(near.size());
-        for (size_t i = 0; i < near.size(); ++i) segments[i] = &tracked.segment(near[i]);
+        for (size_t i = 0; i < near.size(); ++i) segments[i] = &near[i];
         discs_->recompute(segments, quantizer_, vertices, sums_);
         stats.recomputeCandidates += segments.size();
     }
@@ -370,10 +332,7 @@ private:
     std::vector<uint8_t> mayBeTouched_;  // per vertex: a move can touch it (its disc is refitted)
     std::unique_ptr<DetpDiscs> discs_;
     std::vector<DetpVertexSums> sums_;
-    std::vector<PathCrossings> bySlot_;  // per tracked path (TrackedPaths::slotOf)
-    std::vector<Remembered> remembered_;
-    std::vector<std::array<int32_t, 2>> rememberedMoments_;  // `linear`: each crossing's quantised (x, y)
-    size_t liveRemembered_ = 0;
+    RememberedStore remembered_;  // per tracked path
 };
 
 }  // namespace

@@ -9,7 +9,7 @@ namespace qsgi {
 
 // The most retraces of one path before every tracked path is renumbered (TrackedPaths::kGenerations;
 // frame_solver.h checks they agree).
-constexpr uint32_t kTrackedGenerations = 1u << 16;
+constexpr uint32_t kTrackedGenerations = 256;  // a tracked record's generation is one byte
 
 struct UpdateSettings {
     bool fullRecompute = false;   // every frame from scratch

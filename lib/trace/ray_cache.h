@@ -55,6 +55,9 @@ public:
 
     // Largest RGB component any photon starts with: the scale of fixed-point power sums.
     float maxPhotonPower = 0;
+    // What decodes the traced blocks (null for a cache of segments kept as they are): the
+    // tracked paths decode their own records with it too.
+    const std::shared_ptr<const PhotonSource>& source() const { return source_; }
 
     // What a traced path costs at the least (its first segment's record and its index entry), and
     // each segment after the first.

@@ -1,25 +1,36 @@
-// The part of the ray cache that frames search (docs/design.md §6 steps 2–3 and 5): every path that meets
-// the envelope, from its first segment that does. Finds the paths a move affects — from the first
-// segment that hit a triangle that moved, or that a moved triangle now blocks before its impact —
-// retraces them from there with the same random numbers, and swaps the new tails in.
+// The part of the ray cache that frames search (docs/design.md §6 steps 2–3 and 5): every path that
+// meets the envelope, from its first segment that does. Finds the paths a move affects — from the
+// first segment that hit a triangle that moved (rule a), or that a moved triangle now blocks
+// before its impact (rule b) — and retraces them from there with the same random numbers, in two
+// stages: the new tails are traced in parallel, then committed to the store and the index.
+//
+// The state has two owners: the records, one slot per tracked path in a SlottedPathStore, and the
+// SegmentIndex that finds them. A record keeps what the photon source cannot say again, as the
+// ray cache's later records do (ray_cache.h): origin, direction, length and impacted triangle, 32
+// bytes. Power follows from the path's first tracked segment's, kept once per path, by the
+// tracer's own arithmetic; path, bounce and the dynamic flag from the slot, the record's place
+// and the triangle. Segments are handed out decoded.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "trace/envelope.h"
 #include "trace/photon_tracer.h"
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
-#include "trace/segment_grid.h"
+#include "trace/segment_index.h"
+#include "trace/slotted_path_store.h"
 #include "util/frame_timing.h"
 
 namespace qsgi {
 
-// One affected path: retrace from segment `bounce`.
+// One affected path: retrace from segment `bounce`. slot: its slot among the tracked paths.
 struct AffectedPath {
     uint32_t path;
     uint32_t bounce;
+    uint32_t slot;
 };
 
 // The segments one frame's retrace exchanged: old tails and new tails, in path order.
@@ -29,102 +40,87 @@ struct PathChanges {
 
 class TrackedPaths {
 public:
+    // cache: a traced cache (it decodes with its photon source, which this object shares).
     // extension: how far past its impact a segment is followed for the envelope test
-    // (envelopeMargin's reasoning); gridBounds and cellSize: the segment grid's region (what
-    // queries ask about: the envelope's bounds) and cell edge. generations: how many times a path
-    // can be retraced before every path is renumbered (SegmentRef's 16 bits; tests lower it).
+    // (envelopeMargin's reasoning); gridBounds and cellSize: the index's grid (what queries ask
+    // about: the envelope's bounds) and cell edge. generations: how many times a path can be
+    // retraced before every path is renumbered (at most what the references' bits allow; tests
+    // lower it).
     TrackedPaths(const RayCache& cache, const Envelope& envelope, float extension, const Bounds3f& gridBounds,
                  float cellSize, uint32_t generations = kGenerations);
-    static constexpr uint32_t kGenerations = 1u << 16;
+    static constexpr uint32_t kGenerations = SlottedPathStore<>::kMaxGenerations;
 
-    // The paths the move from the previous pose to the current one affects. movedTriangles: the
-    // scene triangles any of whose vertices moved (sorted), triangleMoved the same as flags;
-    // newBounds: the moved triangles' bounds in the current pose; bvh: the current pose.
-    // useGrid = false tests every tracked segment (the baseline the grid is measured against).
-    // Rule (a) reads the segments listed on the moved triangles, rule (b) the grid's cells in
-    // the new bounds: neither scans the tracked segments. Counts and time go to `stats`. Drops
-    // the stale entries it passes.
+    // The paths the move from the previous pose to the current one affects, in increasing path
+    // order. movedTriangles: the scene triangles any of whose vertices moved (sorted),
+    // triangleMoved the same as flags; newBounds: the moved triangles' bounds in the current
+    // pose; bvh: the current pose. useGrid = false tests every tracked segment (the baseline the
+    // grid is measured against). Rule (a) reads the segments listed on the moved triangles, rule
+    // (b) the grid's cells in the new bounds: neither scans the tracked segments. Counts and time
+    // go to `stats`. Drops the stale entries it passes.
     std::vector<AffectedPath> findAffected(const std::vector<uint32_t>& movedTriangles, const std::vector<uint8_t>& triangleMoved,
                                            const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh, bool useGrid,
                                            FrameTiming& stats);
     // Live tracked segments that impacted one of the triangles: what rule (a) will find, known
     // before any work, for the update's price.
     uint64_t segmentsListedOn(const std::vector<uint32_t>& triangles) const;
-    // Retraces the affected paths and swaps their tails in; fills changes.removed/added.
+    // Retraces the affected paths (findAffected's answer) and swaps their tails in; fills
+    // changes.removed/added.
     void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes, FrameTiming& stats);
 
     // The live tracked segments listed in the grid cells that overlap any of the boxes (with
-    // their extension past the impact), each once, in the grid's order: for the blocking test
-    // and the discs an update recomputes. And the segment a reference names (valid until the
-    // next retrace).
-    // Visiting drops the stale entries of the visited cells (no answer changes), so calls must
-    // not overlap.
-    void refsNear(const std::vector<Bounds3f>& boxes, std::vector<SegmentRef>& out) const;
-    const Segment& segment(const SegmentRef& r) const { return *segmentOf(r); }
-    // Every tracked segment, in path order (valid until the next retrace).
-    void allSegments(std::vector<const Segment*>& out) const;
+    // their extension past the impact), each once, in the grid's order: the discs an update
+    // recomputes. Visiting drops the stale entries of the visited cells (no answer changes), so
+    // calls must not overlap.
+    void segmentsNear(const std::vector<Bounds3f>& boxes, std::vector<Segment>& out) const;
+    // The tracked segments of slots [first, last), in path order, appended.
+    void segmentsOfSlots(uint32_t first, uint32_t last, std::vector<Segment>& out) const;
+    void allSegments(std::vector<Segment>& out) const { segmentsOfSlots(0, uint32_t(trackedPaths()), out); }
 
-    size_t trackedPaths() const { return paths_.size(); }
-    uint64_t renumberings() const { return renumberings_; }  // times every path was renumbered
-    // A tracked path's index among the trackedPaths() (fixed for this object's life), −1 if the
-    // path is not tracked: for per-path state kept beside this one.
-    int32_t slotOf(uint32_t path) const { return path < slot_.size() ? slot_[path] : -1; }
-    size_t trackedSegments() const { return liveSegments_; }
+    size_t trackedPaths() const { return pathOf_.size(); }
+    uint64_t renumberings() const { return store_.renumberings(); }  // times every path was renumbered
+    // A tracked path's slot: its index among the trackedPaths() in path order (fixed for this
+    // object's life), −1 if the path is not tracked: for per-path state kept beside this one.
+    int32_t slotOf(uint32_t path) const;
+    size_t trackedSegments() const { return store_.records(); }
     size_t bytes() const;
 
 private:
-    // A tracked path's segments sit in segments_[begin, begin + count), room for `capacity`. A
-    // retrace writes the new tail over the old one when it fits (the kept head stays where it
-    // is, and stays listed), and moves the path to the end of the store, with some room to
-    // spare, when it does not.
-    struct Tracked {
-        uint32_t path;
-        uint16_t generation = 0;  // of its newest segments: bumped by each retrace
-        uint16_t firstBounce;     // the first segment kept: the first that meets the envelope
-        uint64_t begin;           // into segments_
-        uint32_t count;
-        uint32_t capacity;
+    // A tracked segment as stored: what the photon source cannot say again.
+    struct Record {
+        Vec3f origin, direction;
+        float length;
+        uint32_t triangle;
     };
-    // The reference to segment j of t as it is now.
-    SegmentRef refOf(const Tracked& t, uint32_t j) const {
-        return SegmentRef{t.path, generation_[t.begin + j], uint16_t(t.firstBounce + j)};
-    }
-    const Segment* segmentOf(const SegmentRef& r) const;
-    bool isLive(const SegmentRef& r) const;
-    void index(const Tracked& t);
-    // Lists segment j of t in the given grid cells, and on its triangle if dynamic.
-    void indexSegment(const Tracked& t, uint32_t j, const uint32_t* cells, size_t cellCount);
-    void listOnTriangle(const Tracked& t, uint32_t j);
-    double reach(const Segment& s) const;  // how far along the ray the grid lists it
-
-    // Drops stale entries from the grid and the per-triangle lists once they are a quarter of the
-    // live ones, and compacts the store once moved paths left a quarter of its live size as
-    // garbage: these stores are most of a long run's memory.
+    static Record recordOf(const Segment& s) { return {s.origin, s.direction, s.length, s.triangle}; }
+    // Slot s's segments at places [from, to), decoded into out[0, to − from).
+    void decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) const;
+    bool isLive(const SegmentRef& r) const { return store_.isLive(r.slot, r.place, r.generation); }
+    double reach(const Record& r) const;  // how far along the ray the grid lists it
+    // The retrace's two stages: the new tails traced (in parallel; nothing changes), then
+    // committed to the store and the index (the old tails decoded into changes.removed first).
+    struct NewTails;
+    NewTails traceTails(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer) const;
+    void commit(const std::vector<AffectedPath>& affected, const NewTails& tails, PathChanges& changes);
+    // Lists every segment of slots [first, last), cells found in parallel.
+    void indexSlots(uint32_t first, uint32_t last);
+    // Every generation back to 0, the index's references rewritten (in `layout`): before a
+    // generation would wrap around, or a path outgrow the references' places.
+    void renumber(SegmentRefLayout layout);
+    // Drops stale index entries once they are worth a sweep, and compacts the store once
+    // relocated paths left a quarter of it as garbage.
     void sweepIfStale();
-    // Every path's generation back to 0, and the grid and per-triangle lists rebuilt from the
-    // live segments: before a path's generation would wrap around.
-    void renumber();
 
-    Envelope envelope_;
+    std::shared_ptr<const PhotonSource> source_;
     float extension_;
-    uint32_t generations_;
-    uint64_t renumberings_ = 0;
-    std::vector<Segment> segments_;  // tracked tails; paths that outgrew their room leave garbage
-    // Per slot of segments_: the generation its segment was written in (a reference is live if
-    // it names that generation), and how many grid cells list it.
-    std::vector<uint16_t> generation_;
-    std::vector<uint16_t> cellCount_;
-    size_t garbage_ = 0;             // slots of segments_ no path owns
-    mutable size_t gridEntries_ = 0;  // listed in the grid, stale ones included
-    size_t liveGridEntries_ = 0;
-    std::vector<Tracked> paths_;     // increasing path id
-    std::vector<int32_t> slot_;      // path id -> index in paths_, −1 if untracked
-    std::vector<uint64_t> retracedSinceSweep_;  // one bit per path id: its grid entries may be stale
-    size_t liveSegments_ = 0;
-    // Mutable: refsNear drops stale entries as it passes them, which changes no answer.
-    mutable SegmentGrid grid_;
-    // Per scene triangle, the tracked segments that impacted it (dynamic triangles only): rule (a).
-    std::vector<std::vector<SegmentRef>> byTriangle_;
+    uint32_t generations_;  // as asked; the store's limit is also bounded by the layout
+    SlottedPathStore<Record> store_;
+    // Per slot: the path, the bounce of its first tracked segment, and that segment's power.
+    std::vector<uint32_t> pathOf_;  // increasing
+    std::vector<uint16_t> firstBounce_;
+    std::vector<Vec3f> power_;
+    std::vector<uint64_t> retracedSinceSweep_;  // one bit per slot: its index entries may be stale
+    // Mutable: queries drop stale entries as they pass them, which changes no answer.
+    mutable SegmentIndex index_;
 };
 
 }  // namespace qsgi
