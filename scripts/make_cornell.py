@@ -52,6 +52,18 @@ def cross(a, b):
     return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
+def box_walls(white, red, green):
+    """Inward-facing walls of the box x in [-1,1], y in [0,2], z in [-1,1]; the front (z=+1) is
+    open: (name, corner, u, v, material) for grid()."""
+    return [
+        ("Floor", [-1, 0, 1], [2, 0, 0], [0, 0, -2], white),
+        ("Ceiling", [-1, 2, -1], [2, 0, 0], [0, 0, 2], white),
+        ("BackWall", [-1, 0, -1], [2, 0, 0], [0, 2, 0], white),
+        ("LeftWall", [-1, 0, 1], [0, 0, -2], [0, 2, 0], red),
+        ("RightWall", [1, 0, -1], [0, 0, 2], [0, 2, 0], green),
+    ]
+
+
 def box_faces(half, cells):
     """Outward-facing faces of an axis-aligned box centred at the origin, base at y=0."""
     hx, hy, hz = half
@@ -170,15 +182,7 @@ def build(folder, stem, wall_cells, light, animate, add_nodes=None):
     light_material = g.material("Light", [0.78, 0.78, 0.78], [1.0, 1.0, 1.0], LIGHT_RADIANCE)
     block = g.material("Block", WHITE)
 
-    # Inward-facing walls of the box x in [-1,1], y in [0,2], z in [-1,1]; the front (z=+1) is open.
-    walls = [
-        ("Floor", [-1, 0, 1], [2, 0, 0], [0, 0, -2], white),
-        ("Ceiling", [-1, 2, -1], [2, 0, 0], [0, 0, 2], white),
-        ("BackWall", [-1, 0, -1], [2, 0, 0], [0, 2, 0], white),
-        ("LeftWall", [-1, 0, 1], [0, 0, -2], [0, 2, 0], red),
-        ("RightWall", [1, 0, -1], [0, 0, 2], [0, 2, 0], green),
-    ]
-    for name, corner, u, v, mat in walls:
+    for name, corner, u, v, mat in box_walls(white, red, green):
         p, n, i = grid(corner, u, v, wall_cells)
         g.node({"name": name, "mesh": g.mesh(name, p, n, i, mat)})
     if light == "panel":

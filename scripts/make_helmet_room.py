@@ -20,7 +20,7 @@ import sys
 import urllib.parse
 
 sys.path.insert(0, os.path.dirname(__file__))
-from make_cornell import GltfBuilder, box_faces, grid  # noqa: E402
+from make_cornell import GltfBuilder, box_faces, box_walls, grid  # noqa: E402
 
 HELMET = os.path.join("data", "gltf-samples", "models", "FlightHelmet", "glTF", "FlightHelmet.gltf")
 WALL_CELLS = 20      # 5 walls x 21^2 = 2205 vertices
@@ -73,15 +73,7 @@ def build(folder, helmet_path):
 
     white, red, green, block = (g.material("White", WHITE), g.material("Red", RED), g.material("Green", GREEN),
                                 g.material("Block", WHITE))
-    # Inward-facing walls of the room x in [-1,1], y in [0,2], z in [-1,1]; the front (z=+1) is open.
-    walls = [
-        ("Floor", [-1, 0, 1], [2, 0, 0], [0, 0, -2], white),
-        ("Ceiling", [-1, 2, -1], [2, 0, 0], [0, 0, 2], white),
-        ("BackWall", [-1, 0, -1], [2, 0, 0], [0, 2, 0], white),
-        ("LeftWall", [-1, 0, 1], [0, 0, -2], [0, 2, 0], red),
-        ("RightWall", [1, 0, -1], [0, 0, 2], [0, 2, 0], green),
-    ]
-    for name, corner, u, v, material in walls:
+    for name, corner, u, v, material in box_walls(white, red, green):
         p, n, i = grid(corner, u, v, WALL_CELLS)
         g.node({"name": name, "mesh": g.mesh(name, p, n, i, material)})
     p, n, i = box_faces([BLOCK_HALF, BLOCK_HALF, BLOCK_HALF], BLOCK_CELLS)

@@ -420,17 +420,10 @@ TEST(Incremental, RememberedCrossingsLeaveNoTraceAfterAThousandFrames) {
     }
 }
 
-// A change so large that updating would cost more than recomputing (the whole floor under the
-// light moves, so nearly every path hit a moving triangle) is computed from scratch, with the
-// bytes of --full-recompute, and logged as such; when the floor then pauses, the next frame is an
-// update again that retraces nothing (its tracking state is made only then).
-TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
-    AnimatedScene a{"moving floor", [] {
-                        Scene s = testscenes::boxOnFloor(12, 2, Vec3f(0.7f));
-                        testscenes::addPointLight(s, Vec3f(0.3f, 1.5f, 0.2f), Vec3f(10.0f));
-                        return s;
-                    },
-                    "Floor", [](int f) { return Vec3d(0.0, 0.01 * std::min(f, 3), 0.0); }, 6};
+// Runs `a` with the automatic fallback and with --full-recompute side by side for the estimators
+// that update (impact count, photon map, DETP clip): every frame has --full-recompute's bytes,
+// and check(frame, record) judges the automatic run's record of it.
+void expectAutomaticEqualsFull(const AnimatedScene& a, const std::function<void(int, const FrameTiming&)>& check) {
     for (const EstimatorCase& e : {kEstimators[0], kEstimators[1], kEstimators[3]}) {
         SCOPED_TRACE(e.name);
         int moverA = -1, moverB = -1;
@@ -446,18 +439,34 @@ TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
             const std::vector<Vec3f> ri = inc.solve(a.localsAt(incScene, moverA, f), wi).radiosity;
             const std::vector<Vec3f> rf = ref.solve(a.localsAt(fullScene, moverB, f), wf).radiosity;
             EXPECT_TRUE(sameBits(ri, rf)) << "frame " << f << ": first differing vertex " << firstDifference(ri, rf);
-            if (f >= 1 && f <= 3) {  // the floor moves
-                EXPECT_TRUE(wi.fromScratch) << "frame " << f;
-                EXPECT_EQ(wi.fromScratchReason, "change-too-large") << "frame " << f;
-            }
-            if (f >= 4) {  // it pauses
-                EXPECT_FALSE(wi.fromScratch) << "frame " << f;
-                EXPECT_EQ(wi.pathsRetraced, 0u) << "frame " << f;
-                EXPECT_EQ(wi.verticesUpdated, 0u) << "frame " << f;
-            }
             EXPECT_EQ(wf.fromScratchReason, f == 0 ? "" : "full-recompute");
+            check(f, wi);
         }
     }
+}
+
+// A change so large that updating would cost more than recomputing (the whole floor under the
+// light moves, so nearly every path hit a moving triangle) is computed from scratch, with the
+// bytes of --full-recompute, and logged as such; when the floor then pauses, the next frame is an
+// update again that retraces nothing (its tracking state is made only then).
+TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
+    AnimatedScene a{"moving floor", [] {
+                        Scene s = testscenes::boxOnFloor(12, 2, Vec3f(0.7f));
+                        testscenes::addPointLight(s, Vec3f(0.3f, 1.5f, 0.2f), Vec3f(10.0f));
+                        return s;
+                    },
+                    "Floor", [](int f) { return Vec3d(0.0, 0.01 * std::min(f, 3), 0.0); }, 6};
+    expectAutomaticEqualsFull(a, [](int f, const FrameTiming& wi) {
+        if (f >= 1 && f <= 3) {  // the floor moves
+            EXPECT_TRUE(wi.fromScratch) << "frame " << f;
+            EXPECT_EQ(wi.fromScratchReason, "change-too-large") << "frame " << f;
+        }
+        if (f >= 4) {  // it pauses
+            EXPECT_FALSE(wi.fromScratch) << "frame " << f;
+            EXPECT_EQ(wi.pathsRetraced, 0u) << "frame " << f;
+            EXPECT_EQ(wi.verticesUpdated, 0u) << "frame " << f;
+        }
+    });
 }
 
 // The sweeping panel (issue 34): a plate under the light that nearly every photon meets slides
@@ -471,28 +480,13 @@ TEST(Incremental, APanelSweepingUnderTheLightFallsBackEveryFrameFromCountsAlone)
                         return s;
                     },
                     "Plate", [](int f) { return Vec3d(-0.6 + 0.3 * f, 0.0, 0.0); }, 5};
-    for (const EstimatorCase& e : {kEstimators[0], kEstimators[1], kEstimators[3]}) {
-        SCOPED_TRACE(e.name);
-        int moverA = -1, moverB = -1;
-        Scene incScene = prepare(a, moverA), fullScene = prepare(a, moverB);
-        EmbreeDevice device;
-        FrameSolverSettings automatic = solverSettings(e, 0.12f, 3000);
-        automatic.update.alwaysUpdate = false;
-        FrameSolverSettings full = automatic;
-        full.update.fullRecompute = true;
-        FrameSolver inc(incScene, device, automatic), ref(fullScene, device, full);
-        for (int f = 0; f < a.frames; ++f) {
-            FrameTiming wi, wf;
-            const std::vector<Vec3f> ri = inc.solve(a.localsAt(incScene, moverA, f), wi).radiosity;
-            const std::vector<Vec3f> rf = ref.solve(a.localsAt(fullScene, moverB, f), wf).radiosity;
-            EXPECT_TRUE(sameBits(ri, rf)) << "frame " << f << ": first differing vertex " << firstDifference(ri, rf);
-            EXPECT_TRUE(wi.fromScratch) << "frame " << f;
-            EXPECT_EQ(wi.fromScratchReason, f == 0 ? "" : "change-too-large") << "frame " << f;
-            // Decided before any retrace: no path was looked for or traced again.
-            EXPECT_EQ(wi.pathsAffectedByImpact + wi.pathsAffectedByBlocking, 0u) << "frame " << f;
-            EXPECT_EQ(wi.segmentsRemoved, 0u) << "frame " << f;
-        }
-    }
+    expectAutomaticEqualsFull(a, [](int f, const FrameTiming& wi) {
+        EXPECT_TRUE(wi.fromScratch) << "frame " << f;
+        EXPECT_EQ(wi.fromScratchReason, f == 0 ? "" : "change-too-large") << "frame " << f;
+        // Decided before any retrace: no path was looked for or traced again.
+        EXPECT_EQ(wi.pathsAffectedByImpact + wi.pathsAffectedByBlocking, 0u) << "frame " << f;
+        EXPECT_EQ(wi.segmentsRemoved, 0u) << "frame " << f;
+    });
 }
 
 // DETP's FLANN candidates have no update: its frames are computed from scratch, say so, and
