@@ -45,6 +45,27 @@ SegmentIndex::SegmentIndex(const Bounds3f& bounds, float cellSize, const Segment
     lists_.resize(cells_ * layout_.banks());
 }
 
+std::vector<uint8_t> SegmentIndex::cellsOverlapping(const std::vector<Bounds3f>& boxes) const {
+    std::vector<uint8_t> marked(cells_, 0);
+    for (const Bounds3f& box : boxes) {
+        int lo[3], hi[3];
+        if (!cellRange(box, lo, hi)) continue;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x) marked[cellIndex(x, y, z)] = 1;
+    }
+    return marked;
+}
+
+uint64_t SegmentIndex::entriesNear(const std::vector<Bounds3f>& boxes) const {
+    const std::vector<uint8_t> marked = cellsOverlapping(boxes);
+    uint64_t entries = 0;
+    for (size_t c = 0; c < cells_; ++c)
+        if (marked[c])
+            for (uint32_t bank = 0; bank < layout_.banks(); ++bank) entries += lists_[c * layout_.banks() + bank].size();
+    return entries;
+}
+
 bool SegmentIndex::cellRange(const Bounds3f& box, int lo[3], int hi[3]) const {
     if (cells_ == 0 || !box.overlaps(bounds_)) return false;
     for (int a = 0; a < 3; ++a) {

@@ -91,6 +91,10 @@ public:
     // way (the order of the rest is kept): calls must not overlap.
     template <class IsLive, class Visit>
     void visitNear(const std::vector<Bounds3f>& boxes, IsLive&& isLive, Visit&& visit);
+    // The entries listed in the cells that overlap any of the boxes, stale ones and a segment's
+    // several cells included: a bound on what visitNear visits, counted without reading an entry
+    // (what the frame solver prices an update by before it does any of it).
+    uint64_t entriesNear(const std::vector<Bounds3f>& boxes) const;
     // Calls visit(ref) for every live segment listed on the triangle and drops the stale ones.
     // Returns how many entries it read, stale ones included.
     template <class IsLive, class Visit>
@@ -114,6 +118,8 @@ public:
 
 private:
     bool cellRange(const Bounds3f& box, int lo[3], int hi[3]) const;
+    // Per cell, 1 if it overlaps one of the boxes.
+    std::vector<uint8_t> cellsOverlapping(const std::vector<Bounds3f>& boxes) const;
     size_t cellIndex(int x, int y, int z) const { return (size_t(z) * size_t(n_[1]) + size_t(y)) * size_t(n_[0]) + size_t(x); }
     // A cell's list in a bank, and the key of a triangle's.
     std::vector<uint32_t>& cellList(size_t cell, uint32_t bank) { return lists_[cell * layout_.banks() + bank]; }
@@ -162,14 +168,7 @@ void SegmentIndex::list(ForEach&& forEach) {
 
 template <class IsLive, class Visit>
 void SegmentIndex::visitNear(const std::vector<Bounds3f>& boxes, IsLive&& isLive, Visit&& visit) {
-    std::vector<uint8_t> marked(cells_, 0);
-    for (const Bounds3f& box : boxes) {
-        int lo[3], hi[3];
-        if (!cellRange(box, lo, hi)) continue;
-        for (int z = lo[2]; z <= hi[2]; ++z)
-            for (int y = lo[1]; y <= hi[1]; ++y)
-                for (int x = lo[0]; x <= hi[0]; ++x) marked[cellIndex(x, y, z)] = 1;
-    }
+    const std::vector<uint8_t> marked = cellsOverlapping(boxes);
     // A segment is listed in every cell it passes: one bit per (slot, place) keeps it once,
     // without sorting what may be millions of entries; places past the 64 bits are sorted.
     std::vector<uint64_t> seen(slots_, 0);

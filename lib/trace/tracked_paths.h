@@ -63,6 +63,9 @@ public:
     // Live tracked segments that impacted one of the triangles: what rule (a) will find, known
     // before any work, for the update's price.
     uint64_t segmentsListedOn(const std::vector<uint32_t>& triangles) const;
+    // Index entries in the cells that overlap the boxes (SegmentIndex::entriesNear): a bound on
+    // rule (b)'s candidates for a mover now in those boxes, known before any work.
+    uint64_t entriesNear(const std::vector<Bounds3f>& boxes) const { return index_.entriesNear(boxes); }
     // Retraces the affected paths (findAffected's answer) and swaps their tails in; fills
     // changes.removed/added.
     void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes, FrameTiming& stats);
