@@ -107,6 +107,8 @@ public:
     // must be safe to call from several threads) and every triangle's list. The cells keep their
     // capacity: the next retraces fill them again.
     bool wantsSweep() const { return 2 * entries_ > 3 * entriesAfterSweep_; }
+    // Everything listed so far is live (a new index): what wantsSweep measures against.
+    void allLive() { entriesAfterSweep_ = entries_; }
     template <class IsLive>
     void sweep(IsLive&& isLive);
     // Renumbering: every live entry is kept at generation 0, in the new layout; the stale ones

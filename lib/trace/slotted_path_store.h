@@ -3,8 +3,9 @@
 // run of the array, [begin, begin + count), in a room of `capacity`. Rewriting a path's tail
 // writes the new records over the old ones where they fit (the kept head stays where it is) and
 // moves the whole path to the end of the array, with room to grow, where they do not; the room it
-// left is garbage until the store is compacted, in place, once garbage is a quarter of the rooms.
-// A long run rewrites some paths every frame: these arrays are most of its memory.
+// left is garbage until the store is compacted, in place: once garbage is a quarter of the rooms
+// (compactIfWasteful), and before the arrays would grow when an eighth is garbage. A long run
+// rewrites some paths every frame: these arrays are most of its memory.
 //
 // Generations (optional): each slot counts its rewrites and each record keeps the generation it
 // was written in, so that a reference (slot, j, generation) taken when record j was written is
@@ -14,8 +15,7 @@
 //
 // A record may have several columns (one array each, moved together); a column can be switched
 // off, and then holds nothing. Writing is serial; reading from several threads is safe. Positions
-// (slot(s).begin + j) stay valid until the next compaction; pointers into a column until the next
-// rewrite.
+// (slot(s).begin + j) and pointers into a column stay valid until the next rewrite or compaction.
 #pragma once
 
 #include <algorithm>
@@ -90,7 +90,9 @@ public:
         if (wouldWrap(s)) throw std::logic_error("SlottedPathStore::rewrite: the generation would wrap; renumber first");
         if (count > slot.capacity) {
             // Room to grow by a few records, so that the next rewrites fit where they land.
-            const uint32_t capacity = (count + 4) & ~3u;
+            const uint32_t capacity = count + count / 8;
+            // Reclaiming garbage is cheaper than holding arrays a quarter larger for good.
+            if (uint64_t(end()) + capacity > reserved() && 8 * garbage_ >= end() - garbage_) compact();
             const uint32_t begin = end();
             resize(uint64_t(begin) + capacity);
             forEachColumn([&](auto& c) { std::copy_n(c.begin() + slot.begin, keep, c.begin() + begin); });
@@ -126,30 +128,15 @@ public:
         ++renumberings_;
     }
     uint64_t renumberings() const { return renumberings_; }
+    uint64_t compactions() const { return compactions_; }
 
     // Compacts in place once the garbage is a quarter of the rooms: returns whether it did.
     // Taking the slots in the order they sit, each moves down or stays, so nothing is
     // overwritten before it has moved and no second array is needed. Each slot keeps its room
     // (the array grows by rewrites that outgrow theirs only).
     bool compactIfWasteful() {
-        const uint64_t rooms = end() - garbage_;
-        if (!(4 * garbage_ > rooms)) return false;
-        std::vector<uint32_t> byPlace(slots_.size());
-        std::iota(byPlace.begin(), byPlace.end(), 0u);
-        std::sort(byPlace.begin(), byPlace.end(), [&](uint32_t a, uint32_t b) { return slots_[a].begin < slots_[b].begin; });
-        uint32_t to = 0;
-        for (uint32_t s : byPlace) {
-            Slot& slot = slots_[s];
-            if (slot.begin != to) {
-                forEachColumn([&](auto& c) { std::copy_n(c.begin() + slot.begin, slot.count, c.begin() + to); });
-                if (generations_)
-                    std::copy_n(recordGeneration_.begin() + slot.begin, slot.count, recordGeneration_.begin() + to);
-                slot.begin = to;
-            }
-            to += slot.capacity;
-        }
-        resize(to);
-        garbage_ = 0;
+        if (!(4 * garbage_ > end() - garbage_)) return false;
+        compact();
         return true;
     }
 
@@ -167,7 +154,32 @@ public:
     }
 
 private:
+    void compact() {
+        std::vector<uint32_t> byPlace(slots_.size());
+        std::iota(byPlace.begin(), byPlace.end(), 0u);
+        std::sort(byPlace.begin(), byPlace.end(), [&](uint32_t a, uint32_t b) { return slots_[a].begin < slots_[b].begin; });
+        uint32_t to = 0;
+        for (uint32_t s : byPlace) {
+            Slot& slot = slots_[s];
+            if (slot.begin != to) {
+                forEachColumn([&](auto& c) { std::copy_n(c.begin() + slot.begin, slot.count, c.begin() + to); });
+                if (generations_)
+                    std::copy_n(recordGeneration_.begin() + slot.begin, slot.count, recordGeneration_.begin() + to);
+                slot.begin = to;
+            }
+            to += slot.capacity;
+        }
+        resize(to);
+        garbage_ = 0;
+        ++compactions_;
+    }
     uint32_t end() const { return size_; }
+    // Records the arrays hold room for without growing.
+    uint64_t reserved() {
+        uint64_t room = UINT64_MAX;
+        forEachColumn([&](auto& c) { room = std::min<uint64_t>(room, c.capacity()); });
+        return room;
+    }
     void setGenerations(uint32_t generations) {
         generations_ = generations ? std::clamp<uint32_t>(generations, 2, kMaxGenerations) : 0;
     }
@@ -199,7 +211,7 @@ private:
     uint32_t generations_ = 0;
     std::vector<uint8_t> generation_;        // per slot: its rewrites since the last renumbering
     std::vector<uint8_t> recordGeneration_;  // per position: the generation its record was written in
-    uint64_t renumberings_ = 0;
+    uint64_t renumberings_ = 0, compactions_ = 0;
 };
 
 }  // namespace qsgi

@@ -79,6 +79,7 @@ TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, floa
     retracedSinceSweep_.assign((slots + 63) / 64, 0);
     index_ = SegmentIndex(gridBounds, cellSize, layout, slots);
     indexSlots(0, uint32_t(slots));
+    index_.allLive();
 }
 
 double TrackedPaths::reach(const Record& r) const {
