@@ -18,7 +18,7 @@ namespace {
 // Segments and the grid cells each passes, found in parallel for a fixed run of paths: per path
 // the end of its segments, per segment the end of its cells.
 struct CellsOfRun {
-    std::vector<Segment> segments;  // a retrace's new tails (the store's records when indexing)
+    std::vector<Segment> segments;  // a retrace's new tails (none when indexing the store's own records)
     std::vector<uint32_t> segmentsEnd;
     std::vector<uint32_t> cells;
     std::vector<uint32_t> cellsEnd;
