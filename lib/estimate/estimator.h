@@ -76,8 +76,7 @@ public:
     // every other vertex is updated from the segments that changed. All of them by default; an
     // estimator that reads no disc regions recomputes the moved ones only.
     virtual std::vector<uint32_t> verticesToRecompute(const std::vector<uint32_t>& changed,
-                                                      const std::vector<uint8_t>& vertexMoved) const {
-        (void)vertexMoved;
+                                                      const std::vector<uint8_t>& /*vertexMoved*/) const {
         return changed;
     }
     // How far past its impact a segment counts (DETP: r; the others count impacts only): the

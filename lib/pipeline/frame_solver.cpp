@@ -136,13 +136,7 @@ bool FrameSolver::changeTooLarge(const PoseChange& change, size_t recomputed) co
             uint64_t n = 0, m = 0;
             for (const Segment& s : block) {
                 n += s.hasImpact() && s.impactDynamic && change.triangleMoved[s.triangle];
-                for (const Bounds3f& b : change.newBounds) {
-                    double t0 = 0, t1 = double(s.length);
-                    if (b.clip(s.origin, s.direction, t0, t1)) {
-                        ++m;
-                        break;
-                    }
-                }
+                m += rayMeetsAny(change.newBounds, s.origin, s.direction, double(s.length));
             }
             onMoved += n;
             near += m;

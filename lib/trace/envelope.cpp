@@ -21,11 +21,7 @@ Envelope Envelope::ofAnimation(const Scene& scene, float margin) {
 bool Envelope::meets(const Segment& s, float extension) const {
     if (everything_) return true;
     const double end = s.hasImpact() ? double(s.length) + double(extension) : std::numeric_limits<double>::infinity();
-    for (const Bounds3f& b : boxes_) {
-        double t0 = 0, t1 = end;
-        if (b.clip(s.origin, s.direction, t0, t1)) return true;
-    }
-    return false;
+    return rayMeetsAny(boxes_, s.origin, s.direction, end);
 }
 
 Bounds3f Envelope::bounds() const {

@@ -178,32 +178,22 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
     // The test reaches a little past the impact: a tie there is the tracer's to decide, and
     // retracing a path that would not change repeats the full trace exactly.
     const float eps = bvh.rayEpsilon();
+    std::vector<Bounds3f> boxes;
+    for (const Bounds3f& b : newBounds) boxes.push_back(b.expanded(eps));
     auto blocked = [&](const Record& s) {
         const float end = s.triangle != kNoTriangle ? s.length + eps : s.length;
         // The grid lists whole cells: most candidates pass beside the moved bounds themselves.
-        bool near = false;
-        for (const Bounds3f& b : newBounds) {
-            double t0 = 0, t1 = double(end);
-            near = near || b.expanded(eps).clip(s.origin, s.direction, t0, t1);
-        }
-        return near && bvh.movedOccludes(s.origin, s.direction, 0.0f, end, triangleMoved);
+        return rayMeetsAny(boxes, s.origin, s.direction, double(end)) &&
+               bvh.movedOccludes(s.origin, s.direction, 0.0f, end, triangleMoved);
     };
     std::vector<std::pair<uint32_t, uint32_t>> candidates;  // (slot, place)
     if (useGrid) {
-        std::vector<Bounds3f> boxes;
-        for (const Bounds3f& b : newBounds) boxes.push_back(b.expanded(eps));
         index_.visitNear(boxes, live, [&](const SegmentRef& r) { candidates.push_back({r.slot, r.place}); });
     } else {
         for (uint32_t s = 0; s < trackedPaths(); ++s)
             for (uint32_t j = 0; j < store_.slot(s).count; ++j) {
                 const Record& r = store_.at<0>(s, j);
-                for (const Bounds3f& b : newBounds) {
-                    double t0 = 0, t1 = double(r.length) + double(eps);
-                    if (b.expanded(eps).clip(r.origin, r.direction, t0, t1)) {
-                        candidates.push_back({s, j});
-                        break;
-                    }
-                }
+                if (rayMeetsAny(boxes, r.origin, r.direction, double(r.length) + double(eps))) candidates.push_back({s, j});
             }
     }
     stats.blockingCandidates += candidates.size();

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace qsgi {
 
@@ -102,6 +103,11 @@ struct Bounds3f {
     // Clips the part [t0, t1] of the ray o + t·d to the box (in double precision, closed box);
     // false if it misses. t1 may be infinite.
     bool clip(const Vec3f& o, const Vec3f& d, double& t0, double& t1) const;
+    // Whether the part [0, end] of the ray o + t·d meets the box (end may be infinite).
+    bool meetsRay(const Vec3f& o, const Vec3f& d, double end) const {
+        double t0 = 0, t1 = end;
+        return clip(o, d, t0, t1);
+    }
     // Largest coordinate magnitude: what limits float precision of positions.
     float maxAbsCoordinate() const {
         if (empty()) return 0;
@@ -109,6 +115,14 @@ struct Bounds3f {
                         maxComponent(Vec3f(std::fabs(upper.x), std::fabs(upper.y), std::fabs(upper.z))));
     }
 };
+
+// Whether the part [0, end] of the ray o + t·d meets any of the boxes: the test every segment-
+// against-movers question asks (the envelope, the blocking rule's candidates, the fallback's count).
+inline bool rayMeetsAny(const std::vector<Bounds3f>& boxes, const Vec3f& o, const Vec3f& d, double end) {
+    for (const Bounds3f& b : boxes)
+        if (b.meetsRay(o, d, end)) return true;
+    return false;
+}
 
 // Column-major 4x4 affine transform in double precision (glTF's layout).
 struct Transform {
