@@ -447,8 +447,8 @@ void expectAutomaticEqualsFull(const AnimatedScene& a, const std::function<void(
 
 // A change so large that updating would cost more than recomputing (the whole floor under the
 // light moves, so nearly every path hit a moving triangle) is computed from scratch, with the
-// bytes of --full-recompute, and logged as such; when the floor then pauses, the next frame is an
-// update again that retraces nothing (its tracking state is made only then).
+// bytes of --full-recompute, and logged as such with the prediction it judged by; when the floor
+// then pauses, the next frame is an update again that retraces nothing and predicts nothing.
 TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
     AnimatedScene a{"moving floor", [] {
                         Scene s = testscenes::boxOnFloor(12, 2, Vec3f(0.7f));
@@ -460,9 +460,11 @@ TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
         if (f >= 1 && f <= 3) {  // the floor moves
             EXPECT_TRUE(wi.fromScratch) << "frame " << f;
             EXPECT_EQ(wi.fromScratchReason, "change-too-large") << "frame " << f;
+            EXPECT_GT(wi.predictedUpdateShare, 0.8) << "frame " << f;
         }
         if (f >= 4) {  // it pauses
             EXPECT_FALSE(wi.fromScratch) << "frame " << f;
+            EXPECT_EQ(wi.predictedUpdateShare, 0.0) << "frame " << f;
             EXPECT_EQ(wi.pathsRetraced, 0u) << "frame " << f;
             EXPECT_EQ(wi.verticesUpdated, 0u) << "frame " << f;
         }
@@ -483,6 +485,9 @@ TEST(Incremental, APanelSweepingUnderTheLightFallsBackEveryFrameFromCountsAlone)
     expectAutomaticEqualsFull(a, [](int f, const FrameTiming& wi) {
         EXPECT_TRUE(wi.fromScratch) << "frame " << f;
         EXPECT_EQ(wi.fromScratchReason, f == 0 ? "" : "change-too-large") << "frame " << f;
+        if (f > 0) {
+            EXPECT_GT(wi.predictedUpdateShare, 0.8) << "frame " << f;
+        }
         // Decided before any retrace: no path was looked for or traced again.
         EXPECT_EQ(wi.pathsAffectedByImpact + wi.pathsAffectedByBlocking, 0u) << "frame " << f;
         EXPECT_EQ(wi.segmentsRemoved, 0u) << "frame " << f;

@@ -11,6 +11,8 @@
 #include <map>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "trace/photon_tracer.h"
 
 namespace fs = std::filesystem;
@@ -19,8 +21,22 @@ using namespace qsgi;
 fs::path sourceDir() { return fs::path(QSGI_SOURCE_DIR); }
 fs::path sharedDir() { return sourceDir().parent_path() / "shared"; }
 
+namespace {
+// Every test process writes under a folder of its own, so that two test runs at once (the release
+// and sanitizer builds, or a developer's run beside CI) never share a scratch folder; the folder
+// goes when the process ends.
+struct ProcessScratchRoot {
+    fs::path path = fs::temp_directory_path() / ("qsgi_test_" + std::to_string(::getpid()));
+    ~ProcessScratchRoot() {
+        std::error_code ignored;
+        fs::remove_all(path, ignored);
+    }
+};
+}  // namespace
+
 std::string testScratchDir(const std::string& name) {
-    auto p = fs::temp_directory_path() / ("qsgi_test_" + name);
+    static ProcessScratchRoot root;
+    auto p = root.path / name;
     fs::remove_all(p);
     fs::create_directories(p);
     return p.string();

@@ -47,6 +47,13 @@ constexpr double kSegmentsPerListedImpact = 2.0;
 constexpr double kRemoveAndAdd = 2.0;
 constexpr double kRecomputedVertex = 3.0;
 constexpr double kWorthUpdatingBelow = 0.8;
+// Building the tracking state (the tracked paths' store and index, and the estimator's own:
+// DETP's remembered crossings) after a frame solved from scratch costs, per tracked segment,
+// one to three times what solving it from scratch does. Measured at 10^6 photons as the build's
+// share of a full frame over the share of segments tracked: DETP 0.8-1.4 (data/cornell, its
+// flying block, the sweeping panel, data/tree), the walker's 1.8, impact count 3.0 on
+// data/cornell (its full frame is cheap). A frame pays it whole, so the larger figure is taken.
+constexpr double kTrackingBuildPerTrackedShare = 2.0;
 
 }  // namespace
 
@@ -118,7 +125,11 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
     return change;
 }
 
-bool FrameSolver::changeTooLarge(const PoseChange& change, size_t recomputed) const {
+double FrameSolver::trackingBuildShare() const {
+    return mode_ == Mode::Tracking ? 0.0 : kTrackingBuildPerTrackedShare * trackedShare_;
+}
+
+double FrameSolver::predictedUpdateShare(const PoseChange& change, size_t recomputed) const {
     // Segments that impacted a moved triangle (rule a) and segments passing through a mover's
     // new bounds (rule b's candidates): from the index once tracking (the entries of the cells
     // the new bounds overlap, a bound on the candidates), counted in the last frame's cache
@@ -148,14 +159,16 @@ bool FrameSolver::changeTooLarge(const PoseChange& change, size_t recomputed) co
     const double segmentShare = double(listed) * kSegmentsPerListedImpact * kRemoveAndAdd * perSegment +
                                 double(nearMovers) * kBlockingCandidate * perSegment;
     const double vertexShare = double(recomputed) * kRecomputedVertex / double(std::max<size_t>(scene_.vertexCount(), 1));
-    return segmentShare + vertexShare > kWorthUpdatingBelow;
+    return segmentShare + vertexShare + trackingBuildShare();
 }
 
-FromScratchReason FrameSolver::fromScratchReason(const PoseChange& change, size_t recomputed) const {
+FromScratchReason FrameSolver::fromScratchReason(const PoseChange& change, size_t recomputed, FrameTiming& stats) const {
     if (settings_.update.fullRecompute) return FromScratchReason::FullRecompute;
     if (!estimator_->canUpdate()) return FromScratchReason::EstimatorHasNoUpdate;
     if (mode_ == Mode::FromScratch && !lastCache_) return FromScratchReason::NoKeptState;
-    if (change.any && !settings_.update.alwaysUpdate && changeTooLarge(change, recomputed)) return FromScratchReason::ChangeTooLarge;
+    if (!change.any) return FromScratchReason::None;
+    stats.predictedUpdateShare = predictedUpdateShare(change, recomputed);
+    if (!settings_.update.alwaysUpdate && stats.predictedUpdateShare > kWorthUpdatingBelow) return FromScratchReason::ChangeTooLarge;
     return FromScratchReason::None;
 }
 
@@ -171,20 +184,27 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     const std::vector<uint32_t> recomputed = estimator_->verticesToRecompute(changed, change.vertexMoved);
     const double regionSeconds = clock.seconds();
 
-    const FromScratchReason why = firstFrame ? FromScratchReason::None : fromScratchReason(change, recomputed.size());
+    const FromScratchReason why = firstFrame ? FromScratchReason::None : fromScratchReason(change, recomputed.size(), stats);
     if (firstFrame || why != FromScratchReason::None) {
         // A frame may update from this one only if one follows and could.
         const bool updatesMayFollow = updateFollows && !settings_.update.fullRecompute && estimator_->canUpdate();
         solveFromScratch(updatesMayFollow, stats);
         stats.fromScratchReason = nameOf(kFromScratchReasonNames, why);
         // After the first frame the tracking state is made at once, so that the frames after it
-        // pay only their updates; after a fallback, only once a frame updates again.
+        // pay only their updates; after a fallback, only once a frame updates again, and that
+        // frame's price includes it.
         if (firstFrame && updatesMayFollow) startTracking(stats);
     } else {
         stats.fromScratch = false;
-        if (mode_ == Mode::FromScratch) startTracking(stats);
-        // Nothing moved: no path changes, no vertex changes.
-        if (change.any) solveIncrementally(change, recomputed, stats);
+        if (change.any) {
+            if (mode_ == Mode::FromScratch) startTracking(stats);
+            solveIncrementally(change, recomputed, stats);
+        } else if (mode_ == Mode::FromScratch && updateFollows && trackingBuildShare() <= kWorthUpdatingBelow) {
+            // Nothing moved, so nothing changes; a frame that costs nothing else is the time to
+            // build the tracking state, if that costs less than a frame (else the next update
+            // pays for it, or falls back).
+            startTracking(stats);
+        }
     }
     stats.estimationSeconds += regionSeconds;
     if (lighting_) secondPass(change, changed, stats);
@@ -239,6 +259,7 @@ void FrameSolver::startTracking(FrameTiming& stats) {
     const float cellSize = std::max(4 * reach, gridBounds.extent() / divisions);
     tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize, settings_.update.trackedGenerations);
     foldedSegments_ = cache.segmentCount() - tracked_->trackedSegments();
+    trackedShare_ = double(tracked_->trackedSegments()) / double(std::max<uint64_t>(cache.segmentCount(), 1));
     stats.photonSimulationSeconds += clock.seconds();
     clock.restart();
     estimator_->prepareUpdates(*tracked_, stats);

@@ -44,7 +44,7 @@ inline constexpr NamedValue<FromScratchReason> kFromScratchReasonNames[] = {
     {FromScratchReason::None, ""},
     {FromScratchReason::FullRecompute, "full-recompute"},
     {FromScratchReason::EstimatorHasNoUpdate, "estimator"},  // e.g. --detp-index flann
-    {FromScratchReason::ChangeTooLarge, "change-too-large"},  // judged from counts (FrameSolver::changeTooLarge)
+    {FromScratchReason::ChangeTooLarge, "change-too-large"},  // judged from counts (FrameSolver::predictedUpdateShare)
     {FromScratchReason::NoKeptState, "no-kept-state"},  // the frame before kept nothing to update from
 };
 
@@ -104,9 +104,14 @@ private:
     PoseChange pose(const Pose& target);
     // Why this frame cannot or should not be updated (None: update it). `recomputed`: the
     // vertices the estimator would recompute.
-    FromScratchReason fromScratchReason(const PoseChange& change, size_t recomputed) const;
-    // Whether updating would cost more than solving the frame from scratch, from counts alone.
-    bool changeTooLarge(const PoseChange& change, size_t recomputed) const;
+    // The prediction it judges by goes to stats.predictedUpdateShare.
+    FromScratchReason fromScratchReason(const PoseChange& change, size_t recomputed, FrameTiming& stats) const;
+    // What updating to this pose would cost, in shares of a frame solved from scratch, from
+    // counts alone (timing.json's predicted_update_share): the update's own work and, when the
+    // last frame was solved from scratch, the tracking state it must build first.
+    double predictedUpdateShare(const PoseChange& change, size_t recomputed) const;
+    // The share of a from-scratch frame that building the tracking state costs.
+    double trackingBuildShare() const;
     // keepCache: a frame may update from this one (its cache is kept for the tracked paths).
     void solveFromScratch(bool keepCache, FrameTiming& stats);
     // The incremental state from the last frame's cache: tracked paths and the estimator's own.
@@ -138,6 +143,9 @@ private:
     std::optional<RayCache> lastCache_;
     std::unique_ptr<TrackedPaths> tracked_;  // Mode::Tracking
     uint64_t foldedSegments_ = 0;            // Mode::Tracking: the cache's segments not tracked
+    // Of the segments, the share the last tracking build tracked: what a build after a fallback
+    // will cost, before it is made.
+    double trackedShare_ = 1;
     VertexRadiosity result_;
 };
 

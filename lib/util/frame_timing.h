@@ -20,6 +20,10 @@ struct FrameTiming {
     // cost more than recomputing, judged from counts). "" for a frame updated incrementally and for
     // the run's first frame, which is always from scratch (fromScratch says so).
     std::string fromScratchReason;
+    // What updating this frame was predicted to cost, in shares of a from-scratch frame, from
+    // counts before any work (FrameSolver::predictedUpdateShare; 0 where nothing was predicted:
+    // the first frame, a frame nothing moved in, --full-recompute).
+    double predictedUpdateShare = 0;
     double findAffectedSeconds = 0, retraceSeconds = 0;  // the parts of an update's photon time
     double photonSimulationSeconds = 0;  // tracing (or finding and retracing) photons
     double estimationSeconds = 0;        // density estimation, disc regions included
@@ -59,6 +63,7 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("frame", f.frame);
     visit("from_scratch", f.fromScratch);
     visit("from_scratch_reason", f.fromScratchReason);
+    visit("predicted_update_share", f.predictedUpdateShare);
     visit("photon_update_s", f.photonSimulationSeconds);
     visit("find_affected_s", f.findAffectedSeconds);
     visit("retrace_s", f.retraceSeconds);
