@@ -60,11 +60,10 @@ TEST(SceneBvh, EqualDistancesGoToTheLowestTriangleId) {
 
 TEST(Envelope, SegmentsMeetItWithTheirExtensionAndEscapingOnesWithoutEnd) {
     Scene s = testscenes::boxOnFloor(2, 1, Vec3f(0.5f));
-    s.sweptInstanceBounds.assign(s.instances.size(), Bounds3f());
     Bounds3f mover;
     mover.extend(Vec3f(0, 0, 0));
     mover.extend(Vec3f(1, 1, 1));
-    s.sweptInstanceBounds[1] = mover;
+    s.sweptBoxes = {mover};
     const Envelope e = Envelope::ofAnimation(s, 0.1f);
     Segment seg;
     seg.origin = Vec3f(-2, 0.5f, 0.5f);

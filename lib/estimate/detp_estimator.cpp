@@ -3,8 +3,8 @@
 // "+ new − old" to the bit:
 //   - a removed segment leaves by the crossings remembered when it entered — no second trace
 //     through the discs — at every vertex a move can never touch (their crossings never change);
-//     the few discs a move can touch (dynamic vertices and those whose test region meets an
-//     instance's swept bounds) sit in a small refitted BVH, and removed segments are traced
+//     the few discs a move can touch (dynamic vertices and those whose test region meets a
+//     moving instance's swept boxes, Scene::sweptBoxes) sit in a small refitted BVH, and removed segments are traced
 //     through that one only;
 //   - an added segment is traced through every disc once, and its crossings remembered;
 //   - a vertex the move touched (its disc moved, or its regions changed) is recomputed from the
@@ -43,7 +43,7 @@ public:
             // Slightly dilated, so that no rounding between the sweep and a frame's pose can put
             // a frame's moved bounds outside (a larger set only remembers less).
             std::vector<Bounds3f> swept;
-            for (const Bounds3f& b : scene_.sweptInstanceBounds)
+            for (const Bounds3f& b : scene_.sweptBoxes)
                 if (!b.empty()) swept.push_back(b.expanded(64 * scene_.sceneEpsilon()));
             for (uint32_t v : regions_->touchedBy(scene_, swept, mayBeTouched_)) mayBeTouched_[v] = 1;
         }

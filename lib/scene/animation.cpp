@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 
+#include "scene/swept_boxes.h"
 #include "util/error.h"
 #include "util/json_file.h"
 #include "util/nearest_name.h"
@@ -333,16 +334,23 @@ void sweepAnimationBounds(Scene& scene, const Animation& animation) {
     sweepAnimationBounds(scene, animation.lastFrame(), [&](int frame) { return animation.poseAt(frame); });
 }
 
+namespace {
+// Boxes kept per moving instance: each segment of a frame's tracking build is tested against
+// them all (Envelope::meets), so a few; eight follow a mover across a room closely enough.
+constexpr size_t kSweptBoxesPerInstance = 8;
+}  // namespace
+
 void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<Pose(int)>& poseAt) {
     Bounds3f swept = scene.bounds();
-    std::vector<Bounds3f> perInstance(scene.instances.size());
+    // Per instance, its bounds at every pose that moved it, in time order.
+    std::vector<std::vector<Bounds3f>> poses(scene.instances.size());
     std::vector<uint32_t> moved;
     for (int frame = 0; frame <= lastFrame; ++frame) {
         moved.clear();
         if (!scene.applyPose(poseAt(frame), &moved)) continue;
         swept.extend(scene.bounds());
         for (uint32_t i : moved) {
-            perInstance[i].extend(scene.instanceBounds(i));
+            poses[i].push_back(scene.instanceBounds(i));
             // A pose that overflows float (NaN escapes min/max) makes the swept bounds endless,
             // which checkSceneExtent refuses.
             const MeshInstance& inst = scene.instances[i];
@@ -356,9 +364,11 @@ void sweepAnimationBounds(Scene& scene, int lastFrame, const std::function<Pose(
     moved.clear();
     scene.applyPose(scene.restPose(), &moved);
     // An instance that moved away from its rest pose was somewhere in between at rest too.
-    for (uint32_t i : moved) perInstance[i].extend(scene.instanceBounds(i));
+    for (uint32_t i : moved) poses[i].push_back(scene.instanceBounds(i));
     scene.animationBounds = swept;
-    scene.sweptInstanceBounds = std::move(perInstance);
+    scene.sweptBoxes.clear();
+    for (const std::vector<Bounds3f>& p : poses)
+        for (const Bounds3f& b : sweptBoxes(p, kSweptBoxesPerInstance)) scene.sweptBoxes.push_back(b);
 }
 
 }  // namespace qsgi

@@ -155,9 +155,10 @@ struct Scene {
     // Union of the bounds of every pose the run can show: the rest pose after finalize(), every
     // frame once the animation is known (sweepAnimationBounds).
     Bounds3f animationBounds;
-    // Per instance: the union of its bounds over every frame of the animation, for instances the
-    // animation moves (empty for the others). The incremental update's envelope (docs/design.md §6.5).
-    std::vector<Bounds3f> sweptInstanceBounds;
+    // Boxes that together hold every pose the animation gives the instances it moves: a few per
+    // instance, following its way (sweptBoxes, lib/scene/swept_boxes.h). The incremental update's
+    // envelope (docs/design.md §6.5).
+    std::vector<Bounds3f> sweptBoxes;
     // 10^-6 of animationBounds' diagonal: the tolerance of the estimators' geometric tests (docs/design.md §5).
     float sceneEpsilon() const { return 1e-6f * std::max(animationBounds.extent(), 1e-6f); }
 

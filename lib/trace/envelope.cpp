@@ -13,14 +13,16 @@ Envelope Envelope::everything() {
 
 Envelope Envelope::ofAnimation(const Scene& scene, float margin) {
     Envelope e;
-    for (const Bounds3f& b : scene.sweptInstanceBounds)
+    for (const Bounds3f& b : scene.sweptBoxes)
         if (!b.empty()) e.boxes_.push_back(b.expanded(margin));
+    e.union_ = e.bounds();
     return e;
 }
 
 bool Envelope::meets(const Segment& s, float extension) const {
     if (everything_) return true;
     const double end = s.hasImpact() ? double(s.length) + double(extension) : std::numeric_limits<double>::infinity();
+    if (boxes_.size() > 1 && !union_.meetsRay(s.origin, s.direction, end)) return false;
     return rayMeetsAny(boxes_, s.origin, s.direction, end);
 }
 

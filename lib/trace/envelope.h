@@ -1,6 +1,6 @@
-// The envelope of the moving geometry (docs/design.md §6 step 5): the boxes each moving instance sweeps
-// over the whole animation, dilated by a margin. A light path can change only from a segment that
-// meets it: a moving triangle is hit or blocks inside it, and every disc an update recomputes lies
+// The envelope of the moving geometry (docs/design.md §6 step 5): boxes that hold every pose of each
+// moving instance over the whole animation (Scene::sweptBoxes), dilated by a margin. A light path
+// can change only from a segment that meets it: a moving triangle is hit or blocks inside it, and every disc an update recomputes lies
 // inside it. Paths that never meet it are folded into the estimators' sums once and never searched
 // again; the others are tracked from their first segment that does.
 #pragma once
@@ -17,7 +17,7 @@ public:
     Envelope() = default;
     // Everything: every segment meets it (estimators that cannot fold, and --no-envelope).
     static Envelope everything();
-    // The moving instances' swept bounds (Scene::sweptInstanceBounds) dilated by `margin`.
+    // The moving instances' swept boxes (Scene::sweptBoxes) dilated by `margin`.
     static Envelope ofAnimation(const Scene& scene, float margin);
 
     // Whether the segment, continued `extension` past its impact (an escaping segment: without
@@ -30,6 +30,7 @@ public:
 private:
     bool everything_ = false;
     std::vector<Bounds3f> boxes_;
+    Bounds3f union_;  // of boxes_: most segments miss it, and test one box instead of several
 };
 
 // How far past its impact an estimator can count a segment, and how far from the moving geometry

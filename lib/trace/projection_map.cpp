@@ -130,7 +130,7 @@ std::vector<Target> mapTargets(const Scene& scene, double epsilon, double discRa
             // Crossed from the front only (d·n < 0); the tolerance keeps grazing discs.
             if (dot(view, n) < 1e-6) addDisc(p, n, discRadius, view, epsilon, targets);
         }
-    for (const Bounds3f& b : scene.sweptInstanceBounds)
+    for (const Bounds3f& b : scene.sweptBoxes)
         if (!b.empty()) addBox(b, discRadius + epsilon, targets);
     return targets;
 }

@@ -79,6 +79,7 @@ struct Bounds3f {
     Vec3f upper{-std::numeric_limits<float>::max()};
 
     bool empty() const { return lower.x > upper.x; }
+    bool operator==(const Bounds3f& o) const { return lower == o.lower && upper == o.upper; }
     void extend(const Vec3f& p) { lower = min(lower, p); upper = max(upper, p); }
     Vec3f center() const { return (lower + upper) * 0.5f; }
     Vec3f diagonal() const { return empty() ? Vec3f(0) : upper - lower; }
