@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bitset>
 #include <cmath>
+#include <optional>
 
 #include "estimate/own_surface.h"
 #include "scene/mesh_topology.h"
@@ -80,35 +82,71 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
     disc.start = startPoint;
     const Vec3d start(disc.start);
     const Vec3f& centre = scene.positions[v];
-    // segmentClear, with the static and dynamic halves of SceneBvh::occluded asked apart.
-    auto clearRay = [&](double x, double y, int slot) {
+    const DiscPatternPoints& points = discPatternPoints();
+    // The ray from s_v toward a lifted point of the disc (none if the point is s_v itself).
+    struct Ray {
+        Vec3f origin, direction;
+        float length;
+    };
+    auto rayTo = [&](double x, double y) -> std::optional<Ray> {
         const Vec3d d = liftedDiscPoint(disc, centre, normal, radius, x, y) - start;
         const double len = length(d);
-        if (!(len > 0)) return true;
-        const Vec3f origin(start), direction(d / len);
-        bool staticClear;
-        if (slot >= 0 && shortcuts.reuse) {
-            staticClear = shortcuts.answers->clear.test(size_t(slot));
-        } else {
-            staticClear = shortcuts.nothingNear || !bvh.staticOccludes(origin, direction, 0.0f, float(len));
-            if (slot >= 0 && shortcuts.answers) shortcuts.answers->clear.set(size_t(slot), staticClear);
-        }
-        return staticClear && !bvh.dynamicOccludes(origin, direction, 0.0f, float(len));
+        if (!(len > 0)) return std::nullopt;
+        return Ray{Vec3f(start), Vec3f(d / len), float(len)};
     };
-    auto clear = [&](double x, double y) { return clearRay(x, y, -1); };
+    // Whether the static geometry leaves each ray clear: sixteen rays to a packet, as they all
+    // start at s_v. Bit i of `clear` for ray i of `at`.
+    auto staticallyClear = [&](int count, auto&& at, auto&& setClear) {
+        SceneBvh::RayPacket packet;
+        int slots[SceneBvh::RayPacket::kMaxRays];
+        auto flush = [&] {
+            const uint32_t blocked = bvh.staticOccludesPacket(packet);
+            for (int i = 0; i < packet.count; ++i) setClear(slots[i], !(blocked >> i & 1));
+            packet.count = 0;
+        };
+        for (int k = 0; k < count; ++k) {
+            const DiscPatternPoints::Point p = at(k);
+            const std::optional<Ray> ray = rayTo(p.x, p.y);
+            if (!ray || shortcuts.nothingNear) {
+                setClear(k, true);
+                continue;
+            }
+            slots[packet.count] = k;
+            packet.add(ray->origin, ray->direction, ray->length);
+            if (packet.count == SceneBvh::RayPacket::kMaxRays) flush();
+        }
+        flush();
+    };
+    // The static answers of every corner (rings 1…16) and cell centre, kept or asked now.
+    std::bitset<size_t(2 * kDiscCells)> staticClear;
+    if (shortcuts.reuse) {
+        staticClear = shortcuts.answers->clear;
+    } else {
+        staticallyClear(
+            2 * kDiscCells,
+            [&](int slot) {
+                return slot < kDiscCells ? points.corners[size_t(slot + kDiscSectors)] : points.centres[size_t(slot - kDiscCells)];
+            },
+            [&](int slot, bool clear) { staticClear.set(size_t(slot), clear); });
+        if (shortcuts.answers) shortcuts.answers->clear = staticClear;
+    }
+    // segmentClear: the static half as asked above, the dynamic half now.
+    auto clearAfterStatic = [&](double x, double y, bool isStaticallyClear) {
+        const std::optional<Ray> ray = rayTo(x, y);
+        return !ray || (isStaticallyClear && !bvh.dynamicOccludes(ray->origin, ray->direction, 0.0f, ray->length));
+    };
     // Corners of the polar cells (shared between neighbours): ring boundaries × sector boundaries.
-    const DiscPatternPoints& points = discPatternPoints();
     std::array<uint8_t, size_t(kDiscRings + 1) * kDiscSectors> cornerClear;
     for (int i = 0; i <= kDiscRings; ++i)
         for (int j = 0; j < kDiscSectors; ++j) {
             const size_t k = size_t(i) * kDiscSectors + size_t(j);
-            cornerClear[k] = i == 0 ? 1 : clearRay(points.corners[k].x, points.corners[k].y, cornerSlot(i, j));
+            cornerClear[k] = i == 0 ? 1 : clearAfterStatic(points.corners[k].x, points.corners[k].y, staticClear.test(size_t(cornerSlot(i, j))));
         }
     double share = 0;
     for (int c = 0; c < kDiscCells; ++c) {
         const int ring = c / kDiscSectors, sector = c % kDiscSectors, next = (sector + 1) % kDiscSectors;
         const double x = points.centres[size_t(c)].x, y = points.centres[size_t(c)].y;
-        const bool centreClear = clearRay(x, y, centreSlot(c));
+        const bool centreClear = clearAfterStatic(x, y, staticClear.test(size_t(centreSlot(c))));
         // The centre of ring 0's corners is v itself: its own side, reachable by construction.
         const uint8_t corners[4] = {cornerClear[size_t(ring) * kDiscSectors + size_t(sector)],
                                     cornerClear[size_t(ring) * kDiscSectors + size_t(next)],
@@ -121,8 +159,13 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
             disc.reachable.set(c);
             share += 1;
         } else {
+            const auto& subPoints = points.subPoints[size_t(c)];
+            uint32_t subClear = 0;
+            staticallyClear(
+                int(subPoints.size()), [&](int k) { return subPoints[size_t(k)]; },
+                [&](int k, bool clear) { subClear |= uint32_t(clear) << k; });
             int clearSubPoints = 0;
-            for (const DiscPatternPoints::Point& sub : points.subPoints[size_t(c)]) clearSubPoints += clear(sub.x, sub.y);
+            for (size_t k = 0; k < subPoints.size(); ++k) clearSubPoints += clearAfterStatic(subPoints[k].x, subPoints[k].y, subClear >> k & 1);
             disc.mixed.set(c);
             disc.mixedShare.emplace_back(uint8_t(c), uint8_t(clearSubPoints));
             share += clearSubPoints / 16.0;

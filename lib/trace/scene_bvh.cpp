@@ -173,6 +173,37 @@ bool SceneBvh::staticOccludes(const Vec3f& origin, const Vec3f& direction, float
     return !static_.empty() && occludes(staticScene_.get(), origin, direction, tnear, tfar);
 }
 
+uint32_t SceneBvh::staticOccludesPacket(const RayPacket& rays) const {
+    if (static_.empty() || rays.count == 0) return 0;
+    RTCRay16 packet;
+    alignas(64) int valid[16];
+    for (int i = 0; i < 16; ++i) {
+        const bool used = i < rays.count;
+        const size_t k = size_t(used ? i : 0);
+        valid[i] = used ? -1 : 0;
+        packet.org_x[i] = rays.origin[k].x;
+        packet.org_y[i] = rays.origin[k].y;
+        packet.org_z[i] = rays.origin[k].z;
+        packet.dir_x[i] = rays.direction[k].x;
+        packet.dir_y[i] = rays.direction[k].y;
+        packet.dir_z[i] = rays.direction[k].z;
+        packet.tnear[i] = 0.0f;
+        packet.tfar[i] = rays.tfar[k];
+        packet.time[i] = 0;
+        packet.mask[i] = 0xFFFFFFFFu;
+        packet.id[i] = 0;
+        packet.flags[i] = 0;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded16(valid, staticScene_.get(), &context, &packet);
+    uint32_t blocked = 0;
+    for (int i = 0; i < rays.count; ++i)
+        if (packet.tfar[i] < 0) blocked |= uint32_t(1) << i;  // Embree sets tfar to -inf on a hit
+    return blocked;
+}
+
 namespace {
 struct NearQuery {
     const uint32_t* index;  // the static geometry's own buffers
