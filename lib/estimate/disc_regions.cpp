@@ -94,8 +94,8 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
         if (!(len > 0)) return std::nullopt;
         return Ray{Vec3f(start), Vec3f(d / len), float(len)};
     };
-    // Whether the static geometry leaves each ray clear: sixteen rays to a packet, as they all
-    // start at s_v. Bit i of `clear` for ray i of `at`.
+    // Whether the static geometry leaves the ray toward each of `count` points (at(k)) clear,
+    // told to setClear(k, clear): sixteen rays to a packet, as they all start at s_v.
     auto staticallyClear = [&](int count, auto&& at, auto&& setClear) {
         SceneBvh::RayPacket packet;
         int slots[SceneBvh::RayPacket::kMaxRays];
