@@ -94,9 +94,9 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
         if (!(len > 0)) return std::nullopt;
         return Ray{Vec3f(start), Vec3f(d / len), float(len)};
     };
-    // Whether the static geometry leaves the ray toward each of `count` points (at(k)) clear,
-    // told to setClear(k, clear): sixteen rays to a packet, as they all start at s_v.
-    auto staticallyClear = [&](int count, auto&& at, auto&& setClear) {
+    // Whether the static geometry leaves each of `count` rays clear (no ray: clear), told to
+    // setClear(k, clear): sixteen rays to a packet, as they all start at s_v.
+    auto staticallyClear = [&](const std::optional<Ray>* rays, int count, auto&& setClear) {
         SceneBvh::RayPacket packet;
         int slots[SceneBvh::RayPacket::kMaxRays];
         auto flush = [&] {
@@ -105,48 +105,47 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
             packet.count = 0;
         };
         for (int k = 0; k < count; ++k) {
-            const DiscPatternPoints::Point p = at(k);
-            const std::optional<Ray> ray = rayTo(p.x, p.y);
-            if (!ray || shortcuts.nothingNear) {
+            if (!rays[k] || shortcuts.nothingNear) {
                 setClear(k, true);
                 continue;
             }
             slots[packet.count] = k;
-            packet.add(ray->origin, ray->direction, ray->length);
+            packet.add(rays[k]->origin, rays[k]->direction, rays[k]->length);
             if (packet.count == SceneBvh::RayPacket::kMaxRays) flush();
         }
         flush();
     };
-    // The static answers of every corner (rings 1…16) and cell centre, kept or asked now.
+    // The rays to every corner (rings 1…16) and cell centre, by answer slot, made once.
+    std::array<std::optional<Ray>, size_t(2 * kDiscCells)> rays;
+    for (int slot = 0; slot < 2 * kDiscCells; ++slot) {
+        const auto& p = slot < kDiscCells ? points.corners[size_t(slot + kDiscSectors)] : points.centres[size_t(slot - kDiscCells)];
+        rays[size_t(slot)] = rayTo(p.x, p.y);
+    }
+    // Their static answers, kept or asked now.
     std::bitset<size_t(2 * kDiscCells)> staticClear;
     if (shortcuts.reuse) {
         staticClear = shortcuts.answers->clear;
     } else {
-        staticallyClear(
-            2 * kDiscCells,
-            [&](int slot) {
-                return slot < kDiscCells ? points.corners[size_t(slot + kDiscSectors)] : points.centres[size_t(slot - kDiscCells)];
-            },
-            [&](int slot, bool clear) { staticClear.set(size_t(slot), clear); });
+        staticallyClear(rays.data(), 2 * kDiscCells, [&](int slot, bool clear) { staticClear.set(size_t(slot), clear); });
         if (shortcuts.answers) shortcuts.answers->clear = staticClear;
     }
     // segmentClear: the static half as asked above, the dynamic half now.
-    auto clearAfterStatic = [&](double x, double y, bool isStaticallyClear) {
-        const std::optional<Ray> ray = rayTo(x, y);
+    auto clearAfterStatic = [&](const std::optional<Ray>& ray, bool isStaticallyClear) {
         return !ray || (isStaticallyClear && !bvh.dynamicOccludes(ray->origin, ray->direction, 0.0f, ray->length));
     };
+    auto slotClear = [&](int slot) { return clearAfterStatic(rays[size_t(slot)], staticClear.test(size_t(slot))); };
     // Corners of the polar cells (shared between neighbours): ring boundaries × sector boundaries.
     std::array<uint8_t, size_t(kDiscRings + 1) * kDiscSectors> cornerClear;
     for (int i = 0; i <= kDiscRings; ++i)
         for (int j = 0; j < kDiscSectors; ++j) {
             const size_t k = size_t(i) * kDiscSectors + size_t(j);
-            cornerClear[k] = i == 0 ? 1 : clearAfterStatic(points.corners[k].x, points.corners[k].y, staticClear.test(size_t(cornerSlot(i, j))));
+            cornerClear[k] = i == 0 ? 1 : slotClear(cornerSlot(i, j));
         }
     double share = 0;
     for (int c = 0; c < kDiscCells; ++c) {
         const int ring = c / kDiscSectors, sector = c % kDiscSectors, next = (sector + 1) % kDiscSectors;
         const double x = points.centres[size_t(c)].x, y = points.centres[size_t(c)].y;
-        const bool centreClear = clearAfterStatic(x, y, staticClear.test(size_t(centreSlot(c))));
+        const bool centreClear = slotClear(centreSlot(c));
         // The centre of ring 0's corners is v itself: its own side, reachable by construction.
         const uint8_t corners[4] = {cornerClear[size_t(ring) * kDiscSectors + size_t(sector)],
                                     cornerClear[size_t(ring) * kDiscSectors + size_t(next)],
@@ -160,12 +159,12 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
             share += 1;
         } else {
             const auto& subPoints = points.subPoints[size_t(c)];
+            std::array<std::optional<Ray>, 16> subRays;
+            for (size_t k = 0; k < subPoints.size(); ++k) subRays[k] = rayTo(subPoints[k].x, subPoints[k].y);
             uint32_t subClear = 0;
-            staticallyClear(
-                int(subPoints.size()), [&](int k) { return subPoints[size_t(k)]; },
-                [&](int k, bool clear) { subClear |= uint32_t(clear) << k; });
+            staticallyClear(subRays.data(), int(subRays.size()), [&](int k, bool clear) { subClear |= uint32_t(clear) << k; });
             int clearSubPoints = 0;
-            for (size_t k = 0; k < subPoints.size(); ++k) clearSubPoints += clearAfterStatic(subPoints[k].x, subPoints[k].y, subClear >> k & 1);
+            for (size_t k = 0; k < subRays.size(); ++k) clearSubPoints += clearAfterStatic(subRays[k], subClear >> k & 1);
             disc.mixed.set(c);
             disc.mixedShare.emplace_back(uint8_t(c), uint8_t(clearSubPoints));
             share += clearSubPoints / 16.0;
