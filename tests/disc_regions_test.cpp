@@ -106,6 +106,78 @@ TEST(DiscRegions, AreIdenticalForAnyThreadCount) {
     EXPECT_EQ(results[0].fallbackVertices(), 0u);
 }
 
+// A floor grid over [0,1]² (y = 0) with a rug on it: a box 0.3 wide and only `rugHeight` high,
+// lying on the floor. The rays of the floor's discs run just above the floor, so they meet the
+// rug's sides: the shortcut must see the rug rise above them however low it is.
+Scene floorWithRug(float rugHeight) {
+    Scene s;
+    s.materials.push_back(Material{"grey", Vec3f(0.5f), Vec3f(0.0f)});
+    constexpr int n = 24;
+    std::vector<Vec3f> p, nrm;
+    std::vector<uint32_t> idx;
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j) {
+            p.push_back(Vec3f(float(i) / n, 0, float(j) / n));
+            nrm.push_back(Vec3f(0, 1, 0));
+        }
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const uint32_t a = uint32_t(i * (n + 1) + j), b = a + 1, c = a + n + 1, d = c + 1;
+            idx.insert(idx.end(), {a, b, d, a, d, c});
+        }
+    s.addInstance(s.addNode("floor", Transform()), p, nrm, idx, 0);
+    // The rug's top and four sides (its bottom lies on the floor and is left out).
+    const float lo = 0.35f, hi = 0.65f, h = rugHeight;
+    const std::vector<Vec3f> box = {{lo, 0, lo}, {hi, 0, lo}, {hi, 0, hi}, {lo, 0, hi},
+                                    {lo, h, lo}, {hi, h, lo}, {hi, h, hi}, {lo, h, hi}};
+    const std::vector<uint32_t> faces = {4, 6, 5, 4, 7, 6, 0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5,
+                                         2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+    std::vector<Vec3f> boxNormals;
+    for (const Vec3f& q : box) boxNormals.push_back(normalize(q - Vec3f(0.5f, 0, 0.5f) + Vec3f(0, 0.5f, 0)));
+    s.addInstance(s.addNode("rug", Transform()), box, boxNormals, faces, 0);
+    s.finalize();
+    return s;
+}
+
+// Each cell that is not mixed is reachable exactly when the single ray from the disc's start to
+// its lifted centre is clear (discPointReachable asks the whole scene, one ray at a time): the
+// packets, the kept answers and the shortcut that skips the static rays where no static triangle
+// rises to their height must all give that answer. Every third vertex of four scenes: cornell's
+// flat walls and inside edges, the tree's leaves and trunk, and a floor with a rug on it of 20
+// and of 2 scene epsilons (the floor's rays run one epsilon up).
+TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
+    const DiscPatternPoints& points = discPatternPoints();
+    for (auto [file, radius] : {std::pair{"data/cornell/cornell.gltf", 0.05f}, {"data/tree/tree.gltf", 0.2f},
+                                {"rug 20", 0.1f}, {"rug 2", 0.1f}}) {
+        SCOPED_TRACE(file);
+        Warnings w;
+        const bool rug = std::string(file).rfind("rug", 0) == 0;
+        // The floor's extent is √2 (its epsilon 1.41e-6).
+        const Scene scene = rug ? floorWithRug(float(std::stoi(file + 4)) * 1.41e-6f)
+                                : loadGltfScene((sourceDir() / file).string(), w);
+        EmbreeDevice device;
+        const SceneBvh bvh(device, scene);
+        DiscRegions regions(radius, false);
+        regions.computeAll(scene, bvh);
+        uint64_t cells = 0, reachable = 0;
+        for (uint32_t v = 0; v < scene.vertexCount(); v += 3) {
+            const VertexDisc& disc = regions[v];
+            if (disc.fallback) continue;
+            for (int c = 0; c < kDiscCells; ++c) {
+                if (disc.mixed.test(size_t(c))) continue;
+                const bool clear = discPointReachable(disc, scene.positions[v], scene.normals[v], radius,
+                                                      points.centres[size_t(c)].x, points.centres[size_t(c)].y, bvh);
+                ASSERT_EQ(disc.reachable.test(size_t(c)), clear) << "vertex " << v << " cell " << c;
+                ++cells;
+                reachable += clear;
+            }
+        }
+        // Both answers occur: the check is not one-sided.
+        EXPECT_GT(reachable, cells / 2);
+        EXPECT_LT(reachable, cells);
+    }
+}
+
 // The block of data/cornell slides across the floor. Regions updated per frame (the moved
 // vertices and the static vertices whose test region the block's old or new bounds touch) must
 // equal regions computed from scratch for that frame, and far fewer vertices are recomputed.

@@ -2,6 +2,8 @@
 // the dynamic BVH and between them, so no hit depends on a BVH's shape or traversal order.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "trace/scene_bvh.h"
 #include "trace/envelope.h"
 #include "test_support.h"
@@ -56,6 +58,33 @@ TEST(SceneBvh, EqualDistancesGoToTheLowestTriangleId) {
             }
         EXPECT_EQ(onDiagonal, 15);
     }
+}
+
+// The disc regions' shortcut (docs/design.md §5): a static triangle near the ball counts only if
+// a corner rises to the asked height above the plane; coplanar and lower triangles never do.
+TEST(SceneBvh, StaticGeometryRisesOnlyWhereACornerReachesTheHeight) {
+    Scene s;
+    s.materials.push_back(Material{"grey", Vec3f(0.5f), Vec3f(0.0f)});
+    const std::vector<Vec3f> floor = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+    const std::vector<Vec3f> up(4, Vec3f(0, 1, 0));
+    const std::vector<uint32_t> quad = {0, 2, 1, 0, 3, 2};
+    s.addInstance(s.addNode("floor", Transform()), floor, up, quad, 0);
+    // A small raised triangle over the floor's far corner, 0.3 up.
+    const std::vector<Vec3f> raised = {{0.9f, 0.3f, 0.9f}, {1.0f, 0.3f, 0.9f}, {0.9f, 0.3f, 1.0f}};
+    s.addInstance(s.addNode("raised", Transform()), raised, std::vector<Vec3f>(3, Vec3f(0, -1, 0)), {0, 1, 2}, 0);
+    s.finalize();
+    EmbreeDevice device;
+    const SceneBvh bvh(device, s);
+    const Vec3f at = s.positions[0] + Vec3f(0.2f, 0, 0.2f);  // re-centred: relative to a corner
+    const double inf = std::numeric_limits<double>::infinity();
+    // The floor is in every ball around `at`, level with it; the raised triangle is 1.04 away.
+    EXPECT_FALSE(bvh.staticGeometryRises(at, 0.3f, Vec3f(0, 1, 0), 1e-6));
+    EXPECT_TRUE(bvh.staticGeometryRises(at, 0.3f, Vec3f(0, 1, 0), -inf));
+    EXPECT_TRUE(bvh.staticGeometryRises(at, 0.3f, Vec3f(0, 1, 0), -1e-6));  // level counts below 0
+    EXPECT_TRUE(bvh.staticGeometryRises(at, 1.2f, Vec3f(0, 1, 0), 1e-6));
+    EXPECT_FALSE(bvh.staticGeometryRises(at, 1.2f, Vec3f(0, 1, 0), 0.31));  // above the raised one too
+    // Seen from under the floor the raised triangle is below the plane.
+    EXPECT_FALSE(bvh.staticGeometryRises(at, 1.2f, Vec3f(0, -1, 0), 1e-6));
 }
 
 TEST(Envelope, SegmentsMeetItWithTheirExtensionAndEscapingOnesWithoutEnd) {

@@ -224,10 +224,19 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     }
     StaticShortcuts shortcuts;
     // Every ray of the disc (from any of the starts below) stays within r + ε⁺ + the side step
-    // of v; the BVH's ray epsilon is far more than their rounding. Worth asking for a moving
-    // vertex only: a static one has its own surface near.
-    shortcuts.nothingNear = scene.vertexDynamic[v] &&
-        !bvh.staticGeometryNear(scene.positions[v], float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon());
+    // of v, at the height ε⁺ above v's tangent plane: the starts step sideways (along the own
+    // surface, or the tangents), and the disc's points are lifted by ε⁺. Static triangles that
+    // stay below that height, as the own surface of a flat or convex patch does, cannot block
+    // them: when no other static triangle is near, every static answer is "clear". The margin
+    // below ε⁺ covers the floats the rays are made of (their points rounded near v's
+    // coordinates, their directions over a length of about r, both within 2^-22 of those);
+    // where it eats all of ε⁺ (a scene far from its origin) the rays are asked, as always.
+    const double roundingMargin =
+        std::ldexp(std::max({std::abs(double(scene.positions[v].x)), std::abs(double(scene.positions[v].y)),
+                             std::abs(double(scene.positions[v].z))}) + double(radius), -22);
+    shortcuts.nothingNear =
+        !bvh.staticGeometryRises(scene.positions[v], float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon(),
+                                 normal, double(own.epsAbove) - roundingMargin);
     // The kept answers hold while the rays are the same: same start and lift (a static vertex's
     // own surface is static, unless a moved vertex now welds onto it).
     StaticShortcuts primary = shortcuts;

@@ -210,19 +210,24 @@ struct NearQuery {
     const float* vertex;
     Vec3f centre;
     float radius;
+    Vec3d normal;
+    double height;
     bool found = false;
 };
 
-// Called for the static triangles whose BVH boxes meet the query ball: one whose own box does
-// ends the search.
-bool triangleBoxNear(RTCPointQueryFunctionArguments* args) {
+// Called for the static triangles whose BVH boxes meet the query ball: one whose own box does,
+// with a corner at the query's height or above, ends the search.
+bool triangleRisesNear(RTCPointQueryFunctionArguments* args) {
     auto* q = static_cast<NearQuery*>(args->userPtr);
     if (q->found) return false;
     Bounds3f box;
+    double highest = -std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < 3; ++k) {
         const float* p = q->vertex + 3 * size_t(q->index[3 * size_t(args->primID) + k]);
         box.extend(Vec3f(p[0], p[1], p[2]));
+        highest = std::max(highest, dot(Vec3d(p[0], p[1], p[2]) - Vec3d(q->centre), q->normal));
     }
+    if (highest < q->height) return false;
     double squared = 0;
     for (int a = 0; a < 3; ++a) {
         const double below = double(box.lower[a]) - double(q->centre[a]), above = double(q->centre[a]) - double(box.upper[a]);
@@ -236,11 +241,12 @@ bool triangleBoxNear(RTCPointQueryFunctionArguments* args) {
 }
 }  // namespace
 
-bool SceneBvh::staticGeometryNear(const Vec3f& centre, float radius) const {
+bool SceneBvh::staticGeometryRises(const Vec3f& centre, float radius, const Vec3f& normal, double height) const {
     if (static_.empty()) return false;
     RTCGeometry geom = rtcGetGeometry(staticScene_.get(), static_.geomId);
     NearQuery q{static_cast<const uint32_t*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0)),
-                static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0)), centre, radius};
+                static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0)), centre, radius,
+                Vec3d(normal), height};
     RTCPointQuery query;
     query.x = centre.x;
     query.y = centre.y;
@@ -249,7 +255,7 @@ bool SceneBvh::staticGeometryNear(const Vec3f& centre, float radius) const {
     query.time = 0;
     RTCPointQueryContext context;
     rtcInitPointQueryContext(&context);
-    rtcPointQuery(staticScene_.get(), &query, &context, triangleBoxNear, &q);
+    rtcPointQuery(staticScene_.get(), &query, &context, triangleRisesNear, &q);
     return q.found;
 }
 

@@ -65,10 +65,13 @@ public:
         }
     };
     uint32_t staticOccludesPacket(const RayPacket& rays) const;
-    // False only if no static triangle comes within `radius` of `centre` (an Embree point query,
-    // tested on each triangle's box: true may be said of a triangle a little farther). A ray
-    // that stays within the ball is then never blocked by static geometry.
-    bool staticGeometryNear(const Vec3f& centre, float radius) const;
+    // False only if no static triangle that comes within `radius` of `centre` has a corner at
+    // `height` or more above the plane through `centre` with unit normal `normal` (an Embree
+    // point query, tested on each triangle's box: true may be said of a triangle a little
+    // farther). A ray that stays within the ball and higher than `height` above the plane
+    // (a triangle's highest point is a corner) is then never blocked by static geometry; with
+    // height −∞, any ray within the ball.
+    bool staticGeometryRises(const Vec3f& centre, float radius, const Vec3f& normal, double height) const;
     // True if the dynamic geometry alone blocks the ray within (tnear, tfar].
     bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // The same, counting only the triangles flagged in triangleMoved (by scene triangle).
