@@ -104,6 +104,11 @@ public:
                 for (size_t c = begin; c < next; ++c) remember(slot, uint32_t(c - begin), block[found[c].segment].bounce, found[c]);
                 ++slot;
             });
+            // Room for all, extrapolated from the first block: growing a quarter at a time would
+            // copy the store about four times over (fresh pages each time: a tenth of the
+            // flying block's frame 0 went to them).
+            if (first == 0 && slot > 0 && slot < slots)
+                remembered_.reserve(remembered_.records() + remembered_.records() * (slots - slot) / slot * 17 / 16);
         }
     }
 
