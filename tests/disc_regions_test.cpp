@@ -175,6 +175,25 @@ TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
         // Both answers occur: the check is not one-sided.
         EXPECT_GT(reachable, cells / 2);
         EXPECT_LT(reachable, cells);
+        const DiscRegions::Work& work = regions.lastWork();
+        EXPECT_GT(work.rays, 0u);
+        if (!rug) continue;
+        // The shortcut takes exactly the floor vertices whose ball (r and a hair) misses the rug:
+        // the rug's corners and the floor vertices within r of its footprint trace their rays.
+        // The rug's own eight vertices may go either way.
+        auto footprintDistance = [&](const Vec3f& p) {
+            const Vec3f q = p - scene.positions[0];  // floor coordinates (the scene is re-centred)
+            const float dx = std::max({0.35f - q.x, q.x - 0.65f, 0.0f}), dz = std::max({0.35f - q.z, q.z - 0.65f, 0.0f});
+            return std::sqrt(dx * dx + dz * dz);
+        };
+        uint64_t surelyFar = 0, maybeFar = 0;
+        for (uint32_t v = 0; v < 25 * 25; ++v) {
+            surelyFar += footprintDistance(scene.positions[v]) > radius * 1.001f;
+            maybeFar += footprintDistance(scene.positions[v]) > radius * 0.999f;
+        }
+        EXPECT_GE(work.staticRaysSkipped, surelyFar);
+        EXPECT_LE(work.staticRaysSkipped, maybeFar + 8);
+        EXPECT_GT(surelyFar, 300u);
     }
 }
 

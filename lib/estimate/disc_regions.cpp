@@ -67,11 +67,15 @@ namespace {
 constexpr int cornerSlot(int ring, int sector) { return (ring - 1) * kDiscSectors + sector; }
 constexpr int centreSlot(int cell) { return kDiscRings * kDiscSectors + cell; }
 
+// Per thread: the rays the regions asked Embree (DiscRegions::Work).
+using Tally = DiscRegions::Work;
+
 // What a disc's rays may skip asking the static BVH, every answer being the one it would give.
 struct StaticShortcuts {
     bool nothingNear = false;  // no static triangle near any of the disc's rays: all clear
     DiscRegions::StaticAnswers* answers = nullptr;  // where corner and centre answers are kept
     bool reuse = false;  // read them from there (kept for this very start and lift)
+    Tally* tally = nullptr;  // counts the rays asked
 };
 
 // The cells of v's disc that light can reach from `startPoint` (docs/design.md §5).
@@ -101,6 +105,7 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
         int slots[SceneBvh::RayPacket::kMaxRays];
         auto flush = [&] {
             const uint32_t blocked = bvh.staticOccludesPacket(packet);
+            shortcuts.tally->rays += uint64_t(packet.count);
             for (int i = 0; i < packet.count; ++i) setClear(slots[i], !(blocked >> i & 1));
             packet.count = 0;
         };
@@ -173,6 +178,7 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
         // Probe straight down through the band [−ε⁻, ε⁺] for a surface facing n_v.
         const Vec3d lifted = liftedDiscPoint(disc, centre, normal, radius, x, y);
         const auto hit = bvh.intersect(Vec3f(lifted), -normal, 0.0f, own.epsAbove + own.epsBelow);
+        ++shortcuts.tally->rays;
         if (hit && dot(frontNormals[hit->triangle], normal) > kOwnSurfaceCos) disc.covered.set(c);
     }
     disc.reachableArea = float(share / kDiscCells);
@@ -182,20 +188,21 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
 // Whether some cell centre of v's disc is reachable from `start`: then the full regions keep that
 // start (they look further only when nothing is reachable from it).
 bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
-                         float radius) {
+                         float radius, Tally& tally) {
     const DiscPatternPoints& points = discPatternPoints();
-    for (int c = 0; c < kDiscCells; ++c)
-        if (segmentClear(Vec3d(start),
-                         liftedDiscPoint(disc, scene.positions[v], scene.normals[v], radius, points.centres[size_t(c)].x,
-                                         points.centres[size_t(c)].y),
-                         bvh))
-            return true;
+    for (int c = 0; c < kDiscCells; ++c) {
+        ++tally.rays;
+        const Vec3d target = liftedDiscPoint(disc, scene.positions[v], scene.normals[v], radius, points.centres[size_t(c)].x,
+                                             points.centres[size_t(c)].y);
+        if (segmentClear(Vec3d(start), target, bvh)) return true;
+    }
     return false;
 }
 
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
-                             OwnSurfaceScratch& scratch, DiscRegions::StaticAnswers* answers, bool startOnly = false) {
+                             OwnSurfaceScratch& scratch, Tally& tally, DiscRegions::StaticAnswers* answers,
+                             bool startOnly = false) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
     discFrame(normal, disc.tangent, disc.bitangent);
@@ -212,17 +219,18 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     const Vec3f start(lifted + Vec3d(own.towardSurface) * sideStep);
     if (startOnly) {
         disc.start = start;
-        if (someCentreReachable(start, disc, v, scene, bvh, radius)) {
+        if (someCentreReachable(start, disc, v, scene, bvh, radius, tally)) {
             disc.reachableArea = 1.0f / kDiscCells;  // at least that cell: not buried
             return disc;
         }
         // Nothing reachable from any centre: decide exactly as the full regions do, keep the start.
-        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, nullptr);
+        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tally, nullptr);
         disc.start = full.start;
         disc.reachableArea = full.reachableArea;
         return disc;
     }
     StaticShortcuts shortcuts;
+    shortcuts.tally = &tally;
     // Every ray of the disc (from any of the starts below) stays within r + ε⁺ + the side step
     // of v, at the height ε⁺ above v's tangent plane: the starts step sideways (along the own
     // surface, or the tangents), and the disc's points are lifted by ε⁺. Static triangles that
@@ -237,6 +245,7 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     shortcuts.nothingNear =
         !bvh.staticGeometryRises(scene.positions[v], float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon(),
                                  normal, double(own.epsAbove) - roundingMargin);
+    tally.staticRaysSkipped += shortcuts.nothingNear;
     // The kept answers hold while the rays are the same: same start and lift (a static vertex's
     // own surface is static, unless a moved vertex now welds onto it).
     StaticShortcuts primary = shortcuts;
@@ -283,6 +292,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
                                            bool keepAnswers, WorkCounter* progress) {
     if (progress) progress->setTotal(vertices.size());
     if (discs_.size() != scene.vertexCount()) discs_.resize(scene.vertexCount());
+    lastWork_ = Work();
     if (vertices.empty()) return {};
     if (keepAnswers) {
         // A record per vertex a move has touched: the touchable set is small beside the scene.
@@ -298,18 +308,24 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;
+    tbb::enumerable_thread_specific<Work> tallies;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 32), [&](const tbb::blocked_range<size_t>& range) {
         OwnSurfaceScratch& local = scratch.local();
+        Work& tally = tallies.local();
         for (size_t i = range.begin(); i != range.end(); ++i) {
             StaticAnswers* answers = keepAnswers ? &answers_[size_t(answerSlot_[vertices[i]])] : nullptr;
             if (answers && scene.vertexDynamic[vertices[i]]) answers = nullptr;
             VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local,
-                                                startsOnly_ ? nullptr : answers, startsOnly_);
+                                                tally, startsOnly_ ? nullptr : answers, startsOnly_);
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);
         }
         if (progress) progress->add(range.size());
     });
+    for (const Work& t : tallies) {
+        lastWork_.rays += t.rays;
+        lastWork_.staticRaysSkipped += t.staticRaysSkipped;
+    }
     std::vector<uint32_t> out;
     for (size_t i = 0; i < vertices.size(); ++i)
         if (changed[i]) out.push_back(vertices[i]);

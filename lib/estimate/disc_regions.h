@@ -108,6 +108,15 @@ public:
     uint64_t fallbackVertices() const;
     uint64_t buriedVertices() const;
     uint64_t mixedCells() const;  // cells cut by geometry, over all vertices
+    // What the last computeAll or recompute asked Embree: its rays against the static geometry
+    // or the whole scene (corners, centres, sub-points, coverage probes, start searches; not the
+    // dynamic halves, which the movers' bounds clip away first almost always), and the vertices
+    // whose static rays were skipped (no static triangle near rises to their height, design.md §5).
+    struct Work {
+        uint64_t rays = 0;
+        uint64_t staticRaysSkipped = 0;
+    };
+    const Work& lastWork() const { return lastWork_; }
     // Bytes of the static answers kept for recomputed vertices.
     size_t keptAnswerBytes() const { return answers_.capacity() * sizeof(StaticAnswers) + answerSlot_.capacity() * sizeof(int32_t); }
 
@@ -133,6 +142,7 @@ private:
     std::vector<VertexDisc> discs_;
     std::vector<int32_t> answerSlot_;  // per vertex, into answers_ (−1: none kept)
     std::vector<StaticAnswers> answers_;
+    Work lastWork_;
 };
 
 }  // namespace qsgi
