@@ -226,8 +226,8 @@ void FrameSolver::solveFromScratch(bool keepCache, FrameTiming& stats) {
     tracked_.reset();
     lastCache_.reset();
     Stopwatch clock;
-    stage("tracing", 0, settings_.trace.photons);
-    RayCache cache = tracer_.traceAll([this](uint64_t done, uint64_t total) { stage("tracing", done, total); });
+    work_.start("tracing", settings_.trace.photons);
+    RayCache cache = tracer_.traceAll(&work_);
     stats.photonSimulationSeconds = clock.seconds();
     stats.segments = cache.segmentCount();
     stats.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();

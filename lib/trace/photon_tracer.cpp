@@ -3,9 +3,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include <atomic>
 #include <limits>
-#include <thread>
 
 #include "trace/sampling.h"
 
@@ -74,28 +72,18 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
     }
 }
 
-RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& progress) const {
+RayCache PhotonTracer::traceAll(WorkCounter* progress) const {
     const LightSampler& lights = source_->lights();
     const uint64_t n = settings_.photons;
+    if (progress) progress->setTotal(n);
     // Fixed chunks of paths, each written as one block of the cache: the cache is the same for
     // any thread count, and the blocks are kept as they are (no concatenation).
     constexpr uint64_t kChunk = 4096;
     const uint64_t chunks = (n + kChunk - 1) / kChunk;
     std::vector<RayCache::BlockWriter> blocks(chunks);
-    std::atomic<uint64_t> done{0};
-    std::atomic<bool> finished{false};
-    std::thread reporter;
-    if (progress) {
-        reporter = std::thread([&] {
-            while (!finished.load()) {
-                progress(done.load(), n);
-                std::this_thread::sleep_for(std::chrono::milliseconds(200));
-            }
-        });
-    }
     // Each thread writes its chunks into one writer and keeps an exact-size copy of each.
     tbb::enumerable_thread_specific<RayCache::BlockWriter> writers;
-    auto work = [&](const tbb::blocked_range<uint64_t>& r) {
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, chunks, 1), [&](const tbb::blocked_range<uint64_t>& r) {
         RayCache::BlockWriter& block = writers.local();
         for (uint64_t c = r.begin(); c != r.end(); ++c) {
             const uint64_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
@@ -105,19 +93,9 @@ RayCache PhotonTracer::traceAll(const std::function<void(uint64_t, uint64_t)>& p
                 if (!lights.empty()) tracePathInto(p, block);
             }
             blocks[c] = block.exactCopy();
-            done += end - begin;
+            if (progress) progress->add(end - begin);
         }
-    };
-    try {
-        tbb::parallel_for(tbb::blocked_range<uint64_t>(0, chunks, 1), work);
-    } catch (...) {
-        finished = true;
-        if (reporter.joinable()) reporter.join();
-        throw;
-    }
-    finished = true;
-    if (reporter.joinable()) reporter.join();
-    if (progress) progress(n, n);
+    });
     return RayCache::ofBlocks(std::move(blocks), kChunk, source_, lights.maxPhotonPower());
 }
 

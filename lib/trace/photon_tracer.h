@@ -12,6 +12,7 @@
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
 #include "trace/trace_settings.h"
+#include "util/work_counter.h"
 
 namespace qsgi {
 
@@ -21,9 +22,9 @@ class PhotonTracer {
 public:
     PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings);
 
-    // Traces every photon from scratch. progress(done, total), if given, is called about five
-    // times a second from a reporter thread, and once at the end.
-    RayCache traceAll(const std::function<void(uint64_t, uint64_t)>& progress = {}) const;
+    // Traces every photon from scratch. progress, if given, counts the photons done (its total set
+    // here), from the worker threads as every other stage's.
+    RayCache traceAll(WorkCounter* progress = nullptr) const;
 
     // Appends every segment of `path`.
     void tracePath(uint64_t path, std::vector<Segment>& out) const;
