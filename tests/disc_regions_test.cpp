@@ -139,22 +139,31 @@ Scene floorWithRug(float rugHeight) {
     return s;
 }
 
+// The scenes the shortcut is tested on, with their radii: cornell's flat walls and inside edges,
+// the tree's leaves and trunk, and a floor with a rug on it of 20 and of 2 scene epsilons (the
+// floor's rays run one epsilon up).
+const std::pair<const char*, float> kShortcutScenes[] = {
+    {"data/cornell/cornell.gltf", 0.05f}, {"data/tree/tree.gltf", 0.2f}, {"rug 20", 0.1f}, {"rug 2", 0.1f}};
+
+bool isRug(const char* name) { return std::string(name).rfind("rug", 0) == 0; }
+
+Scene shortcutScene(const char* name) {
+    // The floor's extent is √2 (its epsilon 1.41e-6).
+    if (isRug(name)) return floorWithRug(float(std::stoi(name + 4)) * 1.41e-6f);
+    Warnings w;
+    return loadGltfScene((sourceDir() / name).string(), w);
+}
+
 // Each cell that is not mixed is reachable exactly when the single ray from the disc's start to
 // its lifted centre is clear (discPointReachable asks the whole scene, one ray at a time): the
-// packets, the kept answers and the shortcut that skips the static rays where no static triangle
-// rises to their height must all give that answer. Every third vertex of four scenes: cornell's
-// flat walls and inside edges, the tree's leaves and trunk, and a floor with a rug on it of 20
-// and of 2 scene epsilons (the floor's rays run one epsilon up).
+// packets and the shortcut that skips the static rays where no static triangle rises to their
+// height must give that answer. Every third vertex.
 TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
     const DiscPatternPoints& points = discPatternPoints();
-    for (auto [file, radius] : {std::pair{"data/cornell/cornell.gltf", 0.05f}, {"data/tree/tree.gltf", 0.2f},
-                                {"rug 20", 0.1f}, {"rug 2", 0.1f}}) {
+    for (auto [file, radius] : kShortcutScenes) {
         SCOPED_TRACE(file);
-        Warnings w;
-        const bool rug = std::string(file).rfind("rug", 0) == 0;
-        // The floor's extent is √2 (its epsilon 1.41e-6).
-        const Scene scene = rug ? floorWithRug(float(std::stoi(file + 4)) * 1.41e-6f)
-                                : loadGltfScene((sourceDir() / file).string(), w);
+        const bool rug = isRug(file);
+        const Scene scene = shortcutScene(file);
         EmbreeDevice device;
         const SceneBvh bvh(device, scene);
         DiscRegions regions(radius, false);
@@ -177,6 +186,7 @@ TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
         EXPECT_LT(reachable, cells);
         const DiscRegions::Work& work = regions.lastWork();
         EXPECT_GT(work.rays, 0u);
+        EXPECT_GT(work.staticRaysSkipped, 0u);
         if (!rug) continue;
         // The shortcut takes exactly the floor vertices whose ball (r and a hair) misses the rug:
         // the rug's corners and the floor vertices within r of its footprint trace their rays.
@@ -194,6 +204,28 @@ TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
         EXPECT_GE(work.staticRaysSkipped, surelyFar);
         EXPECT_LE(work.staticRaysSkipped, maybeFar + 8);
         EXPECT_GT(surelyFar, 300u);
+    }
+}
+
+// The shortcut spares rays, never changes an answer: every disc (masks, mixed shares, start,
+// areas, coverage) equals the one found with every static ray traced, with and without
+// coverage, on every scene above.
+TEST(DiscRegions, TheStaticShortcutChangesNoDisc) {
+    for (auto [file, radius] : kShortcutScenes) {
+        const Scene scene = shortcutScene(file);
+        EmbreeDevice device;
+        const SceneBvh bvh(device, scene);
+        for (bool coverage : {false, true}) {
+            SCOPED_TRACE(std::string(file) + (coverage ? ", with coverage" : ""));
+            DiscRegions quick(radius, coverage), reference(radius, coverage);
+            reference.useStaticShortcut(false);
+            quick.computeAll(scene, bvh);
+            reference.computeAll(scene, bvh);
+            for (size_t v = 0; v < scene.vertexCount(); ++v) ASSERT_TRUE(quick[v] == reference[v]) << "vertex " << v;
+            EXPECT_GT(quick.lastWork().staticRaysSkipped, 0u);
+            EXPECT_EQ(reference.lastWork().staticRaysSkipped, 0u);
+            EXPECT_LT(quick.lastWork().rays, reference.lastWork().rays);
+        }
     }
 }
 
@@ -224,7 +256,10 @@ TEST(DiscRegions, PerFrameUpdatesEqualAFromScratchComputation) {
         const SceneBvh bvh(device, scene);
         const std::vector<uint32_t> touched = updated.touchedBy(scene, movedBounds, vertexMoved);
         updated.recompute(scene, bvh, touched);
+        // The reference traces every static ray: the update's shortcut and kept answers must
+        // agree with it.
         DiscRegions fresh(0.05f, true);
+        fresh.useStaticShortcut(false);
         fresh.computeAll(scene, bvh);
         for (size_t v = 0; v < scene.vertexCount(); ++v)
             ASSERT_TRUE(updated[v] == fresh[v]) << "frame " << frame << " vertex " << v;

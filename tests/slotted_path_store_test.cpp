@@ -222,3 +222,24 @@ TEST(SlottedPathStore, AColumnSwitchedOffHoldsNothing) {
     first.rewrite(4, 1, 7);  // moves: only the column that is on is copied
     EXPECT_EQ(first.slot(4).count, 7u);
 }
+
+// A reserve that guessed high is given back down to a quarter over the records, and nothing
+// moves: every path reads back what it was given.
+TEST(SlottedPathStore, TrimmingAReserveKeepsEveryRecord) {
+    Store store(100);
+    store.reserve(100000);
+    for (uint32_t s = 0; s < 100; ++s) {
+        store.append(s, s % 7);
+        for (uint32_t j = 0; j < s % 7; ++j) store.at<0>(s, j) = Record{s, 0, j};
+    }
+    const size_t reserved = store.bytes();
+    store.trimReserve();
+    EXPECT_LT(store.bytes(), reserved / 100);
+    for (uint32_t s = 0; s < 100; ++s) {
+        ASSERT_EQ(store.slot(s).count, s % 7);
+        for (uint32_t j = 0; j < s % 7; ++j) ASSERT_EQ(store.at<0>(s, j), (Record{s, 0, j}));
+    }
+    const size_t trimmed = store.bytes();
+    store.trimReserve();  // within a quarter already: nothing to give back
+    EXPECT_EQ(store.bytes(), trimmed);
+}

@@ -106,10 +106,14 @@ public:
             });
             // Room for all, extrapolated from the first block: growing a quarter at a time would
             // copy the store about four times over (fresh pages each time: a tenth of the
-            // flying block's frame 0 went to them).
+            // flying block's frame 0 went to them). The first block may cross more discs than
+            // the rest (its paths may all come from one light): a guess too high is given back
+            // at the end.
             if (first == 0 && slot > 0 && slot < slots)
-                remembered_.reserve(remembered_.records() + remembered_.records() * (slots - slot) / slot * 17 / 16);
+                remembered_.reserve(std::min<uint64_t>(
+                    UINT32_MAX, remembered_.records() + remembered_.records() * (slots - slot) / slot * 17 / 16));
         }
+        remembered_.trimReserve();
     }
 
     void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {

@@ -202,7 +202,7 @@ bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v,
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
                              OwnSurfaceScratch& scratch, Tally& tally, DiscRegions::StaticAnswers* answers,
-                             bool startOnly = false) {
+                             bool staticShortcut, bool startOnly = false) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
     discFrame(normal, disc.tangent, disc.bitangent);
@@ -224,28 +224,40 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
             return disc;
         }
         // Nothing reachable from any centre: decide exactly as the full regions do, keep the start.
-        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tally, nullptr);
+        VertexDisc full =
+            computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tally, nullptr, staticShortcut);
         disc.start = full.start;
         disc.reachableArea = full.reachableArea;
         return disc;
     }
+    // The starts tried below: s_v, and if nothing is reachable from it, a step to each side.
+    const Vec3d sides[4] = {Vec3d(disc.tangent), -Vec3d(disc.tangent), Vec3d(disc.bitangent), -Vec3d(disc.bitangent)};
+    Vec3f sideStarts[4];
+    for (int k = 0; k < 4; ++k) sideStarts[k] = Vec3f(lifted + sides[k] * sideStep);
     StaticShortcuts shortcuts;
     shortcuts.tally = &tally;
-    // Every ray of the disc (from any of the starts below) stays within r + ε⁺ + the side step
-    // of v, at the height ε⁺ above v's tangent plane: the starts step sideways (along the own
-    // surface, or the tangents), and the disc's points are lifted by ε⁺. Static triangles that
-    // stay below that height, as the own surface of a flat or convex patch does, cannot block
-    // them: when no other static triangle is near, every static answer is "clear". The margin
-    // below ε⁺ covers the floats the rays are made of (their points rounded near v's
-    // coordinates, their directions over a length of about r, both within 2^-22 of those);
-    // where it eats all of ε⁺ (a scene far from its origin) the rays are asked, as always.
-    const double roundingMargin =
-        std::ldexp(std::max({std::abs(double(scene.positions[v].x)), std::abs(double(scene.positions[v].y)),
-                             std::abs(double(scene.positions[v].z))}) + double(radius), -22);
-    shortcuts.nothingNear =
-        !bvh.staticGeometryRises(scene.positions[v], float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon(),
-                                 normal, double(own.epsAbove) - roundingMargin);
-    tally.staticRaysSkipped += shortcuts.nothingNear;
+    // Every ray of the disc (from any of those starts) stays within r + ε⁺ + the side step of v,
+    // at about the height ε⁺ above v's tangent plane: the starts step sideways from v lifted by
+    // ε⁺ (toward the own surface, or along the tangents), and the disc's points are lifted by ε⁺.
+    // Static triangles whose corners all stay below the lowest of those heights, as the own
+    // surface of a flat or convex patch does, cannot block them: when no other static triangle is
+    // near, every static answer is "clear". The heights are those of the float starts as made;
+    // the margin below them covers what the rays' floats add (the disc's points and directions
+    // rounded, over coordinates as large as v's and lengths of about r) and Embree's own
+    // rounding, with room to spare (2^-20 of those; the rounding is near 2^-24). Where the
+    // margin eats all of ε⁺ (a scene far from its origin) the rays are asked, as always.
+    if (staticShortcut) {
+        const Vec3d p(scene.positions[v]), n(normal);
+        double lowest = double(own.epsAbove) * dot(n, n);
+        for (const Vec3f& s : sideStarts) lowest = std::min(lowest, dot(Vec3d(s) - p, n));
+        lowest = std::min(lowest, dot(Vec3d(start) - p, n));
+        const double margin = std::ldexp(std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) + double(radius) +
+                                             double(own.epsAbove),
+                                         -20);
+        shortcuts.nothingNear = !bvh.staticGeometryRises(
+            scene.positions[v], float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon(), normal, lowest - margin);
+        tally.staticRaysSkipped += shortcuts.nothingNear;
+    }
     // The kept answers hold while the rays are the same: same start and lift (a static vertex's
     // own surface is static, unless a moved vertex now welds onto it).
     StaticShortcuts primary = shortcuts;
@@ -263,10 +275,8 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     // the wall and gives no side to step to), and which side of it float rounding puts the start
     // on decides everything — the answer would change with the scene's unit. Light reaching v
     // comes from the open side, so try a step to each side and keep the one that sees most.
-    const Vec3d sides[4] = {Vec3d(disc.tangent), -Vec3d(disc.tangent), Vec3d(disc.bitangent), -Vec3d(disc.bitangent)};
-    for (const Vec3d& side : sides) {
-        VertexDisc candidate = discFrom(Vec3f(lifted + side * sideStep), disc, v, scene, bvh, frontNormals, radius,
-                                        withCoverage, own, shortcuts);
+    for (const Vec3f& sideStart : sideStarts) {
+        VertexDisc candidate = discFrom(sideStart, disc, v, scene, bvh, frontNormals, radius, withCoverage, own, shortcuts);
         if (candidate.reachableArea > best.reachableArea) best = std::move(candidate);
     }
     return best;
@@ -316,7 +326,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
             StaticAnswers* answers = keepAnswers ? &answers_[size_t(answerSlot_[vertices[i]])] : nullptr;
             if (answers && scene.vertexDynamic[vertices[i]]) answers = nullptr;
             VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local,
-                                                tally, startsOnly_ ? nullptr : answers, startsOnly_);
+                                                tally, startsOnly_ ? nullptr : answers, staticShortcut_, startsOnly_);
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);
         }

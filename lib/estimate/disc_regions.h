@@ -117,6 +117,8 @@ public:
         uint64_t staticRaysSkipped = 0;
     };
     const Work& lastWork() const { return lastWork_; }
+    // Off: every static ray is traced, the shortcut never taken (the reference its tests compare with).
+    void useStaticShortcut(bool on) { staticShortcut_ = on; }
     // Bytes of the static answers kept for recomputed vertices.
     size_t keptAnswerBytes() const { return answers_.capacity() * sizeof(StaticAnswers) + answerSlot_.capacity() * sizeof(int32_t); }
 
@@ -143,6 +145,7 @@ private:
     std::vector<int32_t> answerSlot_;  // per vertex, into answers_ (−1: none kept)
     std::vector<StaticAnswers> answers_;
     Work lastWork_;
+    bool staticShortcut_ = true;
 };
 
 }  // namespace qsgi

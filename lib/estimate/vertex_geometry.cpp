@@ -18,7 +18,7 @@ void VertexGeometry::computeAll(const Scene& scene, const SceneBvh& bvh, WorkCou
     regions_->computeAll(scene, bvh, progress);
     stats.discRegionsUpdated = scene.vertexCount();
     stats.discRegionsSeconds = clock.seconds();
-    stats.discRegionRays = regions_->lastWork().rays;
+    stats.discRegionsRays = regions_->lastWork().rays;
     stats.discRegionsStaticSkipped = regions_->lastWork().staticRaysSkipped;
 }
 
@@ -41,7 +41,7 @@ std::vector<uint32_t> VertexGeometry::update(const Scene& scene, const SceneBvh&
     changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
     stats.discRegionsUpdated = touched.size();
     stats.discRegionsSeconds = clock.seconds();
-    stats.discRegionRays = regions_->lastWork().rays;
+    stats.discRegionsRays = regions_->lastWork().rays;
     stats.discRegionsStaticSkipped = regions_->lastWork().staticRaysSkipped;
     return changed;
 }

@@ -213,13 +213,23 @@ struct NearQuery {
     Vec3d normal;
     double height;
     bool found = false;
+    uint32_t visited = 0;
 };
+
+// Past this many triangles near, the query answers "rises" without looking further: where it is
+// asked (the disc regions' shortcut) tracing the rays is then the cheaper way to the same answer.
+constexpr uint32_t kMostTrianglesVisited = 2048;
 
 // Called for the static triangles whose BVH boxes meet the query ball: one whose own box does,
 // with a corner at the query's height or above, ends the search.
 bool triangleRisesNear(RTCPointQueryFunctionArguments* args) {
     auto* q = static_cast<NearQuery*>(args->userPtr);
     if (q->found) return false;
+    if (++q->visited > kMostTrianglesVisited) {
+        q->found = true;
+        args->query->radius = 0;
+        return true;
+    }
     Bounds3f box;
     double highest = -std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < 3; ++k) {

@@ -70,7 +70,8 @@ public:
     // point query, tested on each triangle's box: true may be said of a triangle a little
     // farther). A ray that stays within the ball and higher than `height` above the plane
     // (a triangle's highest point is a corner) is then never blocked by static geometry; with
-    // height −∞, any ray within the ball.
+    // height −∞, any ray within the ball. Past 2048 triangles near it says true without looking
+    // further (a bound on its cost: a conservative answer).
     bool staticGeometryRises(const Vec3f& centre, float radius, const Vec3f& normal, double height) const;
     // True if the dynamic geometry alone blocks the ray within (tnear, tfar].
     bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;

@@ -79,6 +79,15 @@ public:
         forEachColumn([&](auto& c) { c.reserve(records); });
         if (generations_) recordGeneration_.reserve(records);
     }
+    // Gives back room reserved beyond a quarter more than the positions in use (a reserve that
+    // guessed high).
+    void trimReserve() {
+        auto trim = [&](auto& c) {
+            if (c.capacity() > c.size() + c.size() / 4) c.shrink_to_fit();
+        };
+        forEachColumn(trim);
+        if (generations_) trim(recordGeneration_);
+    }
 
     // Slot s keeps its first `keep` records and will hold `count`; the caller writes records
     // [keep, count) at slot(s).begin + keep on. The records it replaces must have been read

@@ -48,7 +48,7 @@ struct FrameTiming {
     // empty own surface (paper fallback) or no reachable cell (buried: E = 0).
     double discRegionsSeconds = 0;
     uint64_t discRegionsUpdated = 0;
-    uint64_t discRegionRays = 0;            // rays they asked Embree (DiscRegions::Work)
+    uint64_t discRegionsRays = 0;           // rays they traced (DiscRegions::Work)
     uint64_t discRegionsStaticSkipped = 0;  // vertices whose static rays needed no asking
     uint64_t ownSurfaceFallbacks = 0, buriedVertices = 0;
     // The second pass (--direct exact, --gather M; docs/design.md §5.1): time and rays cast this
@@ -93,7 +93,7 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("vertices_updated", f.verticesUpdated);
     visit("disc_regions_s", f.discRegionsSeconds);
     visit("disc_regions_updated", f.discRegionsUpdated);
-    visit("disc_region_rays", f.discRegionRays);
+    visit("disc_regions_rays", f.discRegionsRays);
     visit("disc_regions_static_skipped", f.discRegionsStaticSkipped);
     visit("own_surface_fallbacks", f.ownSurfaceFallbacks);
     visit("buried_vertices", f.buriedVertices);
