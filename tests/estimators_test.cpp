@@ -129,6 +129,38 @@ TEST(Estimators, IndexedPhotonMapAndDetpEqualBruteForce) {
     }
 }
 
+// timing.json's detp_crossings: the crossings the indexed solve counted are the (segment, vertex)
+// pairs the definition accepts, counted pair by pair (detpCounts on every pair).
+TEST(Estimators, DetpCountsEveryCrossingTheDefinitionAccepts) {
+    const Scene scene = litBoxOnFloor();
+    EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
+    const RayCache cache = trace(scene, 2000);
+    const std::vector<Segment> segments = cache.decodeAll();
+    for (DetpBoundary rule : {DetpBoundary::Clip, DetpBoundary::Paper}) {
+        SCOPED_TRACE(detpBoundaryName(rule));
+        EstimatorSettings s;
+        s.kind = EstimatorKind::Detp;
+        s.detp.boundary = rule;
+        s.radius = 0.3f;
+        DiscRegions discs(s.radius, false);
+        discs.computeAll(scene, bvh);
+        const DiscRegions* regions = rule == DetpBoundary::Paper ? nullptr : &discs;
+        VertexRadiosity out;
+        FrameTiming stats;
+        Estimator::create(s, EstimatorContext{scene, bvh, device, regions})->solve(cache, out, stats);
+        uint64_t pairs = 0;
+        for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
+            const VertexDisc disc = regions ? (*regions)[v] : VertexDisc{};
+            DiscCrossing at;
+            for (const Segment& seg : segments)
+                pairs += detpCounts(seg, scene.positions[v], scene.normals[v], disc, s.radius, rule, &bvh, at);
+        }
+        EXPECT_EQ(stats.detpCrossings, pairs);
+        EXPECT_GT(pairs, segments.size());
+    }
+}
+
 // Inside of a closed sphere, ρ = 0.5, I = 1 W/sr at the centre: E = 2 W/m² (see ImpactCount's
 // test). Each estimator's vertex mean is a mean over ~10^4 overlapping estimates of ≥ 50 impacts;
 // its statistical error is well under 0.3 %, so the 1 % bounds the estimators' own bias

@@ -66,7 +66,9 @@ public:
             return;
         } else {
             discs().updateDynamic();
-            sums_ = discs_->sums(cache, e.sortQueries, quantizer_, nullptr, progress_);
+            DetpQueryStats counted;
+            sums_ = discs_->sums(cache, e.sortQueries, quantizer_, &counted, progress_);
+            stats.detpCrossings = counted.discHits;
         }
         out.irradiance.resize(scene_.vertexCount());
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v) out.irradiance[v] = irradianceAt(v);

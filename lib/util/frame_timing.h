@@ -44,6 +44,7 @@ struct FrameTiming {
     uint64_t verticesRecomputed = 0;
     uint64_t recomputeCandidates = 0;  // segments gathered for those recomputations
     uint64_t crossingsForgotten = 0;   // DETP: removed crossings subtracted as remembered, untraced
+    uint64_t detpCrossings = 0;        // DETP: the (segment, disc) crossings a from-scratch solve counted
     // Disc regions (docs/design.md §5): time, vertices (re)computed this frame, and the vertices with an
     // empty own surface (paper fallback) or no reachable cell (buried: E = 0).
     double discRegionsSeconds = 0;
@@ -91,6 +92,7 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("segments_removed", f.segmentsRemoved);
     visit("segments_added", f.segmentsAdded);
     visit("vertices_updated", f.verticesUpdated);
+    visit("detp_crossings", f.detpCrossings);
     visit("disc_regions_s", f.discRegionsSeconds);
     visit("disc_regions_updated", f.discRegionsUpdated);
     visit("disc_regions_rays", f.discRegionsRays);
