@@ -106,53 +106,32 @@ TEST(DiscRegions, AreIdenticalForAnyThreadCount) {
     EXPECT_EQ(results[0].fallbackVertices(), 0u);
 }
 
-// A floor grid over [0,1]² (y = 0) with a rug on it: a box 0.3 wide and only `rugHeight` high,
-// lying on the floor. The rays of the floor's discs run just above the floor, so they meet the
-// rug's sides: the shortcut must see the rug rise above them however low it is.
-Scene floorWithRug(float rugHeight) {
-    Scene s;
-    s.materials.push_back(Material{"grey", Vec3f(0.5f), Vec3f(0.0f)});
-    constexpr int n = 24;
-    std::vector<Vec3f> p, nrm;
-    std::vector<uint32_t> idx;
-    for (int i = 0; i <= n; ++i)
-        for (int j = 0; j <= n; ++j) {
-            p.push_back(Vec3f(float(i) / n, 0, float(j) / n));
-            nrm.push_back(Vec3f(0, 1, 0));
-        }
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-            const uint32_t a = uint32_t(i * (n + 1) + j), b = a + 1, c = a + n + 1, d = c + 1;
-            idx.insert(idx.end(), {a, b, d, a, d, c});
-        }
-    s.addInstance(s.addNode("floor", Transform()), p, nrm, idx, 0);
-    // The rug's top and four sides (its bottom lies on the floor and is left out).
-    const float lo = 0.35f, hi = 0.65f, h = rugHeight;
-    const std::vector<Vec3f> box = {{lo, 0, lo}, {hi, 0, lo}, {hi, 0, hi}, {lo, 0, hi},
-                                    {lo, h, lo}, {hi, h, lo}, {hi, h, hi}, {lo, h, hi}};
-    const std::vector<uint32_t> faces = {4, 6, 5, 4, 7, 6, 0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5,
-                                         2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
-    std::vector<Vec3f> boxNormals;
-    for (const Vec3f& q : box) boxNormals.push_back(normalize(q - Vec3f(0.5f, 0, 0.5f) + Vec3f(0, 0.5f, 0)));
-    s.addInstance(s.addNode("rug", Transform()), box, boxNormals, faces, 0);
-    s.finalize();
-    return s;
-}
+namespace {
 
 // The scenes the shortcut is tested on, with their radii: cornell's flat walls and inside edges,
-// the tree's leaves and trunk, and a floor with a rug on it of 20 and of 2 scene epsilons (the
-// floor's rays run one epsilon up).
-const std::pair<const char*, float> kShortcutScenes[] = {
-    {"data/cornell/cornell.gltf", 0.05f}, {"data/tree/tree.gltf", 0.2f}, {"rug 20", 0.1f}, {"rug 2", 0.1f}};
+// the tree's leaves and trunk, and a floor with a rug on it (testscenes::slabOnFloor, 0.6 wide)
+// 20 and 2 scene epsilons high: the floor's rays run one epsilon up, so they meet the rug's sides
+// however low it is.
+struct ShortcutScene {
+    const char* name;
+    float radius;
+    float rugEpsilons = 0;  // 0: the glTF file `name`
+};
+const ShortcutScene kShortcutScenes[] = {{"data/cornell/cornell.gltf", 0.05f},
+                                         {"data/tree/tree.gltf", 0.2f},
+                                         {"rug 20 epsilons high", 0.1f, 20},
+                                         {"rug 2 epsilons high", 0.1f, 2}};
+constexpr int kRugFloorCells = 24;
+constexpr float kRugHalf = 0.3f;
 
-bool isRug(const char* name) { return std::string(name).rfind("rug", 0) == 0; }
-
-Scene shortcutScene(const char* name) {
-    // The floor's extent is √2 (its epsilon 1.41e-6).
-    if (isRug(name)) return floorWithRug(float(std::stoi(name + 4)) * 1.41e-6f);
+Scene shortcutScene(const ShortcutScene& c) {
+    // The rug's scene epsilon: 10^-6 of the floor's diagonal, 2√2.
+    if (c.rugEpsilons > 0) return testscenes::slabOnFloor(kRugFloorCells, kRugHalf, c.rugEpsilons * 2.828427e-6f, Vec3f(0.5f));
     Warnings w;
-    return loadGltfScene((sourceDir() / name).string(), w);
+    return loadGltfScene((sourceDir() / c.name).string(), w);
 }
+
+}  // namespace
 
 // Each cell that is not mixed is reachable exactly when the single ray from the disc's start to
 // its lifted centre is clear (discPointReachable asks the whole scene, one ray at a time): the
@@ -160,10 +139,10 @@ Scene shortcutScene(const char* name) {
 // height must give that answer. Every third vertex.
 TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
     const DiscPatternPoints& points = discPatternPoints();
-    for (auto [file, radius] : kShortcutScenes) {
-        SCOPED_TRACE(file);
-        const bool rug = isRug(file);
-        const Scene scene = shortcutScene(file);
+    for (const ShortcutScene& c : kShortcutScenes) {
+        SCOPED_TRACE(c.name);
+        const float radius = c.radius;
+        const Scene scene = shortcutScene(c);
         EmbreeDevice device;
         const SceneBvh bvh(device, scene);
         DiscRegions regions(radius, false);
@@ -187,22 +166,24 @@ TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
         const DiscRegions::Work& work = regions.lastWork();
         EXPECT_GT(work.rays, 0u);
         EXPECT_GT(work.staticRaysSkipped, 0u);
-        if (!rug) continue;
+        if (c.rugEpsilons == 0) continue;
         // The shortcut takes exactly the floor vertices whose ball (r and a hair) misses the rug:
         // the rug's corners and the floor vertices within r of its footprint trace their rays.
-        // The rug's own eight vertices may go either way.
+        // The rug's own vertices may go either way.
         auto footprintDistance = [&](const Vec3f& p) {
-            const Vec3f q = p - scene.positions[0];  // floor coordinates (the scene is re-centred)
-            const float dx = std::max({0.35f - q.x, q.x - 0.65f, 0.0f}), dz = std::max({0.35f - q.z, q.z - 0.65f, 0.0f});
+            // Floor coordinates: the scene is re-centred, and its first vertex is the corner (−1, 0, 1).
+            const Vec3f q = p - scene.positions[0] + Vec3f(-1, 0, 1);
+            const float dx = std::max(std::abs(q.x) - kRugHalf, 0.0f), dz = std::max(std::abs(q.z) - kRugHalf, 0.0f);
             return std::sqrt(dx * dx + dz * dz);
         };
+        const uint32_t floorVertices = (kRugFloorCells + 1) * (kRugFloorCells + 1);
         uint64_t surelyFar = 0, maybeFar = 0;
-        for (uint32_t v = 0; v < 25 * 25; ++v) {
+        for (uint32_t v = 0; v < floorVertices; ++v) {
             surelyFar += footprintDistance(scene.positions[v]) > radius * 1.001f;
             maybeFar += footprintDistance(scene.positions[v]) > radius * 0.999f;
         }
         EXPECT_GE(work.staticRaysSkipped, surelyFar);
-        EXPECT_LE(work.staticRaysSkipped, maybeFar + 8);
+        EXPECT_LE(work.staticRaysSkipped, maybeFar + (scene.vertexCount() - floorVertices));
         EXPECT_GT(surelyFar, 300u);
     }
 }
@@ -211,13 +192,13 @@ TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
 // areas, coverage) equals the one found with every static ray traced, with and without
 // coverage, on every scene above.
 TEST(DiscRegions, TheStaticShortcutChangesNoDisc) {
-    for (auto [file, radius] : kShortcutScenes) {
-        const Scene scene = shortcutScene(file);
+    for (const ShortcutScene& c : kShortcutScenes) {
+        const Scene scene = shortcutScene(c);
         EmbreeDevice device;
         const SceneBvh bvh(device, scene);
         for (bool coverage : {false, true}) {
-            SCOPED_TRACE(std::string(file) + (coverage ? ", with coverage" : ""));
-            DiscRegions quick(radius, coverage), reference(radius, coverage);
+            SCOPED_TRACE(std::string(c.name) + (coverage ? ", with coverage" : ""));
+            DiscRegions quick(c.radius, coverage), reference(c.radius, coverage);
             reference.useStaticShortcut(false);
             quick.computeAll(scene, bvh);
             reference.computeAll(scene, bvh);

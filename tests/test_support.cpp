@@ -128,6 +128,17 @@ void addGrid(Scene& s, int node, Vec3f corner, Vec3f u, Vec3f v, int cells, uint
         }
     s.addInstance(node, std::move(p), std::move(n), idx, material);
 }
+
+// A box standing on y = 0 over [−half, half]² and `height` high: its four sides and top, facing
+// out (the bottom, on the floor, left out), `cells` per face.
+void addBoxOnFloor(Scene& s, int node, float half, float height, int cells, uint32_t material) {
+    const float h = half;
+    addGrid(s, node, {-h, 0, h}, {2 * h, 0, 0}, {0, height, 0}, cells, material);           // +z
+    addGrid(s, node, {h, 0, -h}, {-2 * h, 0, 0}, {0, height, 0}, cells, material);          // -z
+    addGrid(s, node, {h, 0, h}, {0, 0, -2 * h}, {0, height, 0}, cells, material);           // +x
+    addGrid(s, node, {-h, 0, -h}, {0, 0, 2 * h}, {0, height, 0}, cells, material);          // -x
+    addGrid(s, node, {-h, height, h}, {2 * h, 0, 0}, {0, 0, -2 * h}, cells, material);      // top
+}
 }  // namespace
 
 Scene closedSphere(float radius, int subdivisions, Vec3f albedo, bool inwardNormals) {
@@ -213,13 +224,17 @@ Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo) {
     const uint32_t m = addMaterial(s, albedo);
     const int floor = s.addNode("Floor", Transform());
     addGrid(s, floor, {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, floorCells, m);
-    const int cube = s.addNode("Cube", Transform());
     const float h = 0.3f;
-    addGrid(s, cube, {-h, 0, h}, {2 * h, 0, 0}, {0, 2 * h, 0}, cubeCells, m);        // +z
-    addGrid(s, cube, {h, 0, -h}, {-2 * h, 0, 0}, {0, 2 * h, 0}, cubeCells, m);       // -z
-    addGrid(s, cube, {h, 0, h}, {0, 0, -2 * h}, {0, 2 * h, 0}, cubeCells, m);        // +x
-    addGrid(s, cube, {-h, 0, -h}, {0, 0, 2 * h}, {0, 2 * h, 0}, cubeCells, m);       // -x
-    addGrid(s, cube, {-h, 2 * h, h}, {2 * h, 0, 0}, {0, 0, -2 * h}, cubeCells, m);   // top
+    addBoxOnFloor(s, s.addNode("Cube", Transform()), h, 2 * h, cubeCells, m);
+    s.finalize();
+    return s;
+}
+
+Scene slabOnFloor(int floorCells, float half, float height, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    addGrid(s, s.addNode("Floor", Transform()), {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, floorCells, m);
+    addBoxOnFloor(s, s.addNode("Slab", Transform()), half, height, 1, m);
     s.finalize();
     return s;
 }

@@ -81,6 +81,9 @@ qsgi::Scene plane(float halfSize, int cells, qsgi::Vec3f albedo);
 qsgi::Scene closedBox(int cells);
 // A 4x4 m floor (y = 0) with a 0.6 m cube on it: the cube's convex edges make silhouettes.
 qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo);
+// A floor y = 0 (x, z in [-1, 1], `floorCells` per side, its vertices first) with a closed slab
+// standing on it: [−half, half]² and `height` high (a rug, when low).
+qsgi::Scene slabOnFloor(int floorCells, float half, float height, qsgi::Vec3f albedo);
 // An inside corner: floor y = 0 (x in [-1,1], z in [0,2]) and wall z = 0 (x in [-1,1], y in [0,2]).
 qsgi::Scene corner(int cells, qsgi::Vec3f albedo);
 // A floor y = 0 (x, z in [-1, 1]) with a square opaque plate (half size `half`, zero thickness,

@@ -67,15 +67,12 @@ namespace {
 constexpr int cornerSlot(int ring, int sector) { return (ring - 1) * kDiscSectors + sector; }
 constexpr int centreSlot(int cell) { return kDiscRings * kDiscSectors + cell; }
 
-// Per thread: the rays the regions asked Embree (DiscRegions::Work).
-using Tally = DiscRegions::Work;
-
 // What a disc's rays may skip asking the static BVH, every answer being the one it would give.
 struct StaticShortcuts {
-    bool nothingNear = false;  // no static triangle near any of the disc's rays: all clear
+    bool nothingNear = false;  // no static triangle near rises to the disc's rays: all clear
     DiscRegions::StaticAnswers* answers = nullptr;  // where corner and centre answers are kept
     bool reuse = false;  // read them from there (kept for this very start and lift)
-    Tally* tally = nullptr;  // counts the rays asked
+    DiscRegions::Work* tally = nullptr;  // counts the rays traced
 };
 
 // The cells of v's disc that light can reach from `startPoint` (docs/design.md §5).
@@ -188,7 +185,7 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
 // Whether some cell centre of v's disc is reachable from `start`: then the full regions keep that
 // start (they look further only when nothing is reachable from it).
 bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
-                         float radius, Tally& tally) {
+                         float radius, DiscRegions::Work& tally) {
     const DiscPatternPoints& points = discPatternPoints();
     for (int c = 0; c < kDiscCells; ++c) {
         ++tally.rays;
@@ -201,7 +198,7 @@ bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v,
 
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
-                             OwnSurfaceScratch& scratch, Tally& tally, DiscRegions::StaticAnswers* answers,
+                             OwnSurfaceScratch& scratch, DiscRegions::Work& tally, DiscRegions::StaticAnswers* answers,
                              bool staticShortcut, bool startOnly = false) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
@@ -332,10 +329,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
         }
         if (progress) progress->add(range.size());
     });
-    for (const Work& t : tallies) {
-        lastWork_.rays += t.rays;
-        lastWork_.staticRaysSkipped += t.staticRaysSkipped;
-    }
+    for (const Work& t : tallies) lastWork_ += t;
     std::vector<uint32_t> out;
     for (size_t i = 0; i < vertices.size(); ++i)
         if (changed[i]) out.push_back(vertices[i]);

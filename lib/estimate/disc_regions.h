@@ -115,6 +115,11 @@ public:
     struct Work {
         uint64_t rays = 0;
         uint64_t staticRaysSkipped = 0;
+        Work& operator+=(const Work& o) {
+            rays += o.rays;
+            staticRaysSkipped += o.staticRaysSkipped;
+            return *this;
+        }
     };
     const Work& lastWork() const { return lastWork_; }
     // Off: every static ray is traced, the shortcut never taken (the reference its tests compare with).

@@ -16,10 +16,7 @@ void VertexGeometry::computeAll(const Scene& scene, const SceneBvh& bvh, WorkCou
     if (!regions_) return;
     Stopwatch clock;
     regions_->computeAll(scene, bvh, progress);
-    stats.discRegionsUpdated = scene.vertexCount();
-    stats.discRegionsSeconds = clock.seconds();
-    stats.discRegionsRays = regions_->lastWork().rays;
-    stats.discRegionsStaticSkipped = regions_->lastWork().staticRaysSkipped;
+    recordWork(scene.vertexCount(), clock.seconds(), stats);
 }
 
 std::vector<uint32_t> VertexGeometry::update(const Scene& scene, const SceneBvh& bvh, const std::vector<Bounds3f>& movedBounds,
@@ -39,11 +36,15 @@ std::vector<uint32_t> VertexGeometry::update(const Scene& scene, const SceneBvh&
         if (vertexMoved[v]) changed.push_back(v);
     std::sort(changed.begin(), changed.end());
     changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-    stats.discRegionsUpdated = touched.size();
-    stats.discRegionsSeconds = clock.seconds();
+    recordWork(touched.size(), clock.seconds(), stats);
+    return changed;
+}
+
+void VertexGeometry::recordWork(uint64_t vertices, double seconds, FrameTiming& stats) const {
+    stats.discRegionsUpdated = vertices;
+    stats.discRegionsSeconds = seconds;
     stats.discRegionsRays = regions_->lastWork().rays;
     stats.discRegionsStaticSkipped = regions_->lastWork().staticRaysSkipped;
-    return changed;
 }
 
 void VertexGeometry::report(FrameTiming& stats) const {

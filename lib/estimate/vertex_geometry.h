@@ -46,6 +46,9 @@ public:
     void report(FrameTiming& stats) const;
 
 private:
+    // The regions' time, vertices and work of this frame, into timing.json's fields.
+    void recordWork(uint64_t vertices, double seconds, FrameTiming& stats) const;
+
     bool estimatorReadsRegions_;
     std::optional<DiscRegions> regions_;
 };

@@ -1,8 +1,9 @@
 // The envelope of the moving geometry (docs/design.md §6 step 5): boxes that hold every pose of each
 // moving instance over the whole animation (Scene::sweptBoxes), dilated by a margin. A light path
 // can change only from a segment that meets it: a moving triangle is hit or blocks inside it, and
-// every disc an update recomputes lies inside it. Paths that never meet it are folded into the estimators' sums once and never searched
-// again; the others are tracked from their first segment that does.
+// every disc an update recomputes lies inside it. Paths that never meet it are folded into the
+// estimators' sums once and never searched again; the others are tracked from their first
+// segment that does.
 #pragma once
 
 #include <vector>

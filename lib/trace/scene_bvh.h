@@ -66,7 +66,7 @@ public:
     };
     uint32_t staticOccludesPacket(const RayPacket& rays) const;
     // False only if no static triangle that comes within `radius` of `centre` has a corner at
-    // `height` or more above the plane through `centre` with unit normal `normal` (an Embree
+    // `height` or more above `centre`, heights measured along `normal` (an Embree
     // point query, tested on each triangle's box: true may be said of a triangle a little
     // farther). A ray that stays within the ball and higher than `height` above the plane
     // (a triangle's highest point is a corner) is then never blocked by static geometry; with
