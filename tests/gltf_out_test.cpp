@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <regex>
 
 #include "output/ply_reader.h"
 #include "test_support.h"
@@ -17,41 +18,65 @@ namespace fs = std::filesystem;
 
 namespace {
 
-nlohmann::json checkGlb(const fs::path& glb) {
+// The checkers are a test dependency (scripts/setup.sh --test installs them), so their absence
+// fails the tests rather than skipping them: a skip would let CI pass without checking a file.
+std::string checkerCommand(const fs::path& glb, const std::string& options) {
     const fs::path tool = sourceDir() / "scripts/gltf-check";
     if (!fs::exists(tool / "node_modules/gltf-validator"))
         throw std::runtime_error("the glTF checkers are not installed: run scripts/setup.sh (npm ci in " +
                                  tool.string() + ")");
-    const CommandResult r = runCommand("node " + (tool / "check.mjs").string() + " " + glb.string() + " 2>/dev/null");
+    return "node " + (tool / "check.mjs").string() + options + " " + glb.string();
+}
+
+nlohmann::json checkGlb(const fs::path& glb) {
+    const CommandResult r = runCommand(checkerCommand(glb, " --json"));
     if (r.exitCode != 0) throw std::runtime_error("check.mjs failed on " + glb.string() + ": " + r.output);
+    // runCommand adds stderr to the output, but check.mjs writes there only when it fails.
     return nlohmann::json::parse(r.output);
 }
 
 // Relative difference, with a floor for values near zero.
 double relativeDifference(double a, double b) { return std::fabs(a - b) / std::max({std::fabs(a), std::fabs(b), 1e-6}); }
 
+std::string frameName(int frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%04d", frame);
+    return name;
+}
+
 }  // namespace
 
-TEST(GltfOut, FramesPassTheKhronosValidatorAndCarryThePlysGeometryAndRadiance) {
-    const fs::path out = testScratchDir("gltf-out");
-    const std::string common = (sourceDir() / "data/cornell/cornell.gltf").string() + " --animation " +
-                               (sourceDir() / "data/cornell/animation.json").string() +
-                               " --frames 0:2 --photons 20000 --no-exr --gltf-out --quiet" + kCheapSecondPass;
-    const CommandResult r = runQsgi("render " + common + " --threads 2 --out " + (out / "a").string());
-    ASSERT_EQ(r.exitCode, 0) << r.output;
+// Frames 0 to 2 of the animated data/cornell, rendered once for the suite: every test here reads
+// them, and the render is the suite's main cost.
+class GltfOut : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        out_ = testScratchDir("gltf-out");
+        render_ = runQsgi("render " + common() + " --threads 2 --out " + (out_ / "a").string());
+    }
+    static std::string common() {
+        return (sourceDir() / "data/cornell/cornell.gltf").string() + " --animation " +
+               (sourceDir() / "data/cornell/animation.json").string() +
+               " --frames 0:2 --photons 20000 --no-exr --gltf-out --quiet" + kCheapSecondPass;
+    }
+    static inline fs::path out_;
+    static inline CommandResult render_;
+};
+
+TEST_F(GltfOut, FramesPassTheKhronosValidatorAndCarryThePlysGeometryAndRadiance) {
+    ASSERT_EQ(render_.exitCode, 0) << render_.output;
 
     std::vector<float> firstPositions;
     for (int frame = 0; frame <= 2; ++frame) {
         SCOPED_TRACE("frame " + std::to_string(frame));
-        char name[32];
-        std::snprintf(name, sizeof name, "frame_%04d", frame);
+        const std::string name = frameName(frame);
         nlohmann::json glb;
-        ASSERT_NO_THROW(glb = checkGlb(out / "a" / (std::string(name) + ".glb")));
+        ASSERT_NO_THROW(glb = checkGlb(out_ / "a" / (name + ".glb")));
         const nlohmann::json& v = glb["validator"];
         EXPECT_EQ(v["errors"], 0) << v["messages"].dump(1);
         EXPECT_EQ(v["warnings"], 0) << v["messages"].dump(1);
 
-        const VertexRadiosityPly ply = readVertexRadiosityPly((out / "a" / (std::string(name) + ".ply")).string());
+        const VertexRadiosityPly ply = readVertexRadiosityPly((out_ / "a" / (name + ".ply")).string());
         const size_t n = ply.positions.size();
         const auto position = glb["position"].get<std::vector<float>>();
         const auto radiance = glb["radiance"].get<std::vector<float>>();
@@ -92,8 +117,27 @@ TEST(GltfOut, FramesPassTheKhronosValidatorAndCarryThePlysGeometryAndRadiance) {
     }
 
     // Same inputs and seed, other thread count: the same bytes.
-    const CommandResult one = runQsgi("render " + common + " --threads 1 --out " + (out / "b").string());
+    const CommandResult one = runQsgi("render " + common() + " --threads 1 --out " + (out_ / "b").string());
     ASSERT_EQ(one.exitCode, 0) << one.output;
     for (const char* frame : {"frame_0000.glb", "frame_0002.glb"})
-        EXPECT_EQ(readFileBytes(out / "a" / frame), readFileBytes(out / "b" / frame)) << frame;
+        EXPECT_EQ(readFileBytes(out_ / "a" / frame), readFileBytes(out_ / "b" / frame)) << frame;
+}
+
+// Without --json the checker prints a summary for people (issue 35): a few lines, not the ~1 MB of
+// arrays, with the validator's counts and each primitive's attributes and vertex count.
+TEST_F(GltfOut, TheCheckersSummaryIsShortWithTheValidatorsCountsAndTheVertexCount) {
+    ASSERT_EQ(render_.exitCode, 0) << render_.output;
+    const fs::path glb = out_ / "a" / (frameName(0) + ".glb");
+    std::string command;
+    ASSERT_NO_THROW(command = checkerCommand(glb, ""));
+    const CommandResult r = runCommand(command);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_LT(r.output.size(), 4096u) << r.output;
+    EXPECT_NE(r.output.find(": 0 errors, 0 warnings,"), std::string::npos) << r.output;
+
+    const size_t n = readVertexRadiosityPly((out_ / "a" / (frameName(0) + ".ply")).string()).positions.size();
+    std::smatch position;
+    ASSERT_TRUE(std::regex_search(r.output, position, std::regex("\\n +POSITION +count ([0-9]+) +VEC3 FLOAT\\n")))
+        << r.output;
+    EXPECT_EQ(std::stoul(position[1].str()), n) << r.output;
 }
