@@ -170,13 +170,23 @@ TEST(Inspect, ASceneWithoutLightsIsReportedNotRefused) {
     const CommandResult text = runQsgi("inspect " + dark);
     ASSERT_EQ(text.exitCode, 0) << text.output;
     EXPECT_NE(text.output.find("lights     none"), std::string::npos) << text.output;
-    EXPECT_NE(text.output.find("give lights in a config"), std::string::npos) << text.output;
+    for (const char* way : {"\"lights\" in a config", "--sky R,G,B", "--environment FILE"})
+        EXPECT_NE(text.output.find(way), std::string::npos) << text.output;
     const json r = inspectJson(dark);
     EXPECT_FALSE(r["lit"].get<bool>());
     EXPECT_GT(r["scene"]["triangles"].get<int>(), 0);
     EXPECT_NE(r["output_folder"]["render"].get<std::string>().find("no lights"), std::string::npos);
     const fs::path out = fs::path(testScratchDir("inspect-dark")) / "out";
     EXPECT_EQ(runQsgi("render " + dark + " --out " + out.string()).exitCode, 2);
+
+    // With a sky the scene is lit, and the sky is all its power: π R² ∫ L dω = π R² 4π L.
+    const CommandResult sky = runQsgi("inspect " + dark + " --sky 0.5");
+    ASSERT_EQ(sky.exitCode, 0) << sky.output;
+    EXPECT_NE(sky.output.find("  sky (1 x 1 pixels)"), std::string::npos) << sky.output;
+    const json lit = inspectJson(dark + " --sky 0.5");
+    EXPECT_TRUE(lit["lit"].get<bool>());
+    EXPECT_EQ(lit["environment"]["type"], "sky");
+    EXPECT_DOUBLE_EQ(lit["environment"]["share"].get<double>(), 1.0);
 }
 
 // Every render option is accepted (change a render's verb to check it), and the report says which

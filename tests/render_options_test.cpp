@@ -57,6 +57,8 @@ json otherValue(const RenderOption& o, const RenderSettings& s) {
             return "elsewhere.gltf";
         case OptionType::Object:
             if (std::string(o.key) == "camera") return 3;
+            if (std::string(o.key) == "sky") return json::array({0.5, 0.25, 1});
+            if (std::string(o.key) == "environment") return "sky.exr";
             return json::parse(R"([{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1]}])");
     }
     return nullptr;
@@ -315,4 +317,53 @@ TEST(RenderOptions, AnUnknownKeyNamesTheNearestKnownKeyMisspeltOrInOtherWords) {
     RenderSettings s;
     const InputError e = refusal([&] { applyConfigJson("my.json", json{{"photon_count", 1000}}, s); });
     EXPECT_EQ(std::string(e.what()), "my.json: photon_count: unknown key (did you mean \"photons\"?)");
+}
+
+// A config's lights take KHR_lights_punctual's spot light and at most one sky or environment map;
+// --sky and --environment set the same settings from the command line, by the same rules.
+TEST(RenderOptions, LightsTakeSpotsAndOneSkyOrEnvironment) {
+    RenderSettings s;
+    applyConfigJson("c.json", json::parse(R"({"lights": [
+        {"type": "spot", "position": [0, 2, 0], "direction": [0, -2, 0], "intensity": [5, 5, 5], "outer_cone_angle": 0.6},
+        {"type": "sky", "radiance": [0.25, 0.5, 1]}]})"), s);
+    ASSERT_EQ(s.extraLights.size(), 1u);
+    EXPECT_EQ(s.extraLights[0].type, LightType::Spot);
+    EXPECT_FLOAT_EQ(s.extraLights[0].cosOuterCone, std::cos(0.6f));
+    EXPECT_EQ(s.extraLights[0].direction, Vec3f(0, -1, 0));
+    ASSERT_TRUE(s.environment.sky.has_value());
+    EXPECT_EQ(*s.environment.sky, Vec3f(0.25f, 0.5f, 1.0f));
+
+    // The command line's --sky R,G,B is the config's [r, g, b]; a later --environment replaces it.
+    const RenderOption* sky = optionWithKey("sky");
+    const RenderOption* environment = optionWithKey("environment");
+    ASSERT_TRUE(sky && environment);
+    RenderSettings t;
+    applyCommandLineOption(*sky, "0.25,0.5,1", t);
+    EXPECT_EQ(sky->get(t), sky->get(s));
+    applyCommandLineOption(*sky, "2", t);
+    EXPECT_EQ(*t.environment.sky, Vec3f(2.0f));
+    applyCommandLineOption(*environment, R"({"image": "maps/sky.exr", "rotation": 90, "intensity": 3})", t);
+    EXPECT_FALSE(t.environment.sky.has_value());
+    EXPECT_EQ(t.environment.image, "maps/sky.exr");
+    EXPECT_EQ(t.environment.rotationDegrees, 90.0f);
+    EXPECT_EQ(t.environment.intensity, 3.0f);
+    applyCommandLineOption(*environment, "other.hdr", t);
+    EXPECT_EQ(t.environment.image, "other.hdr");
+    EXPECT_EQ(t.environment.rotationDegrees, 0.0f);
+
+    auto refusedFor = [](const std::string& config) {
+        RenderSettings r;
+        return refusal([&] { applyConfigJson("c.json", json::parse(config), r); });
+    };
+    EXPECT_EQ(refusedFor(R"({"lights": [{"type": "sky", "radiance": 1}, {"type": "environment", "image": "a.exr"}]})").place(),
+              "lights[1]");
+    EXPECT_EQ(refusedFor(R"({"lights": [{"type": "sky", "radiance": [1, -1, 1]}]})").place(), "lights[0].radiance");
+    EXPECT_EQ(refusedFor(R"({"lights": [{"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0],
+                                          "intensity": [1, 1, 1], "outer_cone_angle": 0.3, "inner_cone_angle": 0.4}]})").place(),
+              "lights[0].inner_cone_angle");
+    EXPECT_EQ(refusedFor(R"({"environment": {"image": "a.exr", "intensity": 0}})").place(), "environment.intensity");
+    EXPECT_EQ(refusedFor(R"({"lights": [{"type": "area"}]})").place(), "lights[0].type");
+    RenderSettings r;
+    EXPECT_EQ(refusal([&] { applyCommandLineOption(*sky, "1,x,2", r); }).place(), "--sky");
+    EXPECT_EQ(refusal([&] { applyCommandLineOption(*sky, "-1", r); }).place(), "--sky");
 }

@@ -73,6 +73,7 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
         if (l.type == LightType::Spot && dot(-w, Vec3d(l.direction)) < double(l.cosOuterCone)) continue;
         if (shadowTo(Vec3d(l.position), direction, tfar)) visit(direction, tfar, Vec3d(l.intensity) * (cosV / d2));
     }
+    if (scene.environment && samples_ > 0) environmentRays(*scene.environment, n, v, visit);
     if (emitters_.empty() || samples_ == 0) return;
     const VertexSamples numbers(seed_, v, VertexStream::Direct);
     const double perSample = 1.0 / double(samples_);
@@ -95,6 +96,38 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
         // L_e cosθ_v cosθ_e / (d² p), p = P(emitter) / area.
         const double weight = cosV * cosE / d2 * double(emitter.area) / emitter.probability * perSample;
         if (shadowTo(x, direction, tfar)) visit(direction, tfar, Vec3d(emitter.radiance) * weight);
+    }
+}
+
+template <class Visit>
+void DirectLight::environmentRays(const EnvironmentLight& environment, const Vec3d& n, uint32_t v, Visit&& visit) const {
+    constexpr float kInfinity = std::numeric_limits<float>::infinity();
+    const VertexSamples numbers(seed_, v, VertexStream::Environment);
+    const Vec3f normal(n);
+    const double perSample = 1.0 / double(samples_);
+    if (environment.isUniform()) {
+        // Cosine-distributed rays: L cosθ / (cosθ / π) = π L each, so an unshadowed vertex gets
+        // π L exactly, whatever the sample count.
+        const Vec3d each = Vec3d(environment.radiance(normal)) * (M_PI * perSample);
+        for (uint32_t i = 0; i < samples_; ++i) visit(cosineHemisphere(normal, numbers.uniform(i, 0), numbers.uniform(i, 1)), kInfinity, each);
+        return;
+    }
+    // A map: S cosine-distributed rays and S drawn from the map, each weighted by the balance
+    // heuristic, L cosθ / (p_cos + p_map) / S (Veach's one-sample-per-technique MIS). Cosine rays
+    // find a broad sky, map rays a small bright sun; neither alone does both.
+    for (uint32_t i = 0; i < samples_; ++i) {
+        const Vec3f w = cosineHemisphere(normal, numbers.uniform(i, 0), numbers.uniform(i, 1));
+        const double cosV = dot(n, Vec3d(w));
+        if (!(cosV > 0)) continue;
+        const double weight = cosV / (cosV / M_PI + environment.pdf(w)) * perSample;
+        visit(w, kInfinity, Vec3d(environment.radiance(w)) * weight);
+    }
+    for (uint32_t i = 0; i < samples_; ++i) {
+        const EnvironmentLight::DirectionSample d = environment.sample(numbers.uniform(i, 2), numbers.uniform(i, 3));
+        const double cosV = dot(n, Vec3d(d.towardSky));
+        if (!(cosV > 0)) continue;
+        const double weight = cosV / (cosV / M_PI + d.pdf) * perSample;
+        visit(d.towardSky, kInfinity, Vec3d(d.radiance) * weight);
     }
 }
 

@@ -8,7 +8,12 @@
 //   triangles     the emitter's power and uniformly on it (p = P(triangle) / area), from v's own
 //                 scrambled Sobol points: stratified over the emitters by power, with the cosine
 //                 and distance terms exact. Only the front (CCW) side emits, as for photons.
-// One ray per punctual light; S for all emissive triangles together. Each vertex's sum runs in a
+//   environment   a uniform sky: (1/S) Σ π L V(ω_i) over S cosine-distributed directions (π L
+//                 exactly where nothing is in the way); a map: S cosine-distributed and S
+//                 map-distributed directions, each L cosθ / (p_cos + p_map) / S (balance heuristic),
+//                 shadow rays to infinity.
+// One ray per punctual light; S for all emissive triangles together; S (sky) or 2S (map) for the
+// environment. Each vertex's sum runs in a
 // fixed order in one thread, so the bits depend on nothing but the geometry and the seed.
 //
 // After a move only vertices whose start moved, or one of whose shadow segments meets a mover's old
@@ -57,6 +62,9 @@ private:
     // emitter) are not visited.
     template <class Visit>
     void forEachShadowRay(const Scene& scene, const VertexStarts& starts, uint32_t v, Visit&& visit) const;
+    // forEachShadowRay's rays toward the environment, for vertex v with normal n.
+    template <class Visit>
+    void environmentRays(const EnvironmentLight& environment, const Vec3d& n, uint32_t v, Visit&& visit) const;
     // Adds the shadow rays it casts to `rays`.
     Vec3f vertexIrradiance(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, uint32_t v, uint64_t& rays) const;
 

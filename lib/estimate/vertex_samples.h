@@ -14,7 +14,7 @@
 
 namespace qsgi {
 
-enum class VertexStream : uint32_t { Direct = 1, Gather = 2 };
+enum class VertexStream : uint32_t { Direct = 1, Gather = 2, Environment = 3 };
 
 class VertexSamples {
 public:

@@ -71,12 +71,18 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         light.position = Vec3f(Vec3d(light.position) - scene_.worldOrigin);
         scene_.lights.push_back(light);
     }
+    if (settings_.environment.given()) {
+        const EnvironmentSettings& e = settings_.environment;
+        scene_.environment = std::make_shared<const EnvironmentLight>(
+            e.sky ? EnvironmentLight::uniform(*e.sky) : EnvironmentLight::fromImage(e.image, e.intensity, e.rotationDegrees));
+    }
     if (scene_.triangleCount() == 0) throw InputError(settings_.scenePath, "", "the scene has no triangles");
     bool emissive = false;
     for (uint32_t t = 0; t < scene_.triangleCount() && !emissive; ++t)
         emissive = scene_.materials[scene_.triangleMaterial[t]].isEmissive() && scene_.triangleArea(t) > 0;
     lit_ = emissive;
     for (const PunctualLight& l : scene_.lights) lit_ = lit_ || luminance(l.intensity) > 0;
+    if (scene_.environment) lit_ = lit_ || luminance(scene_.environment->integral()) > 0;
 
     // Where the animation comes from, as messages name it.
     std::string animationSource = settings_.animationPath;
@@ -152,8 +158,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
 void RenderJob::refuseIfUnlit() const {
     if (!lit_)
         throw InputError(settings_.scenePath, "",
-                         "the scene has no lights (no emissive material, no KHR_lights_punctual light); add one with "
-                         "\"lights\" in a --config file");
+                         "the scene has no lights (no emissive material, no KHR_lights_punctual light); light it with "
+                         "\"lights\" in a --config file, a sky (--sky R,G,B) or an HDR environment map (--environment FILE)");
 }
 
 std::string RenderJob::unplayedAnimationsNote() const {

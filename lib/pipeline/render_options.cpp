@@ -39,10 +39,73 @@ Vec3f vec3(const json& j, const std::string& file, const std::string& place) {
 }
 json toJson(const Vec3f& v) { return json::array({v.x, v.y, v.z}); }
 
+// A radiance: [r, g, b] or one number (grey) in a config, "R,G,B" or "V" on the command line;
+// finite and non-negative.
+Vec3f parseRadiance(const json& j, const std::string& file, const std::string& place) {
+    json value = j;
+    if (j.is_string()) {
+        // "R,G,B" as the JSON array it spells; anything else is refused below.
+        value = json::parse("[" + j.get<std::string>() + "]", nullptr, false);
+        if (value.is_array() && value.size() == 1) value = value[0];
+    }
+    const char* shape = "must be a radiance (W m^-2 sr^-1): [r, g, b] or one number in a config, R,G,B or V on the command line";
+    Vec3f radiance;
+    if (value.is_number()) {
+        const double v = value.get<double>();
+        if (!(std::fabs(v) <= std::numeric_limits<float>::max())) throw InputError(file, place, "holds a number beyond single precision");
+        radiance = Vec3f(float(v));
+    } else if (value.is_array() && value.size() == 3) {
+        radiance = vec3(value, file, place);
+    } else {
+        throw InputError(file, place, shape);
+    }
+    if (radiance.x < 0 || radiance.y < 0 || radiance.z < 0) throw InputError(file, place, "must be non-negative");
+    return radiance;
+}
+
+// An equirectangular map: its path, or {"image", "intensity", "rotation"} (the "type" key
+// allowed, as a "lights" entry has it).
+void parseEnvironmentMap(const json& j, const OptionSource& src, EnvironmentSettings& e) {
+    if (j.is_string()) {
+        if (j.get<std::string>().empty()) throw InputError(src.file, src.place, "must name an image file");
+        e = EnvironmentSettings{};
+        e.image = resolved(j, src);
+        e.source = src.file;
+        return;
+    }
+    const char* shape = "must be an image's path or {\"image\": FILE, \"intensity\": k, \"rotation\": degrees}";
+    if (!j.is_object()) throw InputError(src.file, src.place, shape);
+    refuseUnknownKeys(j, {"type", "image", "intensity", "rotation"}, src.file, src.place);
+    if (!j.contains("image") || !j["image"].is_string() || j["image"].get<std::string>().empty())
+        throw InputError(src.file, src.place + ".image", "must name an image file (EXR, Radiance HDR, anything OpenImageIO reads)");
+    EnvironmentSettings out;
+    out.image = resolved(j["image"], src);
+    out.source = src.file;
+    if (j.contains("intensity")) {
+        const json& k = j["intensity"];
+        if (!k.is_number() || !(k.get<double>() > 0) || !(k.get<double>() <= double(std::numeric_limits<float>::max())))
+            throw InputError(src.file, src.place + ".intensity", "must be a positive number (the map's pixels are multiplied by it)");
+        out.intensity = k.get<float>();
+    }
+    if (j.contains("rotation")) {
+        const json& r = j["rotation"];
+        if (!r.is_number() || !(std::fabs(r.get<double>()) <= 1e6))
+            throw InputError(src.file, src.place + ".rotation", "must be a number of degrees (about +Y, counter-clockwise seen from above)");
+        out.rotationDegrees = r.get<float>();
+    }
+    e = out;
+}
+
+json environmentJson(const EnvironmentSettings& e) {
+    if (e.image.empty()) return nullptr;
+    return {{"image", pathJson(e.image)}, {"intensity", e.intensity}, {"rotation", e.rotationDegrees}};
+}
+
 PunctualLight parseLight(const json& j, const std::string& file, const std::string& place) {
     if (!j.is_object() || !j.contains("type") || !j["type"].is_string())
-        throw InputError(file, place, "must be an object with a \"type\" (point or directional)");
-    refuseUnknownKeys(j, {"type", "position", "intensity", "direction", "irradiance", "name"}, file, place);
+        throw InputError(file, place, "must be an object with a \"type\" (point, spot, directional, sky or environment)");
+    refuseUnknownKeys(j, {"type", "position", "intensity", "direction", "irradiance", "name", "outer_cone_angle", "inner_cone_angle"},
+                      file, place);
     PunctualLight l;
     const std::string type = j["type"];
     l.name = place;
@@ -63,13 +126,39 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
         l.direction = normalize(vec3(j["direction"], file, place + ".direction"));
         if (dot(l.direction, l.direction) == 0) throw InputError(file, place + ".direction", "must not be zero");
         l.intensity = nonNegative(vec3(j["irradiance"], file, place + ".irradiance"), "irradiance");
+    } else if (type == "spot") {
+        // As KHR_lights_punctual's: intensity in W/sr on the axis, cone angles in radians from it.
+        l.type = LightType::Spot;
+        if (!j.contains("position") || !j.contains("direction") || !j.contains("intensity"))
+            throw InputError(file, place, "a spot light needs \"position\", \"direction\" and \"intensity\" (W/sr)");
+        l.position = vec3(j["position"], file, place + ".position");
+        l.direction = normalize(vec3(j["direction"], file, place + ".direction"));
+        if (!(dot(l.direction, l.direction) > 0)) throw InputError(file, place + ".direction", "must not be zero");
+        l.intensity = nonNegative(vec3(j["intensity"], file, place + ".intensity"), "intensity");
+        auto angle = [&](const char* key, double fallback) {
+            if (!j.contains(key)) return fallback;
+            if (!j[key].is_number()) throw InputError(file, place + "." + key, "must be a number (radians)");
+            return j[key].get<double>();
+        };
+        const double outer = angle("outer_cone_angle", M_PI / 4), inner = angle("inner_cone_angle", 0);
+        if (!(outer > 0 && outer <= M_PI / 2 + 1e-9))
+            throw InputError(file, place + ".outer_cone_angle", "must lie in (0, pi/2] (as KHR_lights_punctual's)");
+        if (!(inner >= 0 && inner < outer))
+            throw InputError(file, place + ".inner_cone_angle", "must lie in [0, outer_cone_angle)");
+        // The inner angle is checked as glTF's is, and not used: qsgi's spot lights, glTF's too,
+        // send their intensity uniformly up to the outer cone (docs/inputs.md).
+        l.cosOuterCone = float(std::cos(outer));
     } else {
-        throw InputError(file, place + ".type", "unknown light type '" + type + "' (point or directional)");
+        throw InputError(file, place + ".type",
+                         "unknown light type '" + type + "' (point, spot, directional, sky or environment)");
     }
     return l;
 }
 
 json lightJson(const PunctualLight& l) {
+    if (l.type == LightType::Spot)
+        return {{"type", "spot"}, {"position", toJson(l.position)}, {"direction", toJson(l.direction)},
+                {"intensity", toJson(l.intensity)}, {"outer_cone_angle", std::acos(double(l.cosOuterCone))}};
     if (l.type == LightType::Directional)
         return {{"type", "directional"}, {"direction", toJson(l.direction)}, {"irradiance", toJson(l.intensity)}};
     return {{"type", "point"}, {"position", toJson(l.position)}, {"intensity", toJson(l.intensity)}};
@@ -109,11 +198,11 @@ json getCamera(const RenderSettings& s) {
 }
 
 // Every setting is reachable: each field of RenderSettings and of the stage settings it holds is
-// set by an option below, except the five that record where values came from (configPath,
-// radiusGiven, qmcBouncesGiven, gatherGiven, framesSource), EmissionAim's margin (FrameSolver
+// set by an option below, except the six that record where values came from (configPath,
+// radiusGiven, qmcBouncesGiven, gatherGiven, framesSource, EnvironmentSettings' source), EmissionAim's margin (FrameSolver
 // sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
 // added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 31, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 32, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
 static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
@@ -121,6 +210,7 @@ static_assert(fieldCount<EstimatorSettings>() == 6, "an EstimatorSettings field 
 static_assert(fieldCount<PhotonMapSettings>() == 1, "a PhotonMapSettings field was added or removed: give it an option");
 static_assert(fieldCount<DetpSettings>() == 2, "a DetpSettings field was added or removed: give it an option");
 static_assert(fieldCount<LightingSettings>() == 3, "a LightingSettings field was added or removed: give it an option");
+static_assert(fieldCount<EnvironmentSettings>() == 5, "an EnvironmentSettings field was added or removed: give it an option");
 static_assert(fieldCount<UpdateSettings>() == 5, "an UpdateSettings field was added or removed: give it an option");
 
 std::vector<RenderOption> declareOptions() {
@@ -320,13 +410,38 @@ std::vector<RenderOption> declareOptions() {
                  [](const RenderSettings& s) { return json(s.overwrite); }});
     // Lights added to the scene
     o.push_back({"lights", nullptr, T::Object, 0, 0, "", {}, true, "", "none",
-                 "lights added to any scene: [{\"type\": \"point\", \"position\": [x,y,z], \"intensity\": [r,g,b] (W/sr)} "
-                 "or {\"type\": \"directional\", \"direction\": [x,y,z], \"irradiance\": [r,g,b] (W/m^2)}], world space",
+                 "lights added to any scene, world space: [{\"type\": \"point\", \"position\": [x,y,z], \"intensity\": "
+                 "[r,g,b] (W/sr)}, {\"type\": \"spot\", \"position\", \"direction\", \"intensity\", \"outer_cone_angle\", "
+                 "\"inner_cone_angle\" (radians, as KHR_lights_punctual)}, {\"type\": \"directional\", \"direction\": [x,y,z], "
+                 "\"irradiance\": [r,g,b] (W/m^2)}, {\"type\": \"sky\", \"radiance\": [r,g,b]} or {\"type\": \"environment\", "
+                 "\"image\": FILE, \"intensity\": k, \"rotation\": degrees} (at most one of the last two; as sky and environment)]",
                  true, false,
                  [](RenderSettings& s, const json& v, const OptionSource& src) {
                      if (!v.is_array()) throw InputError(src.file, src.place, "must be an array of lights");
-                     for (size_t i = 0; i < v.size(); ++i)
-                         s.extraLights.push_back(parseLight(v[i], src.file, src.place + "[" + std::to_string(i) + "]"));
+                     std::string environmentAt;  // the entry that gave the environment, if one did
+                     for (size_t i = 0; i < v.size(); ++i) {
+                         const std::string place = src.place + "[" + std::to_string(i) + "]";
+                         const json& entry = v[i];
+                         const std::string type = entry.is_object() && entry.contains("type") && entry["type"].is_string()
+                                                      ? entry["type"].get<std::string>() : "";
+                         if (type != "sky" && type != "environment") {
+                             s.extraLights.push_back(parseLight(entry, src.file, place));
+                             continue;
+                         }
+                         if (!environmentAt.empty())
+                             throw InputError(src.file, place, "a second sky or environment (the first is " + environmentAt +
+                                                                   "): a scene has at most one");
+                         environmentAt = place;
+                         if (type == "environment") {
+                             parseEnvironmentMap(entry, OptionSource{src.file, place, src.base}, s.environment);
+                             continue;
+                         }
+                         refuseUnknownKeys(entry, {"type", "radiance"}, src.file, place);
+                         if (!entry.contains("radiance")) throw InputError(src.file, place, "a sky needs \"radiance\": [r, g, b]");
+                         s.environment = EnvironmentSettings{};
+                         s.environment.sky = parseRadiance(entry["radiance"], src.file, place + ".radiance");
+                         s.environment.source = src.file;
+                     }
                  },
                  [](const RenderSettings& s) {
                      if (s.extraLights.empty()) return json(nullptr);
@@ -334,6 +449,23 @@ std::vector<RenderOption> declareOptions() {
                      for (const PunctualLight& l : s.extraLights) list.push_back(lightJson(l));
                      return list;
                  }});
+    o.push_back({"sky", "--sky", T::Object, 0, 0, "", {}, true, "R,G,B", "none",
+                 "a uniform sky of this radiance (W m^-2 sr^-1; one number is grey) lights the scene from every "
+                 "direction, replacing an environment map",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     s.environment = EnvironmentSettings{};
+                     s.environment.sky = parseRadiance(v, src.file, src.place);
+                     s.environment.source = src.file;
+                 },
+                 [](const RenderSettings& s) { return s.environment.sky ? toJson(*s.environment.sky) : json(nullptr); }});
+    o.push_back({"environment", "--environment", T::Object, 0, 0, "", {}, true, "FILE", "none",
+                 "an equirectangular HDR map (EXR, Radiance HDR) lights the scene from every direction, replacing a "
+                 "sky; in a config also {\"image\": FILE, \"intensity\": k, \"rotation\": degrees about +Y} "
+                 "(docs/inputs.md: the map's orientation)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) { parseEnvironmentMap(v, src, s.environment); },
+                 [](const RenderSettings& s) { return environmentJson(s.environment); }});
     // Images
     o.push_back({"width", "--width", T::Integer, 1, double(kMaxImageSide), "", {}, true, "W", "640",
                  "image width in pixels", true, false,
@@ -463,9 +595,11 @@ void applyCommandLineOption(const RenderOption& o, const std::string& text, Rend
     const OptionSource src{"command line", o.flag, {}};
     json value = text;
     if (o.type == OptionType::Integer || o.type == OptionType::Number || o.type == OptionType::Object) {
-        // A number as JSON writes it ("1e6" too); anything else is refused by the same check as a config's.
+        // A number as JSON writes it ("1e6" too), or for a structured option a JSON object or array
+        // as a config holds it; anything else is refused by the same check as a config's.
         value = json::parse(text, nullptr, false);
-        if (value.is_discarded() || !value.is_number()) value = text;
+        const bool structured = o.type == OptionType::Object && (value.is_object() || value.is_array());
+        if (value.is_discarded() || !(value.is_number() || structured)) value = text;
     }
     if (o.type == OptionType::Boolean) value = o.flagSets;
     applyOption(o, value, src, s);

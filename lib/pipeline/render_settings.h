@@ -49,6 +49,7 @@ struct RenderSettings {
     bool overwrite = false;  // replace another run's frames and timing.json in outDir
     std::string framesSource;  // where frames came from (the config or "command line"), for messages
     std::vector<PunctualLight> extraLights;  // world space, from the config
+    EnvironmentSettings environment;         // a sky or an HDR map (--sky, --environment, "lights")
 
     // Images (docs/design.md §7)
     int width = 640, height = 480;

@@ -89,6 +89,13 @@ RunFingerprint runFingerprint(const RenderSettings& s, const Scene& scene, const
             f.addValue(l.intensity);
             f.addValue(l.cosOuterCone);
         }
+        // Only when there is one, so that runs without keep their fingerprints.
+        if (scene.environment) {
+            f.addValue(scene.environment->width());
+            f.addValue(scene.environment->height());
+            f.add(scene.environment->pixels());
+            f.addValue(scene.environment->rotationDegrees());
+        }
     });
     both(animation, [&](Fingerprinter& f) { f.add(animationBytes); });
     // Every option that reaches the frame files, as the option table declares them (the scene's

@@ -132,7 +132,8 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
     const LightSampler sampler(scene, 1, scene.sceneEpsilon());
     const std::vector<Vec3f> powers = sampler.lightPowers(scene.lights.size());
     const Vec3f trianglePower = sampler.emissiveTrianglePower();
-    double total = luminance(trianglePower);
+    const Vec3f environmentPower = sampler.environmentPower();
+    double total = luminance(trianglePower) + luminance(environmentPower);
     for (const Vec3f& p : powers) total += luminance(p);
     auto share = [&](const Vec3f& p) { return total > 0 ? double(luminance(p)) / total : 0.0; };
     nlohmann::json lights = nlohmann::json::array();
@@ -149,6 +150,18 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
     r["lights"] = lights;
     r["lit"] = job.hasLight();
     r["emissive_surfaces"] = {{"power_w", luminance(trianglePower)}, {"share", share(trianglePower)}};
+    if (scene.environment) {
+        const EnvironmentSettings& e = settings.environment;
+        r["environment"] = {{"type", scene.environment->isUniform() ? "sky" : "environment"},
+                            {"image", e.image.empty() ? nlohmann::json(nullptr) : pathJson(e.image)},
+                            {"pixels", {scene.environment->width(), scene.environment->height()}},
+                            {"rotation", e.rotationDegrees},
+                            // What enters the bounding sphere of the animation, π R² ∫ L dω.
+                            {"power_w", luminance(environmentPower)},
+                            {"share", share(environmentPower)}};
+    } else {
+        r["environment"] = nullptr;
+    }
 
     const Camera& camera = job.camera();
     r["cameras"] = {{"in_scene", scene.cameras.size()},
@@ -227,14 +240,19 @@ std::string inspectionText(const nlohmann::json& r) {
          std::to_string(m["emissive"].get<uint64_t>()) + " emissive (" + std::to_string(m["emissive_triangles"].get<uint64_t>()) +
          " triangles, " + number(100 * r["emissive_surfaces"]["share"].get<double>(), "%.1f") + " % of the power)");
     if (!r["lit"].get<bool>())
-        line("lights     none: no emissive material and no light of any power; give lights in a config (\"lights\": "
-             "point or directional, docs/inputs.md) before rendering");
+        line("lights     none: no emissive material and no light of any power; light the scene with \"lights\" in a "
+             "config (docs/inputs.md), --sky R,G,B or --environment FILE before rendering");
     else
         line("lights     " + std::to_string(r["lights"].size()));
     for (const auto& l : r["lights"])
         line("  " + l["type"].get<std::string>() + " '" + l["name"].get<std::string>() + "' (" + l["from"].get<std::string>() +
              "): " + number(l["power_w"].get<double>()) + " W, " + number(100 * l["share"].get<double>(), "%.1f") +
              " % of the power");
+    if (const auto& e = r["environment"]; !e.is_null())
+        line("  " + e["type"].get<std::string>() + (e["image"].is_null() ? "" : " " + shownPath(e["image"])) + " (" +
+             std::to_string(e["pixels"][0].get<uint32_t>()) + " x " + std::to_string(e["pixels"][1].get<uint32_t>()) +
+             " pixels): " + number(e["power_w"].get<double>()) + " W into the animation's bounding sphere, " +
+             number(100 * e["share"].get<double>(), "%.1f") + " % of the power");
     const auto& c = r["cameras"];
     line("camera     " + c["render"]["projection"].get<std::string>() + ", from " + c["render"]["from"].get<std::string>() +
          " (" + std::to_string(c["in_scene"].get<uint64_t>()) + " in the scene)");

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "scene/camera.h"
+#include "scene/environment_light.h"
 #include "scene/keyframes.h"
 #include "util/vecmath.h"
 
@@ -121,6 +123,9 @@ struct Scene {
     std::vector<MeshInstance> instances;
     std::vector<Material> materials;
     std::vector<PunctualLight> lights;
+    // Light from infinitely far away (a sky or an HDR map), from the config or the command line;
+    // shared, as a map can be large and a scene is copied whole.
+    std::shared_ptr<const EnvironmentLight> environment;
     std::optional<Camera> camera;          // the first camera node's
     std::vector<std::optional<Camera>> cameras;  // by glTF camera index (first node using it)
     std::vector<KeyframeAnimation> animations;             // the file's own (glTF animations)

@@ -11,6 +11,8 @@
 #include <cstring>
 #include <vector>
 
+#include "util/error.h"
+
 namespace qsgi {
 namespace {
 
@@ -23,14 +25,6 @@ const char* extensionOf(const unsigned char* bytes, size_t size) {
     if (size >= sizeof png && std::memcmp(bytes, png, sizeof png) == 0) return "png";
     if (size >= sizeof jpeg && std::memcmp(bytes, jpeg, sizeof jpeg) == 0) return "jpg";
     return nullptr;
-}
-
-// OIIO's messages may span lines; a warning is one.
-std::string oneLine(std::string text) {
-    for (char& c : text)
-        if (c == '\n') c = ' ';
-    while (!text.empty() && text.back() == ' ') text.pop_back();
-    return text;
 }
 
 std::string tooManyPixels(uint64_t width, uint64_t height) {

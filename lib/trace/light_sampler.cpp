@@ -60,12 +60,19 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         // One-sided Lambertian emitter: exitance π L_e over the area.
         emitters_.push_back({Emitter::Triangle, t, m.emission * (kPi * area), Vec3f(0.0f), -1, scene.geometricNormal(t)});
     }
+    if (scene.environment) {
+        // Through the disc of radius R facing each direction: π R² ∫ L dω.
+        const Vec3d power = scene.environment->integral() * (M_PI * double(boundsRadius_) * double(boundsRadius_));
+        emitters_.push_back({Emitter::Environment, 0, Vec3f(power), Vec3f(0.0f)});
+    }
+    // Emissive triangles and the environment are never aimed.
+    auto aimable = [](const Emitter& e) { return e.kind != Emitter::Triangle && e.kind != Emitter::Environment; };
     size_t aimedLights = 0;
-    for (const Emitter& e : emitters_) aimedLights += aim.enabled && e.kind != Emitter::Triangle;
+    for (const Emitter& e : emitters_) aimedLights += aim.enabled && aimable(e);
     mapDepth_ = mapDepthFor(aimedLights);
     double unaimed = 0;
     for (Emitter& e : emitters_) {
-        if (e.kind == Emitter::Triangle || !aim.enabled) {
+        if (!aimable(e) || !aim.enabled) {
             unaimed += luminance(e.power);
             continue;
         }
@@ -90,7 +97,13 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
     for (Emitter& e : emitters_) {
         const double p = luminance(e.power) / sum;
         e.photonPower = e.power * float(1.0 / (double(photonCount) * p));
-        maxPhotonPower_ = std::max(maxPhotonPower_, maxComponent(e.photonPower));
+        // An environment photon's power has the luminance of photonPower and the colour of its
+        // pixel (sample()), so its largest component is at most the map's largest chroma times
+        // that luminance (a little above it, for the float roundings in between).
+        const float largest = e.kind == Emitter::Environment
+                                  ? float(scene.environment->largestChroma() * double(luminance(e.photonPower)) * (1 + 1e-6))
+                                  : maxComponent(e.photonPower);
+        maxPhotonPower_ = std::max(maxPhotonPower_, largest);
     }
     if (dealSeed && !emitters_.empty()) {
         const double offset = double(mix64(*dealSeed ^ 0xDEA1DEA1DEA1ull) >> 11) * 0x1p-53;
@@ -166,8 +179,14 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
 std::vector<Vec3f> LightSampler::lightPowers(size_t lightCount) const {
     std::vector<Vec3f> powers(lightCount, Vec3f(0.0f));
     for (const Emitter& e : emitters_)
-        if (e.kind != Emitter::Triangle && e.index < lightCount) powers[e.index] = e.power;
+        if (e.kind != Emitter::Triangle && e.kind != Emitter::Environment && e.index < lightCount) powers[e.index] = e.power;
     return powers;
+}
+
+Vec3f LightSampler::environmentPower() const {
+    for (const Emitter& e : emitters_)
+        if (e.kind == Emitter::Environment) return e.power;
+    return Vec3f(0.0f);
 }
 
 Vec3f LightSampler::emissiveTrianglePower() const {
@@ -240,6 +259,21 @@ PhotonEmission LightSampler::sample(const PathNumbers& rng) const {
             uniformDisc(u0, u1, x, y);
             out.origin = boundsCentre_ + (t * x + b * y) * boundsRadius_ - l.direction * (2 * boundsRadius_);
             out.direction = l.direction;
+            break;
+        }
+        case Emitter::Environment: {
+            // The direction from the main pair, the point on the disc from the other.
+            const EnvironmentLight& environment = *scene_.environment;
+            const EnvironmentLight::DirectionSample d = environment.sample(v0, v1);
+            Vec3f t, b;
+            orthonormalBasis(d.towardSky, t, b);
+            float x, y;
+            uniformDisc(u0, u1, x, y);
+            out.origin = boundsCentre_ + (t * x + b * y) * boundsRadius_ + d.towardSky * (2 * boundsRadius_);
+            out.direction = -d.towardSky;
+            // L(ω) π R² / (p(ω) N P(environment)) with p = luminance(L) / ∫ luminance(L) dω: the
+            // pixel's colour at the luminance every environment photon carries.
+            out.power = d.radiance * float(double(luminance(e.photonPower)) / double(luminance(d.radiance)));
             break;
         }
         case Emitter::Triangle: {

@@ -1,5 +1,9 @@
-// Chooses where photons start (docs/design.md §4): every emitter — punctual lights and each emissive
-// triangle — in proportion to the power it sends toward the scene. With aiming on, point, spot
+// Chooses where photons start (docs/design.md §4): every emitter — punctual lights, each emissive
+// triangle and the environment — in proportion to the power it sends toward the scene. The
+// environment emits as an infinite light does in a physically based renderer: a direction in
+// proportion to the map's luminance × solid angle (EnvironmentLight::sample), a point uniform on a
+// disc facing it that covers the animation's bounding sphere, power L(ω) π R² / p(ω) per photon
+// before the share of photons, so the photons carry π R² ∫ L dω exactly. With aiming on, point, spot
 // and directional lights emit only where their projection map (projection_map.h) says photons
 // may reach geometry, each photon carrying the power of the part actually sampled.
 #pragma once
@@ -30,9 +34,10 @@ public:
 
     bool empty() const { return emitters_.empty(); }
     // What each emitter sends toward the scene (W, RGB): punctual lights by index (zero for one
-    // that sends nothing), and every emissive triangle together.
+    // that sends nothing), every emissive triangle together, and the environment.
     std::vector<Vec3f> lightPowers(size_t lightCount) const;
     Vec3f emissiveTrianglePower() const;
+    Vec3f environmentPower() const;
     Vec3f totalPower() const { return totalPower_; }  // W, RGB, that the emitters send
     // The luminance of what the emitters send over what they would send unaimed: the share of
     // the lights' power that can reach the scene (1 unaimed).
@@ -62,8 +67,8 @@ private:
         double cosSpot = -1;
     };
     struct Emitter {
-        enum Kind { Point, Spot, Directional, Triangle } kind;
-        uint32_t index;   // light or triangle index
+        enum Kind { Point, Spot, Directional, Triangle, Environment } kind;
+        uint32_t index;   // light or triangle index (0 for the environment)
         Vec3f power;      // W, sent toward the scene
         Vec3f photonPower;
         int aim = -1;     // into aims_, −1: unaimed

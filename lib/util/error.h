@@ -60,4 +60,12 @@ struct Warnings {
     }
 };
 
+// A library's message (OpenImageIO's may span lines) made one line, as every message qsgi prints is.
+inline std::string oneLine(std::string text) {
+    for (char& c : text)
+        if (c == '\n') c = ' ';
+    while (!text.empty() && text.back() == ' ') text.pop_back();
+    return text;
+}
+
 }  // namespace qsgi
