@@ -226,6 +226,37 @@ TEST(Incremental, WithExactDirectEqualsFullWithOneThreadAndWithoutGather) {
     }
 }
 
+// Light from the environment (issue 35): its photons come from outside the scene's bounds and its
+// shadow rays run to infinity; both are kept and updated as every other light's, to the bit. A sky,
+// and a map with a bright low sun the cube's shadow sweeps across, under the paper's method and
+// with exact direct light and a gather.
+TEST(Incremental, UnderASkyOrAnEnvironmentMapEveryFrameEqualsFull) {
+    auto underSky = [](bool map) {
+        return [map] {
+            Scene s = testscenes::boxOnFloor(16, 3, Vec3f(0.7f));
+            if (!map) {
+                s.environment = std::make_shared<const EnvironmentLight>(EnvironmentLight::uniform(Vec3f(0.6f, 0.8f, 1.0f)));
+                return s;
+            }
+            std::vector<Vec3f> pixels(16 * 8, Vec3f(0.2f, 0.3f, 0.5f));
+            pixels[3 * 16 + 5] = Vec3f(400.0f, 380.0f, 300.0f);  // a sun 20-odd degrees above the horizon
+            s.environment = std::make_shared<const EnvironmentLight>(EnvironmentLight::fromPixels(pixels, 16, 8, 35));
+            return s;
+        };
+    };
+    const AnimatedScene skies[] = {
+        {"under a sky", underSky(false), "Cube", [](int f) { return slide(f, 0.11, 0.05); }, 4},
+        {"under an environment map", underSky(true), "Cube", [](int f) { return slide(f, -0.09, 0.07); }, 4},
+    };
+    for (const AnimatedScene& a : skies)
+        for (const EstimatorCase& e : kEstimators) {
+            if (!e.index || e.rule != DetpBoundary::Clip) continue;  // impact count, photon map, DETP
+            expectIncrementalEqualsFull(a, e, 2, true, 6000, 0.12f);
+            expectIncrementalEqualsFull(a, e, 2, true, 6000, 0.12f, TrackedPaths::kGenerations, exactDirect(16));
+            if (HasFatalFailure()) return;
+        }
+}
+
 TEST(Incremental, EqualsFullWithOneThreadAndWithoutTheEnvelope) {
     const AnimatedScene a = scenes()[0];
     for (const EstimatorCase& e : kEstimators) {
