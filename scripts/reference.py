@@ -19,9 +19,11 @@ Setup (Debian 12): pip install mitsuba drjit numpy; apt-get install libllvm19. D
 make Dr.Jit's JIT fail ("Cannot select fminimum"), so this script points DRJIT_LIBLLVM_PATH at
 LLVM 19 when it is not set.
 
-  scripts/reference.py SCENE.gltf QSGI_FRAME.ply OUT.ply [--spp N] [--seed S] [--config CONFIG]
+  scripts/reference.py SCENE.gltf QSGI_FRAME.ply OUT.ply [--spp N] [--seed S] [--config CONFIG] [--sky R,G,B]
 
-CONFIG: a qsgi config whose "lights" are added (point lights only here).
+CONFIG: a qsgi config whose "lights" are added (point lights and a uniform sky only here); --sky R,G,B
+adds a uniform sky as qsgi's --sky does (Mitsuba's `constant` emitter). Light that escapes to the sky
+is the sky's emission: it is in E_direct, and subtracted from the gathered rays as a hit's emission is.
 """
 import argparse
 import base64
@@ -149,15 +151,32 @@ def gltf_point_lights(path, config):
         lights.append((node.get("translation", [0, 0, 0]), [c * light.get("intensity", 1.0) for c in colour]))
     if config:
         for light in json.load(open(config)).get("lights", []):
+            if light["type"] == "sky":
+                continue  # read by config_sky
             if light["type"] != "point":
-                sys.exit(f"{config}: only point lights are supported by this script")
+                sys.exit(f"{config}: only point lights and a sky are supported by this script")
             lights.append((light["position"], light["intensity"]))
     return lights
 
 
+def config_sky(config):
+    """The radiance of a config's sky (its "sky" key or a "lights" entry of type sky), or None."""
+    if not config:
+        return None
+    doc = json.load(open(config))
+    if "sky" in doc:
+        value = doc["sky"]
+        return [float(value)] * 3 if isinstance(value, (int, float)) else [float(c) for c in value]
+    for light in doc.get("lights", []):
+        if light["type"] == "sky":
+            value = light["radiance"]
+            return [float(value)] * 3 if isinstance(value, (int, float)) else [float(c) for c in value]
+    return None
+
+
 # ---------------------------------------------------------------------------------------------
 
-def build_scene(positions, faces, albedo, emission, point_lights, workdir):
+def build_scene(positions, faces, albedo, emission, point_lights, sky, workdir):
     shapes = {"type": "scene", "integrator": {"type": "path", "max_depth": 64, "rr_depth": 8}}
     # One mesh per material, from the PLY's world-space triangles.
     face_material = [(tuple(albedo[f[0]]), tuple(emission[f[0]])) for f in faces]
@@ -186,6 +205,8 @@ def build_scene(positions, faces, albedo, emission, point_lights, workdir):
         shapes[f"group{g}"] = shape
     for i, (p, intensity) in enumerate(point_lights):
         shapes[f"light{i}"] = {"type": "point", "position": list(p), "intensity": {"type": "rgb", "value": list(intensity)}}
+    if sky is not None:
+        shapes["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": list(sky)}}
     return mi.load_dict(shapes)
 
 
@@ -229,7 +250,8 @@ def irradiance(scene, origins, normals, spp, seed, chunk):
         ray = mi.Ray3f(o, d)
         L, _, _ = integrator.sample(scene, sampler, ray)
         si = scene.ray_intersect(ray)
-        emitted = dr.select(si.is_valid(), si.emitter(scene).eval(si), 0)
+        # A ray that escapes meets the environment: si.emitter() is then the scene's sky (none: 0).
+        emitted = si.emitter(scene).eval(si)
         total = direct + dr.pi * (L - emitted)
         values = np.array(mi.TensorXf(dr.ravel(total), (size, 3)))
         out[start:end] = values.reshape(n, spp, 3).mean(1)
@@ -243,7 +265,8 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=1024, help="paths per vertex (default 1024)")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--config", help="qsgi config whose point lights are added")
+    ap.add_argument("--config", help="qsgi config whose point lights and sky are added")
+    ap.add_argument("--sky", help="R,G,B: a uniform sky of this radiance, as qsgi's --sky")
     ap.add_argument("--chunk", type=int, default=2048, help="vertices per wavefront")
     args = ap.parse_args()
 
@@ -254,7 +277,10 @@ def main():
         sys.exit(f"{args.frame_ply} has {len(positions)} vertices but {args.scene} flattens to {len(albedo)}")
     diagonal = float(np.linalg.norm(positions.max(0) - positions.min(0)))
     with tempfile.TemporaryDirectory() as workdir:
-        scene = build_scene(positions, faces, albedo, emission, gltf_point_lights(args.scene, args.config), workdir)
+        sky = [float(c) for c in args.sky.split(",")] if args.sky else config_sky(args.config)
+        if sky is not None and len(sky) == 1:
+            sky = sky * 3
+        scene = build_scene(positions, faces, albedo, emission, gltf_point_lights(args.scene, args.config), sky, workdir)
     started = time.time()
     E = irradiance(scene, query_points(positions, normals, faces, diagonal), normals, args.spp, args.seed, args.chunk)
     B = albedo * E + np.pi * emission

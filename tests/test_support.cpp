@@ -13,6 +13,7 @@
 
 #include <unistd.h>
 
+#include "scene/gltf_loader.h"
 #include "trace/photon_tracer.h"
 
 namespace fs = std::filesystem;
@@ -20,6 +21,15 @@ using namespace qsgi;
 
 fs::path sourceDir() { return fs::path(QSGI_SOURCE_DIR); }
 fs::path sharedDir() { return sourceDir().parent_path() / "shared"; }
+
+Scene loadReferenceScene(const std::string& relativePath) {
+    Warnings w;
+    Scene scene = loadGltfScene((sourceDir() / relativePath).string(), w);
+    const std::string suffix = "_sky.gltf";
+    if (relativePath.size() > suffix.size() && relativePath.compare(relativePath.size() - suffix.size(), suffix.size(), suffix) == 0)
+        scene.environment = std::make_shared<const EnvironmentLight>(EnvironmentLight::uniform(Vec3f(1.0f)));
+    return scene;
+}
 
 namespace {
 // Every test process writes under a folder of its own, so that two test runs at once (the release

@@ -40,6 +40,11 @@ inline constexpr const char* kCheapSecondPass = " --gather 16 --direct-samples 4
 std::filesystem::path sourceDir();  // the repository root
 std::filesystem::path sharedDir();  // ../shared beside the repository (may be absent)
 std::string testScratchDir(const std::string& name);
+// A scene of the reference tests (tests/reference_accuracy_test.cpp, tests/gather_accuracy_test.cpp)
+// by its path under the repository, lit as its reference was rendered: a scene named *_sky.gltf
+// has no light of its own and gets the uniform sky of radiance 1 its reference was made under
+// (scripts/reference.py --sky 1,1,1), as --sky 1,1,1 gives it.
+qsgi::Scene loadReferenceScene(const std::string& relativePath);
 
 struct CommandResult {
     int exitCode;
