@@ -67,9 +67,11 @@ TEST(Inspect, IncludesAConfigsLightsAndRadiusAndTheRendersWarnings) {
     EXPECT_FLOAT_EQ(r["radius"]["value"].get<float>(), 0.02f);
 
     // A scene with no camera: the render would warn that it frames the bounds; so does inspect.
+    // (Its one quad, 4 r across many times, is warned about too: mesh_resolution.h.)
     const json noCamera = inspectJson((sourceDir() / "tests/data/good/base.gltf").string() + " --config " + config.string());
-    ASSERT_EQ(noCamera["warnings"].size(), 1u) << noCamera.dump(2);
+    ASSERT_EQ(noCamera["warnings"].size(), 2u) << noCamera.dump(2);
     EXPECT_NE(noCamera["warnings"][0].get<std::string>().find("no camera"), std::string::npos);
+    EXPECT_NE(noCamera["warnings"][1].get<std::string>().find("longer than 4 r"), std::string::npos);
 }
 
 TEST(Inspect, BadInputGetsTheRendersMessageAndExitCode) {
@@ -215,4 +217,26 @@ TEST(Inspect, TakesARendersCommandLineAndReportsItsOptionsAndTheOutputFolder) {
     EXPECT_EQ(r["output_folder"]["state"], "another run");
     EXPECT_EQ(r["output_folder"]["differences"], json::array({"photons 20000 there, 30000 here"}));
     EXPECT_NE(r["output_folder"]["render"].get<std::string>().find("refuses"), std::string::npos);
+}
+
+// A mesh too coarse for the radius (issue 35): a quad of two triangles, each edge many radii long,
+// carries no shadow or patch of light smaller than itself. inspect counts the triangles with an
+// edge past 4 r, their vertices and their share of the area, and the run warns; data/cornell's
+// grids are within 4 r and get no warning.
+TEST(Inspect, TrianglesLongerThanFourRadiiAreCountedAndWarnedAbout) {
+    const json quad = inspectJson((sourceDir() / "tests/data/good/base.gltf").string() + " --sky 1 --radius 0.05");
+    const json& m = quad["mesh_resolution"];
+    EXPECT_DOUBLE_EQ(m["edge_limit"].get<double>(), 4 * double(0.05f));
+    EXPECT_EQ(m["coarse_triangles"].get<int>(), 2);
+    EXPECT_EQ(m["coarse_vertices"].get<int>(), 4);
+    EXPECT_DOUBLE_EQ(m["coarse_area_share"].get<double>(), 1.0);
+    bool warned = false;
+    for (const auto& w : quad["warnings"]) warned = warned || w.get<std::string>().find("2 of 2 triangles have an edge longer than 4 r") != std::string::npos;
+    EXPECT_TRUE(warned) << quad["warnings"].dump();
+    // A radius a quarter of the quad's side or more: nothing is coarse.
+    EXPECT_EQ(inspectJson((sourceDir() / "tests/data/good/base.gltf").string() + " --sky 1 --radius 1")["mesh_resolution"]
+                  ["coarse_triangles"].get<int>(), 0);
+    const json cornellReport = inspectJson(cornell());
+    EXPECT_EQ(cornellReport["mesh_resolution"]["coarse_triangles"].get<int>(), 0);
+    EXPECT_LE(cornellReport["mesh_resolution"]["longest_edge"].get<double>(), cornellReport["mesh_resolution"]["edge_limit"].get<double>());
 }

@@ -103,6 +103,17 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
 
     camera_ = resolveCamera(settings_, scene_, warnings);
     if (!settings_.radiusGiven) settings_.estimator.radius = defaultRadius(scene_);
+    resolution_ = qsgi::meshResolution(scene_, settings_.estimator.radius);
+    if (resolution_.coarseAreaShare() >= kCoarseAreaWarning) {
+        char text[400];
+        std::snprintf(text, sizeof text,
+                      "%zu of %zu triangles have an edge longer than 4 r = %g (the longest %g): they cover %.1f %% of the "
+                      "surface with %zu vertices, and radiosity lives at vertices, so no shadow or patch of light smaller "
+                      "than them can show (a finer mesh, or a larger --radius, matches the two)",
+                      resolution_.coarseTriangles, scene_.triangleCount(), resolution_.edgeLimit, resolution_.longestEdge,
+                      100 * resolution_.coarseAreaShare(), resolution_.coarseVertices);
+        warnings.add(settings_.scenePath + ": " + text);
+    }
 
     first_ = 0;
     last_ = animation_.lastFrame();

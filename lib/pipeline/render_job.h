@@ -9,6 +9,7 @@
 #include "pipeline/run_fingerprint.h"
 #include "pipeline/render_settings.h"
 #include "scene/animation.h"
+#include "scene/mesh_resolution.h"
 #include "scene/scene.h"
 #include "util/error.h"
 
@@ -74,6 +75,8 @@ public:
     const Camera& camera() const { return camera_; }  // at frame 0
     int firstFrame() const { return first_; }
     int lastFrame() const { return last_; }
+    // The rest pose's triangles against 4 r (a warning when any is longer: mesh_resolution.h).
+    const MeshResolution& meshResolution() const { return resolution_; }
     // Whether anything emits: an emissive triangle with area or a light of nonzero power.
     bool hasLight() const { return lit_; }
     // Throws InputError for a scene without light (run() does too).
@@ -95,6 +98,7 @@ private:
     int first_ = 0, last_ = 0;
     RunFingerprint fingerprint_;
     bool lit_ = false;
+    MeshResolution resolution_;
 };
 
 }  // namespace qsgi

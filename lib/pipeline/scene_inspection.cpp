@@ -191,6 +191,12 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
                       {"dynamic_fraction", scene.triangleCount() ? double(dynamicTriangles) / scene.triangleCount() : 0.0},
                       {"bounds", {{"min", world(scene.animationBounds.lower, scene)}, {"max", world(scene.animationBounds.upper, scene)}}},
                       {"diagonal", scene.animationBounds.extent()}};
+    const MeshResolution& mesh = job.meshResolution();
+    r["mesh_resolution"] = {{"edge_limit", mesh.edgeLimit},
+                            {"longest_edge", mesh.longestEdge},
+                            {"coarse_triangles", mesh.coarseTriangles},
+                            {"coarse_vertices", mesh.coarseVertices},
+                            {"coarse_area_share", mesh.coarseAreaShare()}};
     r["radius"] = {{"value", settings.estimator.radius},
                    {"from", settings.radiusGiven ? "settings" : "default: 1.5 % of the animation's diagonal"}};
     r["animation"]["unplayed_animations"] = job.unplayedAnimationsNote();
@@ -272,6 +278,13 @@ std::string inspectionText(const nlohmann::json& r) {
          triple(a["bounds"]["min"]) + " to " + triple(a["bounds"]["max"]));
     if (!a["unplayed_animations"].get<std::string>().empty()) line("  " + a["unplayed_animations"].get<std::string>());
     line("radius     " + number(r["radius"]["value"].get<double>()) + " (" + r["radius"]["from"].get<std::string>() + ")");
+    const auto& mesh = r["mesh_resolution"];
+    const uint64_t coarse = mesh["coarse_triangles"].get<uint64_t>();
+    line("mesh       longest edge " + number(mesh["longest_edge"].get<double>()) + "; " +
+         (coarse == 0 ? std::string("no edge longer than 4 r = ") + number(mesh["edge_limit"].get<double>())
+                      : std::to_string(coarse) + " triangles longer than 4 r = " + number(mesh["edge_limit"].get<double>()) +
+                            " cover " + number(100 * mesh["coarse_area_share"].get<double>(), "%.1f") + " % of the surface with " +
+                            std::to_string(mesh["coarse_vertices"].get<uint64_t>()) + " vertices"));
     std::string options;
     for (auto it = r["options_set"].begin(); it != r["options_set"].end(); ++it)
         options += (options.empty() ? "" : ", ") + it.key() + " " +
