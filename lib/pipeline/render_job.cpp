@@ -26,6 +26,7 @@
 #include "pipeline/output_folder.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
+#include "scene/mesh_refinement.h"
 #include "trace/photon_tracer.h"
 #include "util/stopwatch.h"
 
@@ -95,6 +96,16 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     } else animation_ = Animation::fromTransformFile(settings_.animationPath, scene_);
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, animationSource);
     scene_.setRestPose(animation_.poseAt(0));
+    if (settings_.subdivide > 0) {
+        const size_t estimate = estimatedRefinedTriangles(scene_, settings_.subdivide);
+        if (double(estimate) > kMaxRefinedTriangles) {
+            char text[200];
+            std::snprintf(text, sizeof text, "%g would refine %zu triangles into about %.3g, more than %.0e: choose a longer length",
+                          double(settings_.subdivide), scene_.triangleCount(), double(estimate), kMaxRefinedTriangles);
+            throw InputError("subdivide (--subdivide)", "", text);
+        }
+        refineMesh(scene_, settings_.subdivide);
+    }
     scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
     checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
@@ -109,9 +120,9 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         std::snprintf(text, sizeof text,
                       "%zu of %zu triangles have an edge longer than 4 r = %g (the longest %g): they cover %.1f %% of the "
                       "surface with %zu vertices, and radiosity lives at vertices, so no shadow or patch of light smaller "
-                      "than them can show (a finer mesh, or a larger --radius, matches the two)",
+                      "than them can show (--subdivide %g refines them to 2 r; a larger --radius also matches the two)",
                       resolution_.coarseTriangles, scene_.triangleCount(), resolution_.edgeLimit, resolution_.longestEdge,
-                      100 * resolution_.coarseAreaShare(), resolution_.coarseVertices);
+                      100 * resolution_.coarseAreaShare(), resolution_.coarseVertices, resolution_.edgeLimit / 2);
         warnings.add(settings_.scenePath + ": " + text);
     }
 

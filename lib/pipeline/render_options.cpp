@@ -202,7 +202,7 @@ json getCamera(const RenderSettings& s) {
 // radiusGiven, qmcBouncesGiven, gatherGiven, framesSource, EnvironmentSettings' source), EmissionAim's margin (FrameSolver
 // sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
 // added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 32, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 33, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
 static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
@@ -466,6 +466,12 @@ std::vector<RenderOption> declareOptions() {
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource& src) { parseEnvironmentMap(v, src, s.environment); },
                  [](const RenderSettings& s) { return environmentJson(s.environment); }});
+    o.push_back({"subdivide", "--subdivide", T::Number, 0, kMaxSceneExtent, "", {}, true, "LENGTH", "off",
+                 "refine every triangle with an edge longer than LENGTH (scene units) before the bake, once on the "
+                 "rest pose, without T-junctions; every output holds the refined mesh (docs/inputs.md: coarse meshes)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.subdivide = v.get<float>(); },
+                 [](const RenderSettings& s) { return s.subdivide > 0 ? json(s.subdivide) : json(nullptr); }});
     // Images
     o.push_back({"width", "--width", T::Integer, 1, double(kMaxImageSide), "", {}, true, "W", "640",
                  "image width in pixels", true, false,

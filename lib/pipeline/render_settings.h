@@ -50,6 +50,7 @@ struct RenderSettings {
     std::string framesSource;  // where frames came from (the config or "command line"), for messages
     std::vector<PunctualLight> extraLights;  // world space, from the config
     EnvironmentSettings environment;         // a sky or an HDR map (--sky, --environment, "lights")
+    float subdivide = 0;  // refine triangles with an edge longer than this (scene units) on the rest pose; 0: off
 
     // Images (docs/design.md §7)
     int width = 640, height = 480;
@@ -73,6 +74,8 @@ constexpr int64_t kMaxThreads = 1024;
 constexpr int64_t kMaxImageSide = 16384;
 constexpr int64_t kMaxSamplesPerPixel = 4096;
 constexpr int64_t kMaxSeed = INT64_MAX;
+// --subdivide refuses a length that would make more triangles than this (about 40 GB of scene).
+constexpr double kMaxRefinedTriangles = 2e8;
 
 // `value` if it lies in [lo, hi], else InputError(source, place, "must lie in lo..hi" + why).
 int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string& source, const std::string& place,

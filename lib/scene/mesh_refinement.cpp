@@ -1,0 +1,194 @@
+#include "scene/mesh_refinement.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
+
+namespace qsgi {
+
+namespace {
+
+using LocalTriangle = std::array<uint32_t, 3>;
+
+// One instance's vertices (local indices) and triangles, growing as edges are split.
+class InstanceRefiner {
+public:
+    InstanceRefiner(const Scene& scene, const MeshInstance& inst)
+        : inst_(inst), positions_(inst.objectPositions), normals_(inst.objectNormals), joints_(inst.skinJoints),
+          weights_(inst.skinWeights), morphPositions_(inst.morphPositions), morphNormals_(inst.morphNormals) {
+        world_.reserve(inst.vertexCount);
+        for (uint32_t i = 0; i < inst.vertexCount; ++i) world_.push_back(Vec3d(scene.positions[inst.firstVertex + i]));
+        for (uint32_t t = 0; t < inst.triangleCount; ++t) {
+            const Triangle& tri = scene.triangles[inst.firstTriangle + t];
+            triangles_.push_back({tri.v[0] - inst.firstVertex, tri.v[1] - inst.firstVertex, tri.v[2] - inst.firstVertex});
+        }
+    }
+
+    void refine(double maxEdge) {
+        for (bool changed = true; changed;) {
+            changed = false;
+            std::vector<LocalTriangle> next;
+            next.reserve(triangles_.size() * 2);
+            for (const LocalTriangle& t : triangles_) {
+                const int e = edgeToSplit(t, maxEdge);
+                if (e < 0) {
+                    next.push_back(t);
+                    continue;
+                }
+                const uint32_t p = t[size_t(e)], q = t[size_t(e + 1) % 3], r = t[size_t(e + 2) % 3];
+                const uint32_t m = midpoint(p, q);
+                // (p, q, r) counter-clockwise gives (p, m, r) and (m, q, r), counter-clockwise.
+                next.push_back({p, m, r});
+                next.push_back({m, q, r});
+                changed = true;
+            }
+            triangles_ = std::move(next);
+        }
+    }
+
+    // Writes the refined instance back: its object-space data, and its block of the scene's arrays
+    // from `firstVertex` and `firstTriangle` on.
+    void store(MeshInstance& inst, Scene& scene, uint32_t firstVertex, uint32_t firstTriangle, uint32_t material,
+               uint32_t triangleMaterial) {
+        inst.firstVertex = firstVertex;
+        inst.vertexCount = uint32_t(positions_.size());
+        inst.firstTriangle = firstTriangle;
+        inst.triangleCount = uint32_t(triangles_.size());
+        inst.objectPositions = std::move(positions_);
+        inst.objectNormals = std::move(normals_);
+        inst.skinJoints = std::move(joints_);
+        inst.skinWeights = std::move(weights_);
+        inst.morphPositions = std::move(morphPositions_);
+        inst.morphNormals = std::move(morphNormals_);
+        for (uint32_t i = 0; i < inst.vertexCount; ++i) {
+            scene.positions.push_back(Vec3f(0.0f));
+            scene.normals.push_back(Vec3f(0.0f));
+            scene.vertexHidden.push_back(0);
+            scene.vertexMaterial.push_back(material);
+        }
+        for (const LocalTriangle& t : triangles_) {
+            scene.triangles.push_back({{firstVertex + t[0], firstVertex + t[1], firstVertex + t[2]}});
+            scene.triangleMaterial.push_back(triangleMaterial);
+        }
+    }
+
+private:
+
+    double edgeLength(uint32_t a, uint32_t b) const { return length(world_[b] - world_[a]); }
+
+    // The edge (0, 1, 2: from corner e to corner e + 1) to split: the longest, if it exceeds
+    // maxEdge; else −1.
+    int edgeToSplit(const LocalTriangle& t, double maxEdge) const {
+        int longest = -1;
+        double longestLength = maxEdge;
+        for (int e = 0; e < 3; ++e) {
+            const double len = edgeLength(t[size_t(e)], t[size_t(e + 1) % 3]);
+            if (len > longestLength) longest = e, longestLength = len;
+        }
+        return longest;
+    }
+
+    // The vertex halfway along a–b, made once per pair of corners.
+    uint32_t midpoint(uint32_t a, uint32_t b) {
+        const std::pair<uint32_t, uint32_t> pair(std::min(a, b), std::max(a, b));
+        const auto found = midpoints_.find(pair);
+        if (found != midpoints_.end()) return found->second;
+        const uint32_t m = uint32_t(positions_.size());
+        midpoints_.emplace(pair, m);
+        auto mean = [](const Vec3f& x, const Vec3f& y) { return Vec3f((Vec3d(x) + Vec3d(y)) * 0.5); };
+        positions_.push_back(mean(positions_[a], positions_[b]));
+        world_.push_back((world_[a] + world_[b]) * 0.5);
+        if (!normals_.empty()) {
+            const Vec3d n = Vec3d(normals_[a]) + Vec3d(normals_[b]);
+            // Opposite normals (a knife edge) have no mean direction: take a corner's.
+            normals_.push_back(dot(n, n) > 0 ? Vec3f(normalize(n)) : normals_[a]);
+        }
+        for (std::vector<Vec3f>& target : morphPositions_) target.push_back(mean(target[a], target[b]));
+        for (std::vector<Vec3f>& target : morphNormals_)
+            if (!target.empty()) target.push_back(mean(target[a], target[b]));
+        if (inst_.influences > 0) blendInfluences(a, b);
+        return m;
+    }
+
+    // The union of a's and b's joint influences at half weight each, the largest kept.
+    void blendInfluences(uint32_t a, uint32_t b) {
+        const size_t k = size_t(inst_.influences);
+        std::map<uint16_t, double> weightOf;
+        for (uint32_t corner : {a, b})
+            for (size_t i = 0; i < k; ++i) {
+                const double w = weights_[corner * k + i];
+                if (w > 0) weightOf[joints_[corner * k + i]] += 0.5 * w;
+            }
+        std::vector<std::pair<double, uint16_t>> ranked;
+        for (const auto& [joint, w] : weightOf) ranked.push_back({w, joint});
+        // By weight, the lower joint first among equals: the same vertex on both sides of a seam.
+        std::sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) {
+            return x.first != y.first ? x.first > y.first : x.second < y.second;
+        });
+        ranked.resize(std::min(ranked.size(), k));
+        double total = 0;
+        for (const auto& r : ranked) total += r.first;
+        for (size_t i = 0; i < k; ++i) {
+            const bool used = i < ranked.size() && total > 0;
+            joints_.push_back(used ? ranked[i].second : 0);
+            weights_.push_back(used ? float(ranked[i].first / total) : 0.0f);
+        }
+    }
+
+    const MeshInstance& inst_;
+    std::vector<Vec3f> positions_, normals_;
+    std::vector<uint16_t> joints_;
+    std::vector<float> weights_;
+    std::vector<std::vector<Vec3f>> morphPositions_, morphNormals_;
+    std::vector<Vec3d> world_;  // the current pose's, for lengths
+    std::vector<LocalTriangle> triangles_;
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints_;
+};
+
+}  // namespace
+
+RefinementReport refineMesh(Scene& scene, double maxEdge) {
+    RefinementReport report;
+    report.trianglesBefore = scene.triangleCount();
+    report.verticesBefore = scene.vertexCount();
+    std::vector<InstanceRefiner> refiners;
+    std::vector<uint32_t> materials, triangleMaterials;
+    for (const MeshInstance& inst : scene.instances) {
+        refiners.emplace_back(scene, inst);
+        refiners.back().refine(maxEdge);
+        materials.push_back(inst.vertexCount ? scene.vertexMaterial[inst.firstVertex] : 0);
+        triangleMaterials.push_back(inst.triangleCount ? scene.triangleMaterial[inst.firstTriangle] : 0);
+    }
+    scene.positions.clear();
+    scene.normals.clear();
+    scene.vertexHidden.clear();
+    scene.vertexMaterial.clear();
+    scene.triangles.clear();
+    scene.triangleMaterial.clear();
+    for (size_t i = 0; i < scene.instances.size(); ++i)
+        refiners[i].store(scene.instances[i], scene, uint32_t(scene.positions.size()), uint32_t(scene.triangles.size()),
+                          materials[i], triangleMaterials[i]);
+    for (size_t i = 0; i < scene.instances.size(); ++i)
+        scene.placeInstance(i, scene.placedWith[i], scene.placedJoints[i], scene.placedWeights[i]);
+    scene.markDynamic({});
+    report.trianglesAfter = scene.triangleCount();
+    report.verticesAfter = scene.vertexCount();
+    return report;
+}
+
+size_t estimatedRefinedTriangles(const Scene& scene, double maxEdge) {
+    double total = 0;
+    for (const Triangle& t : scene.triangles) {
+        double longest = 0;
+        for (int e = 0; e < 3; ++e)
+            longest = std::max(longest, length(Vec3d(scene.positions[t.v[(e + 1) % 3]]) - Vec3d(scene.positions[t.v[e]])));
+        const double pieces = std::max(1.0, std::ceil(longest / maxEdge));
+        total += pieces * pieces;
+    }
+    return total < 1e18 ? size_t(total) : size_t(1e18);
+}
+
+}  // namespace qsgi

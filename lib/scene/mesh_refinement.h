@@ -1,0 +1,39 @@
+// --subdivide LENGTH (issue 35): refines every triangle with an edge longer than LENGTH, so that the
+// mesh is fine enough to carry the lighting (mesh_resolution.h says when it is not).
+//
+// Decided once, on the pose the scene is in (RenderJob calls it on the rest pose, the run's first
+// frame), and then part of the scene: every frame, the PLY, EXR and glTF outputs and the run's
+// fingerprint hold the refined mesh, and incremental frames are computed on it as on any mesh.
+//
+// Longest-edge bisection: each pass splits every triangle whose longest edge exceeds LENGTH at that
+// edge's midpoint, until none does. An edge is thus split exactly when it is longer than LENGTH,
+// always at its midpoint, whichever of its triangles reaches it first: both triangles of an edge,
+// and both sides of a seam (corners duplicated for their normals or UVs), end with the same points,
+// and no T-junction is left.
+// A new vertex takes the mean of its edge's corners: object-space position and normal
+// (renormalised), every morph target's deltas, and for a skinned mesh the union of both corners'
+// joint influences at half weight, cut to the instance's influence count (four per JOINTS_n set)
+// by weight and renormalised to sum 1. Lengths are measured on the current world positions.
+#pragma once
+
+#include <cstddef>
+
+#include "scene/scene.h"
+
+namespace qsgi {
+
+struct RefinementReport {
+    size_t trianglesBefore = 0, trianglesAfter = 0;
+    size_t verticesBefore = 0, verticesAfter = 0;
+};
+
+// Refines `scene` in place (its instances, vertex and triangle arrays) and re-places every
+// instance with what it was last placed with. maxEdge > 0.
+RefinementReport refineMesh(Scene& scene, double maxEdge);
+
+// About how many triangles refineMesh(scene, maxEdge) makes (each triangle as (longest edge /
+// maxEdge)² pieces): what a run checks before refining, so that a LENGTH far too small is refused
+// instead of filling the memory.
+size_t estimatedRefinedTriangles(const Scene& scene, double maxEdge);
+
+}  // namespace qsgi
