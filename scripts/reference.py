@@ -103,13 +103,27 @@ def write_ply(path, positions, normals, faces, radiosity, comment):
 # Materials per vertex, in qsgi's flattening order (docs/design.md §2; lib/scene/gltf_loader.cpp): scene
 # roots in order, depth-first pre-order, each node's mesh primitives in order.
 
+def mean_texture_colour(gltf_path, doc, texture):
+    """The mean linear colour of a base-colour texture, as qsgi takes it (docs/inputs.md: albedo =
+    baseColorFactor x the texture's mean colour, each pixel through the sRGB curve first)."""
+    from PIL import Image  # only scenes with textures need it (pip install pillow)
+    uri = doc["images"][doc["textures"][texture["index"]]["source"]]["uri"]
+    image = Image.open(os.path.join(os.path.dirname(gltf_path), uri))
+    pixels = np.asarray(image.convert("RGB"), np.float64) / 255.0
+    linear = np.where(pixels <= 0.04045, pixels / 12.92, ((pixels + 0.055) / 1.055) ** 2.4)
+    return linear.reshape(-1, 3).mean(0)
+
+
 def gltf_vertex_materials(path):
     doc = json.load(open(path))
     scene = doc["scenes"][doc.get("scene", 0)]
     materials = doc.get("materials", [])
     albedo, emission = [], []
     for m in materials:
-        base = m.get("pbrMetallicRoughness", {}).get("baseColorFactor", [1, 1, 1, 1])[:3]
+        pbr = m.get("pbrMetallicRoughness", {})
+        base = pbr.get("baseColorFactor", [1, 1, 1, 1])[:3]
+        if "baseColorTexture" in pbr:
+            base = list(np.array(base) * mean_texture_colour(path, doc, pbr["baseColorTexture"]))
         strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
         albedo.append(base)
         emission.append([c * strength for c in m.get("emissiveFactor", [0, 0, 0])])
