@@ -274,7 +274,8 @@ int main(int argc, char** argv) {
             char text[256];
             if (r.index == 0 && r.missedFraction > 0.5 && !o.quiet) {
                 std::snprintf(text, sizeof text, "qsgi: warning: %.0f%% of the photons hit no geometry; the estimate "
-                              "rests on the rest (move lights closer or add photons)", 100 * r.missedFraction);
+                              "rests on the rest (move lights closer or add photons; a sky's photons cross the whole disc around "
+                              "the scene's bounds)", 100 * r.missedFraction);
                 display.message(text);
             }
             if (o.verbose) {

@@ -25,13 +25,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// θ (from +Y) and u = φ / 2π + ½ of a direction, as the header defines the map.
+// v = θ / π (θ from +Y) and u = φ / 2π + ½ (φ from +X toward +Z) of a direction, as the header
+// defines the map.
 struct MapCoordinates {
     double u, v;
 };
 MapCoordinates mapCoordinates(const Vec3f& w) {
     const double theta = std::acos(std::clamp(double(w.y), -1.0, 1.0));
-    const double phi = std::atan2(double(w.x), -double(w.z));
+    const double phi = std::atan2(double(w.z), double(w.x));
     return {phi / (2 * M_PI) + 0.5, theta / M_PI};
 }
 
@@ -77,17 +78,23 @@ TEST(EnvironmentLight, AUniformSkyIsTheOneByOneMap) {
     EXPECT_NEAR(sky.pdf(normalize(Vec3f(0.3f, -0.2f, 0.9f))), 1 / (4 * M_PI), 1e-12);
 }
 
-// The header's convention: the top row is +Y, the image's middle −Z, a quarter to its right +X;
-// `rotation` turns the map counter-clockwise about +Y seen from above.
+// The header's convention, Blender's and three.js's: the top row is +Y, the image's middle +X, a
+// quarter to its left −Z and to its right +Z; `rotation` turns the map counter-clockwise about +Y
+// seen from above.
 TEST(EnvironmentLight, TheMapIsOrientedAsDocumented) {
-    // 4 × 2 pixels: column 2 is u in [0.5, 0.75), φ in [0°, 90°]; row 0 the upper hemisphere. So
-    // pixel (2, 0) holds the sky between −Z and +X, above the horizon.
+    // 4 × 2 pixels: column 1 is u in [0.25, 0.5), φ in [−90°, 0°] (from −Z to +X); row 0 the upper
+    // hemisphere. So pixel (1, 0) holds the sky between −Z and +X, above the horizon.
     const Vec3f sun(3.0f, 2.0f, 1.0f);
-    const EnvironmentLight map = EnvironmentLight::fromPixels(onePixelMap(4, 2, 2, 0, sun), 4, 2, 0);
+    const EnvironmentLight map = EnvironmentLight::fromPixels(onePixelMap(4, 2, 1, 0, sun), 4, 2, 0);
     EXPECT_EQ(map.radiance(normalize(Vec3f(0.3f, 0.5f, -0.8f))), sun);
-    EXPECT_EQ(map.radiance(normalize(Vec3f(-0.3f, 0.5f, -0.8f))), Vec3f(0.0f));  // left of −Z: column 1
+    EXPECT_EQ(map.radiance(normalize(Vec3f(-0.3f, 0.5f, -0.8f))), Vec3f(0.0f));  // past −Z toward −X: column 0
     EXPECT_EQ(map.radiance(normalize(Vec3f(0.3f, -0.5f, -0.8f))), Vec3f(0.0f));  // below the horizon: row 1
-    EXPECT_EQ(map.radiance(normalize(Vec3f(0.8f, 0.5f, 0.3f))), Vec3f(0.0f));   // past +X: column 3
+    EXPECT_EQ(map.radiance(normalize(Vec3f(0.8f, 0.5f, 0.3f))), Vec3f(0.0f));   // past +X toward +Z: column 2
+    // The image's middle is +X, its left and right edges meet at −X.
+    const EnvironmentLight middle = EnvironmentLight::fromPixels(onePixelMap(4, 2, 2, 0, sun), 4, 2, 0);
+    EXPECT_EQ(middle.radiance(normalize(Vec3f(0.8f, 0.5f, 0.3f))), sun);
+    const EnvironmentLight edge = EnvironmentLight::fromPixels(onePixelMap(4, 2, 0, 0, sun), 4, 2, 0);
+    EXPECT_EQ(edge.radiance(normalize(Vec3f(-0.8f, 0.5f, -0.3f))), sun);
     forGrid(32, [&](float u0, float u1) {
         const Vec3f w = map.sample(u0, u1).towardSky;
         EXPECT_GE(w.x, -1e-6f);
@@ -95,7 +102,7 @@ TEST(EnvironmentLight, TheMapIsOrientedAsDocumented) {
         EXPECT_LE(w.z, 1e-6f);
     });
     // Turned 90°: −Z goes to −X and +X to −Z, so the sun lies between −X and −Z.
-    const EnvironmentLight turned = EnvironmentLight::fromPixels(onePixelMap(4, 2, 2, 0, sun), 4, 2, 90);
+    const EnvironmentLight turned = EnvironmentLight::fromPixels(onePixelMap(4, 2, 1, 0, sun), 4, 2, 90);
     EXPECT_EQ(turned.radiance(normalize(Vec3f(-0.8f, 0.5f, -0.3f))), sun);
     EXPECT_EQ(turned.radiance(normalize(Vec3f(0.3f, 0.5f, -0.8f))), Vec3f(0.0f));
     forGrid(32, [&](float u0, float u1) {
@@ -206,9 +213,9 @@ TEST(EnvironmentLight, APlaneUnderASkyReceivesPiTimesItsRadiance) {
     }
 }
 
-// A sun (one pixel of an 8 × 4 map: θ in [45°, 90°], φ in [0°, 45°], between −Z and +X above the
-// horizon) behind a wall that faces +Z gives it nothing; turned 180° it shines on the wall's front:
-// E = L ∫ ω_z dω over the pixel = L (π/8 + 1/4) sin 45° = 0.4545 L (the integral of sin²θ cos φ).
+// A sun (one pixel of an 8 × 4 map, column 2 and row 1: θ in [45°, 90°], φ in [−90°, −45°], from
+// −Z a quarter of the way toward +X, above the horizon) behind a wall that faces +Z gives it nothing; turned 180° it shines on the wall's front:
+// E = L ∫ ω_z dω over the pixel = L (π/8 + 1/4) sin 45° = 0.4545 L (the integral of −sin²θ sin φ).
 // The estimate mixes cosine and map directions (balance heuristic), unbiased; each map direction
 // contributes at most L Ω_pixel ≈ 0.555 L, so one vertex's 64-sample mean has a standard error of
 // at most 0.555 L / 2 / 8 = 0.035 L for independent samples, and the mean of the wall's n vertices
@@ -220,7 +227,7 @@ TEST(EnvironmentLight, ATurnedMapMovesTheSunAsTheRotationSays) {
     for (const float rotation : {0.0f, 180.0f}) {
         SCOPED_TRACE(rotation);
         Scene scene = testscenes::partition(16, Vec3f(0.5f));
-        scene.environment = shared(EnvironmentLight::fromPixels(onePixelMap(8, 4, 4, 1, sunRadiance), 8, 4, rotation));
+        scene.environment = shared(EnvironmentLight::fromPixels(onePixelMap(8, 4, 2, 1, sunRadiance), 8, 4, rotation));
         const SecondPassRig rig(scene);
         DirectLight direct(64, 5);
         direct.computeAll(scene, rig.bvh, rig.starts);
@@ -299,6 +306,16 @@ TEST(EnvironmentLight, ALightlessSceneBakesWithOneFlag) {
     for (const Vec3f& B : ply.radiosity) {
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(B[c], 0.5 * M_PI * L[c], 1e-5 * M_PI * L[c]);
     }
+
+    // A black sky lights nothing (the scene is refused as unlit); one past the power floats carry
+    // (10^30 W into the bounding sphere) is refused naming it, as a light that strong is.
+    const CommandResult black = runQsgi("render " + dark + " --sky 0 --out " + (dir / "black").string());
+    EXPECT_EQ(black.exitCode, 2) << black.output;
+    EXPECT_NE(black.output.find("no lights"), std::string::npos) << black.output;
+    const CommandResult blinding = runQsgi("render " + dark + " --sky 1e36 --out " + (dir / "blinding").string());
+    EXPECT_EQ(blinding.exitCode, 2) << blinding.output;
+    EXPECT_NE(blinding.output.find("the sky or environment map"), std::string::npos) << blinding.output;
+    EXPECT_FALSE(fs::exists(dir / "blinding" / "frame_0000.ply"));
 
     const CommandResult missing = runQsgi("render " + dark + " --environment " + (dir / "absent.exr").string() + " --out " +
                                           (dir / "missing").string());

@@ -74,8 +74,11 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     }
     if (settings_.environment.given()) {
         const EnvironmentSettings& e = settings_.environment;
-        scene_.environment = std::make_shared<const EnvironmentLight>(
+        auto light = std::make_shared<const EnvironmentLight>(
             e.sky ? EnvironmentLight::uniform(*e.sky) : EnvironmentLight::fromImage(e.image, e.intensity, e.rotationDegrees));
+        // A black sky or map lights nothing: kept, it would cast shadow rays for nothing (and its
+        // sampling has no density to draw from).
+        if (luminance(light->integral()) > 0) scene_.environment = std::move(light);
     }
     if (scene_.triangleCount() == 0) throw InputError(settings_.scenePath, "", "the scene has no triangles");
     bool emissive = false;
@@ -83,7 +86,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         emissive = scene_.materials[scene_.triangleMaterial[t]].isEmissive() && scene_.triangleArea(t) > 0;
     lit_ = emissive;
     for (const PunctualLight& l : scene_.lights) lit_ = lit_ || luminance(l.intensity) > 0;
-    if (scene_.environment) lit_ = lit_ || luminance(scene_.environment->integral()) > 0;
+    lit_ = lit_ || scene_.environment != nullptr;
 
     // Where the animation comes from, as messages name it.
     std::string animationSource = settings_.animationPath;

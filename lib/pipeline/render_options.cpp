@@ -470,7 +470,10 @@ std::vector<RenderOption> declareOptions() {
                  "refine every triangle with an edge longer than LENGTH (scene units) before the bake, once on the "
                  "rest pose, without T-junctions; every output holds the refined mesh (docs/inputs.md: coarse meshes)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.subdivide = v.get<float>(); },
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     s.subdivide = v.get<float>();
+                     if (!(s.subdivide > 0)) throw InputError(src.file, src.place, "is below single precision's smallest length");
+                 },
                  [](const RenderSettings& s) { return s.subdivide > 0 ? json(s.subdivide) : json(nullptr); }});
     // Images
     o.push_back({"width", "--width", T::Integer, 1, double(kMaxImageSide), "", {}, true, "W", "640",

@@ -89,7 +89,7 @@ RunFingerprint runFingerprint(const RenderSettings& s, const Scene& scene, const
             f.addValue(l.intensity);
             f.addValue(l.cosOuterCone);
         }
-        // Only when there is one, so that runs without keep their fingerprints.
+        // Only when there is one, so that this part stays as it was for runs without.
         if (scene.environment) {
             f.addValue(scene.environment->width());
             f.addValue(scene.environment->height());

@@ -11,7 +11,8 @@ namespace qsgi {
 
 namespace {
 
-// 16384 × 8192, the largest maps in common use; 20 bytes a pixel with the sampling tables.
+// 16384 × 8192, the largest maps in common use; 32 bytes a pixel while loading (the file's floats,
+// the radiance and the sampling table).
 constexpr uint64_t kMaxEnvironmentPixels = uint64_t(1) << 27;
 
 // The first index k in [0, n) with cdf[k + 1] > target, for cdf[0..n] increasing: the cell
@@ -105,7 +106,7 @@ size_t EnvironmentLight::pixelOf(const Vec3f& towardSky) const {
     // The inverse rotation brings ω into the map's frame.
     const double x = w.x * cosRotation_ - w.z * sinRotation_, z = w.x * sinRotation_ + w.z * cosRotation_;
     const double y = std::clamp(w.y, -1.0, 1.0);
-    const double theta = std::acos(y), phi = std::atan2(x, -z);
+    const double theta = std::acos(y), phi = std::atan2(z, x);
     const size_t i = std::min(size_t(height_) - 1, size_t(theta / M_PI * double(height_)));
     const double u = phi / (2 * M_PI) + 0.5;
     const size_t j = std::min(size_t(width_) - 1, size_t(std::max(0.0, u * double(width_))));
@@ -132,15 +133,10 @@ EnvironmentLight::DirectionSample EnvironmentLight::sample(float u0, float u1) c
     const double sinTheta = std::sqrt(std::max(0.0, 1 - cosTheta * cosTheta));
     const double phi = 2 * M_PI * ((double(j) + r1) / double(w) - 0.5);
     DirectionSample s;
-    s.towardSky = normalize(toWorld(Vec3d(sinTheta * std::sin(phi), cosTheta, -sinTheta * std::cos(phi))));
+    s.towardSky = normalize(toWorld(Vec3d(sinTheta * std::cos(phi), cosTheta, sinTheta * std::sin(phi))));
     s.radiance = pixels_[i * w + j];
     s.pdf = double(luminance(s.radiance)) / luminanceIntegral_;
     return s;
-}
-
-size_t EnvironmentLight::bytes() const {
-    return pixels_.capacity() * sizeof(Vec3f) +
-           (rowCdf_.capacity() + columnCdf_.capacity() + cosTheta_.capacity()) * sizeof(double);
 }
 
 }  // namespace qsgi

@@ -1,15 +1,15 @@
 // Light from infinitely far away (docs/design.md §2, issue 35): a uniform sky, or an equirectangular
 // HDR map read with OpenImageIO (EXR, Radiance HDR, anything it reads), static as every light is.
 //
-// The map's orientation, in glTF's Y-up frame. Pixel column u ∈ [0, 1) (left to right) and row
-// v ∈ [0, 1) (top to bottom) hold the radiance arriving from the direction ω (pointing toward the
-// sky) with polar angle θ = π v from +Y and azimuth φ = 2π (u − ½):
-//   ω = (sin θ sin φ, cos θ, −sin θ cos φ)
-// so the top row is the zenith (+Y), the middle of the image is −Z (where a glTF camera at rest
-// looks), a quarter to its right +X: a camera at the origin looking down −Z sees the image's
-// middle the right way round, as Blender and three.js show an equirectangular world. `rotation`
-// turns the map about +Y by that many degrees, counter-clockwise seen from above (right-handed):
-// with 90°, what was at −Z comes from −X.
+// The map's orientation, in glTF's Y-up frame, as Blender and three.js show an equirectangular
+// world. Pixel column u ∈ [0, 1) (left to right) and row v ∈ [0, 1) (top to bottom) hold the
+// radiance arriving from the direction ω (pointing toward the sky) with polar angle θ = π v from
+// +Y and azimuth φ = 2π (u − ½) from +X toward +Z:
+//   ω = (sin θ cos φ, cos θ, sin θ sin φ)
+// so the top row is the zenith (+Y), the middle of the image +X, a quarter to its left −Z (where a
+// glTF camera at rest looks) and a quarter to its right +Z; looking from inside, the image is the
+// right way round. `rotation` turns the map about +Y by that many degrees, counter-clockwise seen
+// from above (right-handed): with 90°, what was at −Z comes from −X.
 //
 // The map is piecewise constant: each pixel is its exact solid angle, a band of the sphere
 // (2π/W)(cos θ_top − cos θ_bottom), so the light's integrals are sums, exact up to rounding. A
@@ -70,14 +70,12 @@ public:
         double pdf = 0;   // per steradian: luminance(L) / ∫ luminance(L) dω
     };
     // A direction in proportion to luminance × solid angle, from two numbers in [0, 1): u0 picks
-    // the row and the place along it, u1 the pixel in the row and the place across it, so a
-    // stratified pair stays stratified. Never called on a light whose luminance integral is 0.
+    // the row and, with what is left of it, θ within the row; u1 the pixel in the row and φ within
+    // the pixel, so a stratified pair stays stratified. Never called on a light whose luminance integral is 0.
     DirectionSample sample(float u0, float u1) const;
     // The density sample() draws `towardSky` with (0 where the map is black).
     double pdf(const Vec3f& towardSky) const;
 
-    // Bytes of the radiance and the sampling tables.
-    size_t bytes() const;
 
 private:
     EnvironmentLight() = default;

@@ -13,7 +13,8 @@
 // A new vertex takes the mean of its edge's corners: object-space position and normal
 // (renormalised), every morph target's deltas, and for a skinned mesh the union of both corners'
 // joint influences at half weight, cut to the instance's influence count (four per JOINTS_n set)
-// by weight and renormalised to sum 1. Lengths are measured on the current world positions.
+// by weight and renormalised to sum 1. Lengths are measured on the current world positions, a new
+// vertex's taken as its corners' mean (where a skinned mesh's midpoint is posed differs slightly).
 #pragma once
 
 #include <cstddef>

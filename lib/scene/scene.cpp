@@ -88,6 +88,15 @@ void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, c
         if (!(watts <= kMaxLightPower)) refuse("materials: " + m.name, watts);
         total += watts;
     }
+    if (scene.environment) {
+        // π R² ∫ L dω, what enters the scene's bounding sphere (the photons carry exactly that).
+        const Vec3d in = scene.environment->integral() * (kPi * sceneRadius * sceneRadius);
+        const double watts = std::max({in.x, in.y, in.z});
+        file = configFile.empty() ? "command line" : configFile;
+        if (!(watts <= kMaxLightPower)) refuse("the sky or environment map", watts);
+        total += watts;
+        file = sceneFile;
+    }
     if (!(total <= kMaxLightPower)) refuse("its lights together", total);
 }
 
