@@ -63,15 +63,22 @@ def read_ply(path):
     end = data.index(b"end_header\n") + len(b"end_header\n")
     header = data[:end].decode("ascii").splitlines()
     vertices = faces = 0
+    fields, element = [], None  # the vertex properties as the header lists them (qsgi adds columns over time)
+    types = {"float": "<f4", "double": "<f8", "uchar": "u1", "int": "<i4", "uint": "<u4"}
     for line in header:
+        if line.startswith("element "):
+            element = line.split()[1]
         if line.startswith("element vertex"):
             vertices = int(line.split()[2])
         elif line.startswith("element face"):
             faces = int(line.split()[2])
+        elif line.startswith("property ") and element == "vertex" and line.split()[1] in types:
+            fields.append((line.split()[2], types[line.split()[1]]))
     if "property uchar blue" not in header or "format binary_little_endian 1.0" not in header:
         sys.exit(f"{path}: not a qsgi frame PLY")
-    v = np.frombuffer(data, VERTEX_DTYPE, vertices, end)
-    fa = np.frombuffer(data, FACE_DTYPE, faces, end + vertices * VERTEX_DTYPE.itemsize)
+    vertex_dtype = np.dtype(fields)
+    v = np.frombuffer(data, vertex_dtype, vertices, end)
+    fa = np.frombuffer(data, FACE_DTYPE, faces, end + vertices * vertex_dtype.itemsize)
     positions = np.stack([v["x"], v["y"], v["z"]], 1).astype(np.float64)
     normals = np.stack([v["nx"], v["ny"], v["nz"]], 1).astype(np.float64)
     return positions, normals, fa["v"].astype(np.int64)

@@ -173,6 +173,13 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     };
     const PlyProperty* fields[9] = {&find("x"), &find("y"), &find("z"), &find("nx"), &find("ny"), &find("nz"),
                                     &find("radiosity_r"), &find("radiosity_g"), &find("radiosity_b")};
+    // Irradiance, which qsgi writes since issue 35 (the asset's _IRRADIANCE is read from it): all
+    // three or none.
+    const PlyProperty* irradiance[3] = {nullptr, nullptr, nullptr};
+    for (const auto& p : properties)
+        for (int c = 0; c < 3; ++c)
+            if (p.name == std::string("irradiance_") + "rgb"[c]) irradiance[c] = &p;
+    const bool hasIrradiance = irradiance[0] && irradiance[1] && irradiance[2];
     const size_t vertexCount = size_t(vertex.count);
     if (vertexCount > (size_t(1) << 31)) throw InputError(path, "header", "implausible vertex count");
     std::vector<char> data(vertexCount * stride);
@@ -182,6 +189,7 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     out.positions.resize(vertexCount);
     out.normals.resize(vertexCount);
     out.radiosity.resize(vertexCount);
+    if (hasIrradiance) out.irradiance.resize(vertexCount);
     for (size_t v = 0; v < vertexCount; ++v) {
         const char* row = data.data() + v * stride;
         for (const PlyProperty& p : properties) {
@@ -201,6 +209,15 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
         out.positions[v] = {f[0], f[1], f[2]};
         out.normals[v] = {f[3], f[4], f[5]};
         out.radiosity[v] = {f[6], f[7], f[8]};
+        if (hasIrradiance) {
+            for (int c = 0; c < 3; ++c) {
+                const double value = readScalar(row + irradiance[c]->offset, irradiance[c]->type);
+                out.irradiance[v][c] = float(value);
+                if (!std::isfinite(out.irradiance[v][c]))
+                    throw InputError(path, "vertex " + std::to_string(v),
+                                     "property '" + irradiance[c]->name + "' is " + number(value) + ", beyond the range of float");
+            }
+        }
     }
 
     // Faces (fanned into triangles), for the edge regions of `qsgi compare`. Elements between the

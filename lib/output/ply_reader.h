@@ -12,6 +12,7 @@ namespace qsgi {
 
 struct VertexRadiosityPly {
     std::vector<Vec3f> positions, normals, radiosity;
+    std::vector<Vec3f> irradiance;    // empty when the file has none (written before issue 35)
     std::vector<Triangle> triangles;  // from `element face` (polygons fanned), if present
 };
 

@@ -41,15 +41,17 @@ std::string encodeVertexRadiosityPly(const Scene& scene, const VertexRadiosity& 
            << " vertex radiosity (W/m^2)\nelement vertex " << scene.vertexCount()
            << "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
               "property float radiosity_r\nproperty float radiosity_g\nproperty float radiosity_b\n"
+              "property float irradiance_r\nproperty float irradiance_g\nproperty float irradiance_b\n"
               "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face "
            << scene.triangleCount() << "\nproperty list uchar int vertex_indices\nend_header\n";
     std::string buf = header.str();
-    buf.reserve(buf.size() + scene.vertexCount() * 39 + scene.triangleCount() * 13);
+    buf.reserve(buf.size() + scene.vertexCount() * 51 + scene.triangleCount() * 13);
     for (size_t v = 0; v < scene.vertexCount(); ++v) {
         const Vec3f p(Vec3d(scene.positions[v]) + scene.worldOrigin);
         const Vec3f& n = scene.normals[v];
         const Vec3f& b = result.radiosity[v];
-        for (float f : {p.x, p.y, p.z, n.x, n.y, n.z, b.x, b.y, b.z}) put(buf, f);
+        const Vec3f& e = result.irradiance[v];
+        for (float f : {p.x, p.y, p.z, n.x, n.y, n.z, b.x, b.y, b.z, e.x, e.y, e.z}) put(buf, f);
         for (float f : {b.x, b.y, b.z}) put(buf, tonemap.encode(f));
     }
     for (const Triangle& t : scene.triangles) {

@@ -1,5 +1,5 @@
 // frame_NNNN.ply (docs/design.md §7): binary little-endian; vertex x y z nx ny nz, radiosity_r/g/b
-// (W/m^2) and a tonemapped red green blue preview; faces as vertex_indices.
+// (W/m^2), irradiance_r/g/b (W/m^2, the light arriving, before the albedo) and a tonemapped red green blue preview; faces as vertex_indices.
 #pragma once
 
 #include <string>

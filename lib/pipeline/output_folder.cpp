@@ -24,6 +24,7 @@ std::string frameFileName(int frame, const char* extension) {
 }
 
 bool isFrameFileName(const std::string& name) {
+    if (name == kBakedAssetName) return true;  // made from the frames: goes with them
     constexpr size_t kPrefix = 6;  // "frame_"
     if (name.rfind("frame_", 0) != 0) return false;
     size_t digits = 0;
@@ -44,7 +45,6 @@ std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& re
     std::vector<std::string> wanted = {frameFileName(record.frame, "ply")};
     if (s.writeExr) wanted.push_back(frameFileName(record.frame, "exr"));
     if (s.writePng) wanted.push_back(frameFileName(record.frame, "png"));
-    if (s.writeGltf) wanted.push_back(frameFileName(record.frame, "glb"));
     // Exactly the names qsgi gives this frame's files: a hand-edited name ("../x") reads nothing
     // outside the folder.
     const std::vector<std::string> names = frameFileNames(record.frame);

@@ -14,7 +14,9 @@
 
 #include "estimate/estimator.h"
 #include "estimate/impact_count.h"
-#include "output/glb_writer.h"
+#include "output/baked_asset.h"
+#include "output/ply_reader.h"
+#include "scene/gltf_document.h"
 #include "output/image_files.h"
 #include "output/ply_writer.h"
 #include "output/radiosity_image.h"
@@ -96,6 +98,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     else if (gltfAnimation) {
         animationSource = settings_.scenePath + " (--animation " + settings_.animationPath + ")";
         animation_ = Animation::fromGltf(scene_, *gltfAnimation, settings_.fps.value_or(kDefaultGltfFps), animationSource);
+        // "gltf" plays them all: the one there is, if there is one.
+        playedGltfAnimation_ = *gltfAnimation >= 0 ? *gltfAnimation : scene_.animations.size() == 1 ? 0 : -1;
     } else animation_ = Animation::fromTransformFile(settings_.animationPath, scene_);
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, animationSource);
     scene_.setRestPose(animation_.poseAt(0));
@@ -108,6 +112,13 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
             throw InputError("subdivide (--subdivide)", "", text);
         }
         refineMesh(scene_, settings_.subdivide);
+    }
+    if (settings_.writeGltf) {
+        // Refused now, not after the render, if the asset cannot take the bake.
+        Warnings ignored;  // the loader has said what the file's oddities are
+        BakedAssetSettings asset;
+        asset.colourSet = settings_.gltfColourSet;
+        checkAssetTakesBake(readGltfDocument(settings_.scenePath, ignored), scene_, asset, settings_.scenePath);
     }
     scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
@@ -284,7 +295,10 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     outcome.framesRemoved = 0;
     for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames)
         if (failed.frame < start || failed.frame > last_) ++outcome.framesRemoved;
-    if (start > last_) return outcome;  // resumed with nothing left to do
+    if (start > last_) {  // resumed with nothing left to do
+        if (settings_.writeGltf) writeBakedAsset(out, outcome, warn);
+        return outcome;
+    }
 
     EmbreeDevice device;
     auto imageMetadata = [&](int frame) {
@@ -360,7 +374,6 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         files.emplace_back(names[0], encodeVertexRadiosityPly(scene_, result, *tonemap));
         if (settings_.writeExr) files.emplace_back(names[1], encodeExr(*image, imageMetadata(frame), settings_.exrHalf));
         if (settings_.writePng) files.emplace_back(names[2], encodePngPreview(*image, *exposure));
-        if (settings_.writeGltf) files.emplace_back(names[3], encodeVertexRadiosityGlb(scene_, result, *tonemap));
         const auto listed = std::find_if(log.frames.begin(), log.frames.end(), [&](const FrameTiming& f) { return f.frame == frame; });
         const bool listedBefore = listed != log.frames.end();
         const std::vector<FrameTiming> logBefore = listedBefore ? std::vector<FrameTiming>{} : log.frames;
@@ -410,7 +423,54 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
             return outcome;
         }
     }
+    if (settings_.writeGltf) writeBakedAsset(out, outcome, warn);
     return outcome;
+}
+
+void RenderJob::writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const std::function<void(const std::string&)>& warn) const {
+    Warnings warnings;
+    const GltfDocument document = readGltfDocument(settings_.scenePath, warnings);
+    const double fps = animation_.fps();
+    auto frameAt = [&](size_t k) {
+        const int frame = first_ + int(k);
+        const std::string name = frameFileName(frame, "ply");
+        const VertexRadiosityPly ply = readVertexRadiosityPly((out.path() / name).string());
+        if (ply.radiosity.size() != scene_.vertexCount() || ply.irradiance.size() != scene_.vertexCount())
+            throw InputError((out.path() / name).string(), "",
+                             ply.irradiance.empty() ? "has no irradiance (an older qsgi wrote it): render it again without --resume"
+                                                    : "does not hold this scene's vertices");
+        BakedFrame baked;
+        baked.seconds = fps > 0 ? frame / fps : 0;
+        baked.radiance.resize(ply.radiosity.size());
+        for (size_t v = 0; v < ply.radiosity.size(); ++v) baked.radiance[v] = ply.radiosity[v] * float(1 / M_PI);
+        baked.irradiance = ply.irradiance;
+        return baked;
+    };
+    BakedAssetSettings asset;
+    asset.colourSet = settings_.gltfColourSet;
+    asset.playedAnimation = playedGltfAnimation_;
+    // COLOR_n's exposure puts the first frame's 99th percentile of B/π at 1, as the PLY previews
+    // do with frame 0's.
+    const BakedFrame firstFrame = frameAt(0);
+    asset.exposure = double(PreviewTonemap::fromPercentile(firstFrame.radiance).scale);
+    // A transform file's motion becomes the asset's node animation; a glTF animation is the file's already.
+    std::vector<NodeMotion> motion;
+    const bool transformFile = !settings_.animationPath.empty() && !gltfAnimationSelector(settings_.animationPath, "").has_value();
+    if (transformFile && last_ > first_) {
+        for (const int node : animation_.movedNodes()) motion.push_back(NodeMotion{node, {}});
+        for (int frame = first_; frame <= last_; ++frame) {
+            const std::vector<Transform> locals = animation_.localsAt(frame);
+            for (NodeMotion& m : motion) m.frames.push_back(decomposeTrs(locals[size_t(m.node)]));
+        }
+    }
+    Stopwatch clock;
+    BakedAssetSummary summary;
+    const std::string bytes = encodeBakedAsset(document, scene_, size_t(last_ - first_ + 1), frameAt, motion, asset, warnings, &summary);
+    out.write(kBakedAssetName, bytes);
+    outcome.assetBytes = summary.bytes;
+    outcome.assetBakeBytes = summary.bakeBytes;
+    outcome.assetSeconds = clock.seconds();
+    for (const std::string& w : warnings.messages) warn(w);
 }
 
 }  // namespace qsgi

@@ -15,6 +15,8 @@
 
 namespace qsgi {
 
+class OutputDirectory;
+
 struct FrameReport {
     int frame;
     int index, count;  // position in the run
@@ -41,6 +43,9 @@ struct RunOutcome {
     int framesRemoved = 0;  // frames outside the range whose files failed verification: unlinked
     int filesReplaced = 0;  // of another run, unlinked by --overwrite (frame files and timing.json)
     int framesWritten = 0;  // by this run
+    // asset.glb (--gltf-out): its bytes, those of the bake in it, and the seconds to assemble and write it
+    size_t assetBytes = 0, assetBakeBytes = 0;
+    double assetSeconds = 0;
 };
 
 // What a run tells its host, all optional: onFrame after each frame; stopRequested, asked after
@@ -90,12 +95,17 @@ public:
     std::string unplayedAnimationsNote() const;
 
 private:
+    // asset.glb (--gltf-out): the scene file with this run's frames first_..last_ baked in,
+    // assembled from their PLYs in the folder (so a resumed run writes it whole).
+    void writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const std::function<void(const std::string&)>& warn) const;
+
     RenderSettings settings_;
     Scene scene_;
     Camera camera_;  // at frame 0
     Camera cameraAt(int frame) const;
     Animation animation_;
     int first_ = 0, last_ = 0;
+    int playedGltfAnimation_ = -1;  // the glTF animation the frames show (-1: none, all, a transform file)
     RunFingerprint fingerprint_;
     bool lit_ = false;
     MeshResolution resolution_;

@@ -202,7 +202,7 @@ json getCamera(const RenderSettings& s) {
 // radiusGiven, qmcBouncesGiven, gatherGiven, framesSource, EnvironmentSettings' source), EmissionAim's margin (FrameSolver
 // sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
 // added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 33, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 34, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
 static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
@@ -504,11 +504,18 @@ std::vector<RenderOption> declareOptions() {
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.writePng = v; },
                  [](const RenderSettings& s) { return json(s.writePng); }});
     o.push_back({"gltf_out", "--gltf-out", T::Boolean, 0, 0, "", {}, true, "", "false",
-                 "also write frame_NNNN.glb: the posed geometry with COLOR_0 = radiosity/pi on an unlit material "
-                 "(irradiance in _IRRADIANCE), for glTF viewers",
+                 "also write asset.glb: the scene's own glTF file, every object kept, with the bake on each rendered "
+                 "primitive as _RADIANCE (B/pi) and _IRRADIANCE (E, before the albedo); an animation's frames as "
+                 "morph targets a STEP weights animation plays (docs/outputs.md)",
                  true, false,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.writeGltf = v; },
                  [](const RenderSettings& s) { return json(s.writeGltf); }});
+    o.push_back({"gltf_colour", "--gltf-colour", T::Integer, 0, 255, "", {}, true, "N", "none",
+                 "with --gltf-out, also add the vertex colour set COLOR_N = min(1, exposure * B/pi) (the first frame's "
+                 "99th percentile at 1); N must be the primitives' next free set: an existing one is never overwritten",
+                 true, false,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.gltfColourSet = v.get<int>(); },
+                 [](const RenderSettings& s) { return s.gltfColourSet >= 0 ? json(s.gltfColourSet) : json(nullptr); }});
     o.push_back({"exposure", "--exposure", T::Number, 0, 1e30, "", {}, true, "X",
                  "automatic: the 99th-percentile luminance of the first frame becomes 0.8",
                  "the PNG preview's exposure multiplier", true, false,

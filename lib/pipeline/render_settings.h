@@ -56,7 +56,8 @@ struct RenderSettings {
     int width = 640, height = 480;
     int samplesPerPixel = 1;
     bool writeExr = true, exrHalf = false, writePng = false;
-    bool writeGltf = false;  // frame_NNNN.glb with the solution as unlit vertex colours
+    bool writeGltf = false;  // asset.glb: the scene file with the bake in it (lib/output/baked_asset.h)
+    int gltfColourSet = -1;  // with writeGltf, the COLOR_n set to add, or -1
     std::optional<float> exposure;        // PNG preview; unset: automatic from frame 0
     std::optional<int> cameraIndex;       // a glTF camera by index
     struct LookAt { Vec3f position, target, up{0, 1, 0}; float yfov = 0.8f; };

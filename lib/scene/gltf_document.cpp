@@ -455,6 +455,7 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     }
     if (!doc.is_object()) throw InputError(path, "", "the glTF JSON must be an object");
     checkAsset(path, doc);
+    json original = doc;
     bool rewritten = refuseNegativeIndices(path, doc);
     rewritten = rewritePlainDataUris(doc, "buffers") || rewritten;
     rewritten = rewritePlainDataUris(doc, "images") || rewritten;
@@ -462,6 +463,7 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
     refuseRemoteUris(path, doc, "images");
 
     GltfDocument out;
+    out.json = std::move(original);
     out.findings = findReferenceProblems(doc);
     // Document-level slips that leave the file readable: warnings, refused under --strict.
     if (jsonText.size() >= 3 && jsonText.compare(0, 3, "\xEF\xBB\xBF") == 0)

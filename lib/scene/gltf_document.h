@@ -13,6 +13,8 @@
 
 #include <tiny_gltf.h>
 
+#include <nlohmann/json.hpp>
+
 #include <map>
 #include <set>
 #include <string>
@@ -24,6 +26,9 @@ namespace qsgi {
 
 struct GltfDocument {
     tinygltf::Model model;
+    // The JSON as the file holds it, before any repair made for tinygltf's sake: what --gltf-out
+    // writes back (lib/output/baked_asset.h), every property kept.
+    nlohmann::json json;
     std::set<int> absentBuffers;  // buffers that have no data (no uri, not the BIN chunk)
     // Broken references, empty arrays and cameras with two projections, wherever they are: the
     // loader refuses those in objects the render reads and warns about the others.

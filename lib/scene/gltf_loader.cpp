@@ -537,7 +537,12 @@ private:
                                      std::to_string(mesh.primitives[0].targets.size()) + " morph targets");
             for (size_t p = 0; p < mesh.primitives.size(); ++p) {
                 const std::string place = gltfPlace("meshes", node.mesh) + "." + gltfPlace("primitives", int(p));
+                const size_t before = scene.instances.size();
                 addPrimitive(scene, n, world, mesh.primitives[p], place, skin, weights);
+                if (scene.instances.size() > before) {  // not skipped (points, lines, no POSITION)
+                    scene.instances.back().mesh = node.mesh;
+                    scene.instances.back().primitive = int(p);
+                }
             }
         }
         // glTF 2.0 (§5.25): a skin or morph weights belong to a node's mesh.

@@ -28,6 +28,44 @@ std::string trsDecompositionProblem(const Transform& t) {
     return "";
 }
 
+NodeTrs decomposeTrs(const Transform& t) {
+    NodeTrs trs;
+    trs.translation = Vec3d(t.at(0, 3), t.at(1, 3), t.at(2, 3));
+    Vec3d axis[3];
+    for (int c = 0; c < 3; ++c) {
+        const Vec3d column(t.at(0, c), t.at(1, c), t.at(2, c));
+        trs.scale[c] = length(column);
+        axis[c] = trs.scale[c] > 0 ? column / trs.scale[c] : Vec3d(double(c == 0), double(c == 1), double(c == 2));
+    }
+    if (dot(cross(axis[0], axis[1]), axis[2]) < 0) {
+        trs.scale.x = -trs.scale.x;
+        axis[0] = -axis[0];
+    }
+    // The rotation matrix's quaternion (Shepperd's method: divide by the largest of the four
+    // candidates, so no square root of a small difference decides the result).
+    const double r00 = axis[0].x, r11 = axis[1].y, r22 = axis[2].z;
+    const double r01 = axis[1].x, r10 = axis[0].y, r02 = axis[2].x, r20 = axis[0].z, r12 = axis[2].y, r21 = axis[1].z;
+    const double trace = r00 + r11 + r22;
+    std::array<double, 4> q;
+    if (trace > 0) {
+        const double s = 2 * std::sqrt(1 + trace);
+        q = {(r21 - r12) / s, (r02 - r20) / s, (r10 - r01) / s, s / 4};
+    } else if (r00 > r11 && r00 > r22) {
+        const double s = 2 * std::sqrt(1 + r00 - r11 - r22);
+        q = {s / 4, (r01 + r10) / s, (r02 + r20) / s, (r21 - r12) / s};
+    } else if (r11 > r22) {
+        const double s = 2 * std::sqrt(1 + r11 - r00 - r22);
+        q = {(r01 + r10) / s, s / 4, (r12 + r21) / s, (r02 - r20) / s};
+    } else {
+        const double s = 2 * std::sqrt(1 + r22 - r00 - r11);
+        q = {(r02 + r20) / s, (r12 + r21) / s, s / 4, (r10 - r01) / s};
+    }
+    const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (double& c : q) c /= n;
+    trs.rotation = q;
+    return trs;
+}
+
 const char* animatedPropertyName(AnimatedProperty p) {
     switch (p) {
         case AnimatedProperty::Translation: return "translation";

@@ -51,6 +51,10 @@ struct NodeTrs {
 // perpendicular) — or "" when it does. The glTF loader refuses such a node's matrix and a
 // transform file such a node's entry, with these words.
 std::string trsDecompositionProblem(const Transform& matrix);
+// The translation, rotation and scale of a matrix that decomposes (trsDecompositionProblem is
+// ""): a mirror goes into the scale's x, so the rotation is proper. A zero column gets scale 0
+// and, where the rotation cannot be told, the identity's axis.
+NodeTrs decomposeTrs(const Transform& matrix);
 
 struct KeyframeAnimation {
     std::string name;

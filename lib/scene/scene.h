@@ -75,6 +75,9 @@ struct Skin {
 //   otherwise p_world = node world transform · p.
 struct MeshInstance {
     int node = -1;
+    // Where it came from in the glTF file (-1 for procedural scenes): vertex i of the block is
+    // vertex i of meshes[mesh].primitives[primitive] until --subdivide adds vertices after them.
+    int mesh = -1, primitive = -1;
     uint32_t firstVertex = 0, vertexCount = 0;
     uint32_t firstTriangle = 0, triangleCount = 0;
     std::vector<Vec3f> objectPositions;

@@ -1,0 +1,574 @@
+#include "output/baked_asset.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+namespace qsgi {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr int kFloat = 5126, kUnsignedInt = 5125, kArrayBuffer = 34962;
+// A GLB's length is a uint32 (glTF 2.0 §4.4.3.1).
+constexpr uint64_t kMaxGlbBytes = 0xFFFFFFFFull;
+const char* const kOption = "gltf_out (--gltf-out)";
+
+std::string colourName(int set) { return "COLOR_" + std::to_string(set); }
+
+// The binary chunk and the JSON's bufferViews and accessors into it.
+class BinaryBuilder {
+public:
+    explicit BinaryBuilder(json& doc) : doc_(doc) {
+        if (!doc_.contains("bufferViews")) doc_["bufferViews"] = json::array();
+        if (!doc_.contains("accessors")) doc_["accessors"] = json::array();
+    }
+    std::string& bytes() { return bin_; }
+    void align(size_t to) { bin_.resize((bin_.size() + to - 1) / to * to, '\0'); }
+
+    // `target` 34962 (ARRAY_BUFFER) for vertex attributes' views, 0 for others (sparse parts,
+    // animation keys, images), which glTF leaves without one.
+    int addView(const void* data, size_t size, int target = 0) {
+        align(4);
+        json view = {{"buffer", 0}, {"byteOffset", bin_.size()}, {"byteLength", size}};
+        if (target) view["target"] = target;
+        bin_.append(static_cast<const char*>(data), size);
+        doc_["bufferViews"].push_back(std::move(view));
+        return int(doc_["bufferViews"].size()) - 1;
+    }
+    int addAccessor(json accessor) {
+        doc_["accessors"].push_back(std::move(accessor));
+        return int(doc_["accessors"].size()) - 1;
+    }
+    int addVec3(const Vec3f* values, size_t count) {
+        return addAccessor({{"bufferView", addView(values, count * sizeof(Vec3f), kArrayBuffer)}, {"componentType", kFloat},
+                            {"count", count}, {"type", "VEC3"}});
+    }
+    // Zeros without a view (glTF 2.0 §3.6.2.3: an accessor without bufferView reads as zeros).
+    int addZeroVec3(size_t count) { return addAccessor({{"componentType", kFloat}, {"count", count}, {"type", "VEC3"}}); }
+    // Zeros but at `indices` (strictly increasing), which hold `values`.
+    int addSparseVec3(size_t count, const std::vector<uint32_t>& indices, const std::vector<Vec3f>& values, int indexView) {
+        json accessor = {{"componentType", kFloat}, {"count", count}, {"type", "VEC3"}};
+        if (!indices.empty())
+            accessor["sparse"] = {{"count", indices.size()},
+                                  {"indices", {{"bufferView", indexView}, {"componentType", kUnsignedInt}}},
+                                  {"values", {{"bufferView", addView(values.data(), values.size() * sizeof(Vec3f))}}}};
+        return addAccessor(std::move(accessor));
+    }
+    int addScalars(const std::vector<float>& values, bool bounds) {
+        json accessor = {{"bufferView", addView(values.data(), values.size() * sizeof(float))}, {"componentType", kFloat},
+                         {"count", values.size()}, {"type", "SCALAR"}};
+        if (bounds && !values.empty()) {
+            accessor["min"] = {*std::min_element(values.begin(), values.end())};
+            accessor["max"] = {*std::max_element(values.begin(), values.end())};
+        }
+        return addAccessor(std::move(accessor));
+    }
+    int addFloats(const std::vector<float>& values, const char* type, size_t count) {
+        return addAccessor({{"bufferView", addView(values.data(), values.size() * sizeof(float))}, {"componentType", kFloat},
+                            {"count", count}, {"type", type}});
+    }
+
+private:
+    json& doc_;
+    std::string bin_;
+};
+
+// The values a primitive shows in one frame: its block of scene vertices.
+struct PrimitiveValues {
+    const Vec3f* radiance = nullptr;
+    const Vec3f* irradiance = nullptr;
+    size_t count = 0;
+};
+
+bool sameBake(const BakedFrame& frame, const MeshInstance& a, const MeshInstance& b) {
+    if (a.vertexCount != b.vertexCount) return false;
+    const size_t bytes = size_t(a.vertexCount) * sizeof(Vec3f);
+    return std::memcmp(&frame.radiance[a.firstVertex], &frame.radiance[b.firstVertex], bytes) == 0 &&
+           std::memcmp(&frame.irradiance[a.firstVertex], &frame.irradiance[b.firstVertex], bytes) == 0;
+}
+
+// The rendered nodes of one glTF mesh, each with its instances by primitive (nullptr: skipped).
+struct MeshUse {
+    std::vector<int> nodes;
+    std::map<int, std::vector<const MeshInstance*>> instances;  // node → by primitive
+};
+
+size_t primitiveCount(const json& doc, int mesh) { return doc["meshes"][size_t(mesh)]["primitives"].size(); }
+
+size_t positionCount(const json& doc, const json& primitive) {
+    const json& attributes = primitive["attributes"];
+    if (!attributes.contains("POSITION")) return 0;
+    return doc["accessors"][attributes["POSITION"].get<size_t>()]["count"].get<size_t>();
+}
+
+size_t targetCount(const json& mesh) {
+    const json& p0 = mesh["primitives"][0];
+    return p0.contains("targets") ? p0["targets"].size() : 0;
+}
+
+// The input's buffers, images and views moved into one buffer: every bufferView's buffer becomes
+// 0 at its buffer's offset; an image's uri becomes a view of its file's bytes.
+void packBuffers(const GltfDocument& document, json& doc, BinaryBuilder& bin, Warnings& warnings, const std::string& file) {
+    const tinygltf::Model& model = document.model;
+    std::vector<size_t> start(model.buffers.size(), 0);
+    for (size_t b = 0; b < model.buffers.size(); ++b) {
+        bin.align(16);  // keeps every accessor's alignment within its buffer
+        start[b] = bin.bytes().size();
+        if (!document.absentBuffers.count(int(b)))
+            bin.bytes().append(reinterpret_cast<const char*>(model.buffers[b].data.data()), model.buffers[b].data.size());
+    }
+    if (doc.contains("bufferViews"))
+        for (json& view : doc["bufferViews"]) {
+            const size_t b = view.value("buffer", size_t(0));
+            view["buffer"] = 0;
+            view["byteOffset"] = view.value("byteOffset", size_t(0)) + (b < start.size() ? start[b] : 0);
+        }
+    if (doc.contains("images"))
+        for (size_t i = 0; i < doc["images"].size() && i < model.images.size(); ++i) {
+            json& image = doc["images"][i];
+            if (!image.contains("uri")) continue;
+            const tinygltf::Image& decoded = model.images[i];
+            std::string mime = decoded.mimeType;
+            const std::string uri = image["uri"].get<std::string>();
+            if (uri.rfind("data:", 0) == 0) mime = uri.substr(5, uri.find_first_of(";,") - 5);
+            if (mime.empty()) {
+                std::string extension = uri.substr(uri.find_last_of('.') + 1);
+                std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+                mime = extension == "png" ? "image/png" : extension == "jpg" || extension == "jpeg" ? "image/jpeg"
+                     : extension == "webp" ? "image/webp" : extension == "ktx2" ? "image/ktx2" : "";
+            }
+            if (decoded.image.empty() || mime.empty()) {
+                warnings.add(file + ": images[" + std::to_string(i) + "] ('" + uri.substr(0, 200) +
+                             "') could not be embedded and keeps its uri, relative to the scene's folder");
+                continue;
+            }
+            image.erase("uri");
+            image["bufferView"] = bin.addView(decoded.image.data(), decoded.image.size());
+            image["mimeType"] = mime;
+        }
+}
+
+// glTF's weights of a node at rest: its own, else its mesh's, else zeros.
+std::vector<double> restWeights(const json& node, const json& mesh, size_t count) {
+    std::vector<double> w(count, 0.0);
+    const json* given = node.contains("weights") ? &node["weights"] : mesh.contains("weights") ? &mesh["weights"] : nullptr;
+    if (given)
+        for (size_t i = 0; i < count && i < given->size(); ++i) w[i] = (*given)[i].get<double>();
+    return w;
+}
+
+const char* interpolationKeyword(Interpolation i) {
+    return i == Interpolation::Step ? "STEP" : i == Interpolation::Linear ? "LINEAR" : "CUBICSPLINE";
+}
+
+// The track of animation `a`'s channel driving node `node`'s weights, as the scene read it.
+const KeyframeTrack* weightsTrack(const Scene& scene, size_t a, int node) {
+    if (a >= scene.animations.size()) return nullptr;
+    for (const AnimationChannel& c : scene.animations[a].channels)
+        if (c.node == node && c.property == AnimatedProperty::Weights) return &c.track;
+    return nullptr;
+}
+
+// The lighting weights channels (and a transform file's motion) in the animation that played, or
+// in a new one; every other animation's weights channels on those nodes extended with zeros.
+void addLightingAnimation(json& doc, BinaryBuilder& bin, const Scene& scene, const std::vector<double>& frameSeconds,
+                          const std::map<int, size_t>& ownTargets,
+                          const std::map<int, int>& nodeMesh, const std::vector<NodeMotion>& motion,
+                          const BakedAssetSettings& settings, Warnings& warnings, const std::string& file) {
+    if (!doc.contains("animations")) doc["animations"] = json::array();
+    json& animations = doc["animations"];
+    const size_t fileAnimations = animations.size();
+    size_t played = size_t(settings.playedAnimation);
+    if (settings.playedAnimation < 0 || !motion.empty() || played >= fileAnimations) {
+        animations.push_back({{"name", "qsgi"}, {"channels", json::array()}, {"samplers", json::array()}});
+        played = animations.size() - 1;
+    }
+    // Key times are floats in the file: the frames' as floats, strictly increasing.
+    std::vector<float> frameTimes;
+    for (const double t : frameSeconds) frameTimes.push_back(float(t));
+    const size_t frames = frameTimes.size(), lighting = frames - 1;
+    int frameTimesAccessor = -1;
+    auto frameTimesIndex = [&] {
+        if (frameTimesAccessor < 0) frameTimesAccessor = bin.addScalars(frameTimes, true);
+        return frameTimesAccessor;
+    };
+    auto addSampler = [&](json& animation, int input, int output, Interpolation interpolation) {
+        animation["samplers"].push_back({{"input", input}, {"output", output}, {"interpolation", interpolationKeyword(interpolation)}});
+        return int(animation["samplers"].size()) - 1;
+    };
+    // Which frame shows at time t: the last whose time is at or before t (the first before them all).
+    auto frameAtTime = [&](float t) {
+        const size_t after = size_t(std::upper_bound(frameTimes.begin(), frameTimes.end(), t) - frameTimes.begin());
+        return after == 0 ? size_t(0) : after - 1;
+    };
+
+    for (const NodeMotion& m : motion) {
+        json& node = doc["nodes"][size_t(m.node)];
+        if (node.contains("matrix")) {
+            // glTF animates translation, rotation and scale only: the matrix becomes them.
+            const std::vector<double> values = node["matrix"].get<std::vector<double>>();
+            const NodeTrs rest = decomposeTrs(Transform::fromColumnMajor(values.data()));
+            node.erase("matrix");
+            node["translation"] = {rest.translation.x, rest.translation.y, rest.translation.z};
+            node["rotation"] = {rest.rotation[0], rest.rotation[1], rest.rotation[2], rest.rotation[3]};
+            node["scale"] = {rest.scale.x, rest.scale.y, rest.scale.z};
+        }
+        std::vector<float> translation, rotation, scale;
+        for (const NodeTrs& trs : m.frames) {
+            for (int c = 0; c < 3; ++c) translation.push_back(float(trs.translation[c]));
+            for (int c = 0; c < 4; ++c) rotation.push_back(float(trs.rotation[size_t(c)]));
+            for (int c = 0; c < 3; ++c) scale.push_back(float(trs.scale[c]));
+        }
+        json& animation = animations[played];
+        const std::pair<const char*, std::pair<const std::vector<float>*, const char*>> paths[] = {
+            {"translation", {&translation, "VEC3"}}, {"rotation", {&rotation, "VEC4"}}, {"scale", {&scale, "VEC3"}}};
+        for (const auto& [path, data] : paths) {
+            const int sampler = addSampler(animation, frameTimesIndex(), bin.addFloats(*data.first, data.second, frames), Interpolation::Linear);
+            animation["channels"].push_back({{"sampler", sampler}, {"target", {{"node", m.node}, {"path", path}}}});
+        }
+    }
+
+    for (const auto& [node, mesh] : nodeMesh) {
+        const size_t own = ownTargets.at(mesh);
+        const std::vector<double> rest = restWeights(doc["nodes"][size_t(node)], doc["meshes"][size_t(mesh)], own);
+        bool drivenInPlayed = false;
+        for (size_t a = 0; a < animations.size(); ++a) {
+            json& animation = animations[a];
+            if (!animation.contains("channels")) continue;
+            for (json& channel : animation["channels"]) {
+                if (!channel.contains("target") || channel["target"].value("node", -1) != node ||
+                    channel["target"].value("path", "") != "weights")
+                    continue;
+                const KeyframeTrack* track = weightsTrack(scene, a, node);
+                if (!track) {
+                    warnings.add(file + ": animations[" + std::to_string(a) + "]'s weights channel on nodes[" + std::to_string(node) +
+                                 "] was not read, so its output could not be given the baked frames' weights");
+                    continue;
+                }
+                std::vector<float> keys(track->times.begin(), track->times.end());
+                std::vector<float> values;
+                Interpolation interpolation = track->interpolation;
+                if (a != played) {
+                    // Another animation: our targets stay at 0 while it plays (frame 0's lighting).
+                    const size_t groups = interpolation == Interpolation::CubicSpline ? 3 : 1;
+                    for (size_t k = 0; k < keys.size(); ++k)
+                        for (size_t g = 0; g < groups; ++g) {
+                            for (size_t i = 0; i < own; ++i) values.push_back(float(track->values[(k * groups + g) * own + i]));
+                            values.insert(values.end(), lighting, 0.0f);
+                        }
+                } else {
+                    // The played animation: its keys and the frames' merged. A cubic spline is
+                    // resampled as LINEAR there (exact at the keys); a LINEAR sampler gains a key just
+                    // before each frame so that the lighting steps rather than fades.
+                    drivenInPlayed = true;
+                    if (interpolation == Interpolation::CubicSpline) {
+                        warnings.add(file + ": animations[" + std::to_string(a) + "]'s cubic-spline weights on nodes[" +
+                                     std::to_string(node) + "] are written LINEAR between their keys and the frames");
+                        interpolation = Interpolation::Linear;
+                    }
+                    keys.insert(keys.end(), frameTimes.begin(), frameTimes.end());
+                    if (interpolation == Interpolation::Linear)
+                        for (size_t k = 1; k < frames; ++k) {
+                            const float before = frameTimes[k] - 1e-3f * (frameTimes[k] - frameTimes[k - 1]);
+                            if (before > frameTimes[k - 1] && before < frameTimes[k]) keys.push_back(before);
+                        }
+                    std::sort(keys.begin(), keys.end());
+                    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+                    std::vector<double> own_(std::max<size_t>(own, 1));
+                    for (const float t : keys) {
+                        track->sample(double(t), false, own_.data());
+                        for (size_t i = 0; i < own; ++i) values.push_back(float(own_[i]));
+                        const size_t f = frameAtTime(t);
+                        for (size_t i = 0; i < lighting; ++i) values.push_back(f == i + 1 ? 1.0f : 0.0f);
+                    }
+                }
+                // Keys unchanged: the channel's own input accessor serves.
+                const int input = keys == std::vector<float>(track->times.begin(), track->times.end())
+                                      ? animation["samplers"][channel["sampler"].get<size_t>()]["input"].get<int>()
+                                      : bin.addScalars(keys, true);
+                channel["sampler"] = addSampler(animation, input, bin.addFloats(values, "SCALAR", values.size()), interpolation);
+            }
+        }
+        if (!drivenInPlayed) {
+            std::vector<float> values;
+            for (size_t f = 0; f < frames; ++f) {
+                for (size_t i = 0; i < own; ++i) values.push_back(float(rest[i]));
+                for (size_t i = 0; i < lighting; ++i) values.push_back(f == i + 1 ? 1.0f : 0.0f);
+            }
+            json& animation = animations[played];
+            const int sampler = addSampler(animation, frameTimesIndex(), bin.addFloats(values, "SCALAR", values.size()), Interpolation::Step);
+            animation["channels"].push_back({{"sampler", sampler}, {"target", {{"node", node}, {"path", "weights"}}}});
+        }
+    }
+}
+
+}  // namespace
+
+void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const BakedAssetSettings& settings,
+                         const std::string& sceneFile) {
+    const json& doc = document.json;
+    for (const MeshInstance& instance : scene.instances) {
+        if (instance.mesh < 0) throw InputError(kOption, "", "needs a scene read from a glTF file");
+        const json& primitive = doc["meshes"][size_t(instance.mesh)]["primitives"][size_t(instance.primitive)];
+        const std::string place = "meshes[" + std::to_string(instance.mesh) + "].primitives[" + std::to_string(instance.primitive) + "]";
+        if (instance.vertexCount != positionCount(doc, primitive))
+            throw InputError(kOption, "",
+                             "cannot be combined with --subdivide yet: the refined meshes would need every attribute of the "
+                             "asset (texture coordinates, tangents, colours) refined with them");
+        const json& attributes = primitive["attributes"];
+        for (const char* name : {"_RADIANCE", "_IRRADIANCE"})
+            if (attributes.contains(name))
+                throw InputError(sceneFile, place + ".attributes." + name,
+                                 "is already there (a baked asset?): --gltf-out adds it, so bake the original asset");
+        if (settings.colourSet >= 0) {
+            if (attributes.contains(colourName(settings.colourSet)))
+                throw InputError(sceneFile, place + ".attributes." + colourName(settings.colourSet),
+                                 "is the asset's own: --gltf-colour never overwrites a colour set; give the next free one");
+            if (settings.colourSet > 0 && !attributes.contains(colourName(settings.colourSet - 1)))
+                throw InputError(sceneFile, place + ".attributes",
+                                 "has no " + colourName(settings.colourSet - 1) + ", so --gltf-colour " +
+                                     std::to_string(settings.colourSet) + " would leave a gap (glTF numbers colour sets from 0 without gaps)");
+        }
+    }
+}
+
+std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, size_t frameCount,
+                             const std::function<BakedFrame(size_t)>& frameAt, const std::vector<NodeMotion>& motion,
+                             const BakedAssetSettings& settings, Warnings& warnings, BakedAssetSummary* summary) {
+    const std::string file = scene.sourcePath;
+    json doc = document.json;
+    BinaryBuilder bin(doc);
+    packBuffers(document, doc, bin, warnings, file);
+    const size_t assetBytes = bin.bytes().size();
+
+    // Which nodes show which glTF mesh, in the order the scene placed them.
+    std::map<int, MeshUse> uses;
+    for (const MeshInstance& instance : scene.instances) {
+        MeshUse& use = uses[instance.mesh];
+        auto& list = use.instances[instance.node];
+        if (list.empty()) {
+            use.nodes.push_back(instance.node);
+            list.resize(primitiveCount(doc, instance.mesh), nullptr);
+        }
+        list[size_t(instance.primitive)] = &instance;
+    }
+
+    // Pass 1: the nodes of a mesh fall into groups whose bakes are equal in every frame (split on
+    // the first frame that tells them apart), and a group is animated if any frame differs from
+    // frame 0 for it.
+    struct Group {
+        int mesh = -1;  // the output mesh: the input's for the first group, a copy for the others
+        std::vector<int> nodes;
+        bool animated = false;
+    };
+    std::map<int, std::vector<Group>> groups;
+    for (const auto& [mesh, use] : uses) groups[mesh].push_back(Group{mesh, use.nodes, false});
+    const BakedFrame first = frameAt(0);
+    std::vector<double> times(frameCount);
+    auto instancesOf = [&](int mesh, int node) -> const std::vector<const MeshInstance*>& { return uses.at(mesh).instances.at(node); };
+    for (size_t k = 0; k < frameCount; ++k) {
+        const BakedFrame frame = k == 0 ? first : frameAt(k);
+        times[k] = frame.seconds;
+        for (auto& [mesh, list] : groups) {
+            std::vector<Group> split;
+            for (const Group& g : list) {
+                const size_t begin = split.size();
+                for (const int node : g.nodes) {
+                    auto same = [&](const Group& other) {
+                        const auto& a = instancesOf(mesh, node);
+                        const auto& b = instancesOf(mesh, other.nodes[0]);
+                        for (size_t p = 0; p < a.size(); ++p) {
+                            if (!a[p] != !b[p]) return false;
+                            if (a[p] && !sameBake(frame, *a[p], *b[p])) return false;
+                        }
+                        return true;
+                    };
+                    auto match = std::find_if(split.begin() + std::ptrdiff_t(begin), split.end(), same);
+                    if (match == split.end()) split.push_back(Group{-1, {node}, g.animated});
+                    else match->nodes.push_back(node);
+                }
+            }
+            for (Group& g : split) {
+                if (g.animated || k == 0) continue;
+                for (const MeshInstance* instance : instancesOf(mesh, g.nodes[0]))
+                    if (instance && !(std::memcmp(&frame.radiance[instance->firstVertex], &first.radiance[instance->firstVertex],
+                                                  instance->vertexCount * sizeof(Vec3f)) == 0 &&
+                                      std::memcmp(&frame.irradiance[instance->firstVertex], &first.irradiance[instance->firstVertex],
+                                                  instance->vertexCount * sizeof(Vec3f)) == 0))
+                        g.animated = true;
+            }
+            list = std::move(split);
+        }
+    }
+    // The first group keeps the mesh; the others get copies, their nodes pointed at them.
+    size_t copies = 0;
+    for (auto& [mesh, list] : groups)
+        for (size_t g = 0; g < list.size(); ++g) {
+            if (g == 0) {
+                list[g].mesh = mesh;
+                continue;
+            }
+            json copy = doc["meshes"][size_t(mesh)];
+            doc["meshes"].push_back(std::move(copy));
+            list[g].mesh = int(doc["meshes"].size()) - 1;
+            for (const int node : list[g].nodes) doc["nodes"][size_t(node)]["mesh"] = list[g].mesh;
+            ++copies;
+        }
+
+    // Pass 2: frame 0's values as attributes, later frames' differences as sparse targets.
+    const bool colour = settings.colourSet >= 0;
+    auto colourOf = [&](const Vec3f& radiance) {
+        Vec3f c;
+        for (int i = 0; i < 3; ++i) c[i] = float(std::clamp(double(radiance[i]) * settings.exposure, 0.0, 1.0));
+        return c;
+    };
+    struct Target {
+        int radiance, irradiance, colour;
+    };
+    std::map<std::pair<int, size_t>, std::vector<Target>> targets;  // (output mesh, primitive) → per later frame
+    size_t animatedPrimitives = 0;
+    for (size_t k = 0; k < frameCount; ++k) {
+        const BakedFrame frame = k == 0 ? first : frameAt(k);
+        for (const auto& [mesh, list] : groups)
+            for (const Group& g : list) {
+                if (k > 0 && !g.animated) continue;
+                json& out = doc["meshes"][size_t(g.mesh)];
+                const auto& instances = instancesOf(mesh, g.nodes[0]);
+                for (size_t p = 0; p < instances.size(); ++p) {
+                    const MeshInstance* instance = instances[p];
+                    json& primitive = out["primitives"][p];
+                    const size_t count = instance ? instance->vertexCount : positionCount(doc, primitive);
+                    if (k == 0) {
+                        json& attributes = primitive["attributes"];
+                        if (!instance) {  // not rendered (points, lines): zeros, as every primitive of a morphing mesh needs the base
+                            attributes["_RADIANCE"] = bin.addZeroVec3(count);
+                            attributes["_IRRADIANCE"] = bin.addZeroVec3(count);
+                            if (colour) attributes[colourName(settings.colourSet)] = bin.addZeroVec3(count);
+                            continue;
+                        }
+                        attributes["_RADIANCE"] = bin.addVec3(&frame.radiance[instance->firstVertex], count);
+                        attributes["_IRRADIANCE"] = bin.addVec3(&frame.irradiance[instance->firstVertex], count);
+                        if (colour) {
+                            std::vector<Vec3f> c(count);
+                            for (size_t v = 0; v < count; ++v) c[v] = colourOf(frame.radiance[instance->firstVertex + v]);
+                            attributes[colourName(settings.colourSet)] = bin.addVec3(c.data(), count);
+                        }
+                        if (g.animated) ++animatedPrimitives;
+                        continue;
+                    }
+                    Target target{};
+                    if (!instance) {
+                        target = {bin.addZeroVec3(count), bin.addZeroVec3(count), colour ? bin.addZeroVec3(count) : -1};
+                    } else {
+                        std::vector<uint32_t> changed;
+                        std::vector<Vec3f> dRadiance, dIrradiance, dColour;
+                        for (size_t v = 0; v < count; ++v) {
+                            const size_t i = instance->firstVertex + v;
+                            if (frame.radiance[i] == first.radiance[i] && frame.irradiance[i] == first.irradiance[i]) continue;
+                            changed.push_back(uint32_t(v));
+                            dRadiance.push_back(frame.radiance[i] - first.radiance[i]);
+                            dIrradiance.push_back(frame.irradiance[i] - first.irradiance[i]);
+                            if (colour) dColour.push_back(colourOf(frame.radiance[i]) - colourOf(first.radiance[i]));
+                        }
+                        const int indexView = changed.empty() ? -1 : bin.addView(changed.data(), changed.size() * 4);
+                        target.radiance = bin.addSparseVec3(count, changed, dRadiance, indexView);
+                        target.irradiance = bin.addSparseVec3(count, changed, dIrradiance, indexView);
+                        target.colour = colour ? bin.addSparseVec3(count, changed, dColour, indexView) : -1;
+                    }
+                    targets[{g.mesh, p}].push_back(target);
+                }
+            }
+        if (bin.bytes().size() > kMaxGlbBytes) break;  // reported below
+    }
+    if (uint64_t(bin.bytes().size()) + 65536 > kMaxGlbBytes) {
+        char text[320];
+        std::snprintf(text, sizeof text,
+                      "the baked asset would exceed the 4 GiB a GLB holds: the asset's own data is %.3g GB and the bake "
+                      "%.3g GB a frame over the first %zu frames; render fewer frames (--frames) or a coarser mesh",
+                      double(assetBytes) * 1e-9, double(bin.bytes().size() - assetBytes) * 1e-9 / double(frameCount), frameCount);
+        throw InputError(kOption, "", text);
+    }
+
+    // The targets, and the weights glTF keeps per target.
+    const size_t lighting = frameCount - 1;  // targets a lighting-animated mesh gains
+    std::set<int> animatedMeshes;
+    std::map<int, size_t> ownTargets;  // output mesh → targets before ours
+    for (const auto& [mesh, list] : groups)
+        for (const Group& g : list) {
+            if (!g.animated) continue;
+            json& out = doc["meshes"][size_t(g.mesh)];
+            ownTargets[g.mesh] = targetCount(out);
+            animatedMeshes.insert(g.mesh);
+            for (size_t p = 0; p < out["primitives"].size(); ++p) {
+                json& primitive = out["primitives"][p];
+                if (!primitive.contains("targets")) primitive["targets"] = json::array();
+                for (const Target& t : targets[{g.mesh, p}]) {
+                    json target = {{"_RADIANCE", t.radiance}, {"_IRRADIANCE", t.irradiance}};
+                    if (t.colour >= 0) target[colourName(settings.colourSet)] = t.colour;
+                    primitive["targets"].push_back(std::move(target));
+                }
+            }
+            if (out.contains("weights"))
+                for (size_t i = 0; i < lighting; ++i) out["weights"].push_back(0.0);
+        }
+    // Nodes showing a mesh that gained targets: their default weights, and every weights channel.
+    std::map<int, int> nodeMesh;  // node → output mesh, for the nodes whose mesh gained targets
+    if (doc.contains("nodes"))
+        for (size_t n = 0; n < doc["nodes"].size(); ++n) {
+            json& node = doc["nodes"][n];
+            if (!node.contains("mesh") || !animatedMeshes.count(node["mesh"].get<int>())) continue;
+            nodeMesh[int(n)] = node["mesh"].get<int>();
+            if (node.contains("weights"))
+                for (size_t i = 0; i < lighting; ++i) node["weights"].push_back(0.0);
+        }
+
+    // The animation the lighting (and a transform file's motion) goes into.
+    if (!animatedMeshes.empty() || !motion.empty()) 
+        addLightingAnimation(doc, bin, scene, times, ownTargets, nodeMesh, motion, settings, warnings, file);
+
+    // One buffer, the GLB's binary chunk.
+    json buffer = doc.contains("buffers") && !doc["buffers"].empty() ? doc["buffers"][0] : json::object();
+    buffer.erase("uri");
+    bin.align(4);
+    buffer["byteLength"] = bin.bytes().size();
+    doc["buffers"] = json::array({std::move(buffer)});
+    if (!doc.contains("extras") || doc["extras"].is_object())
+        doc["extras"]["qsgi"] = {{"units", "_RADIANCE: W m^-2 sr^-1 (B/pi); _IRRADIANCE: W m^-2 (before the albedo)"},
+                                 {"frames", frameCount},
+                                 {"color", colour ? colourName(settings.colourSet) + " = min(1, exposure * _RADIANCE)" : ""},
+                                 {"exposure", settings.exposure}};
+
+    std::string text = doc.dump();
+    while (text.size() % 4) text += ' ';
+    const uint64_t total = 12 + 8 + uint64_t(text.size()) + 8 + bin.bytes().size();
+    if (total > kMaxGlbBytes)
+        throw InputError(kOption, "", "the baked asset would exceed the 4 GiB a GLB holds (" + std::to_string(total) + " bytes)");
+    std::string glb;
+    glb.reserve(size_t(total));
+    auto u32 = [&](uint64_t v) {
+        const uint32_t w = uint32_t(v);
+        glb.append(reinterpret_cast<const char*>(&w), 4);
+    };
+    glb += "glTF";
+    u32(2);
+    u32(total);
+    u32(text.size());
+    u32(0x4E4F534A);  // JSON
+    glb += text;
+    u32(bin.bytes().size());
+    u32(0x004E4942);  // BIN
+    glb += bin.bytes();
+    if (summary) {
+        summary->bytes = glb.size();
+        summary->bakeBytes = bin.bytes().size() - assetBytes;
+        summary->meshesCopied = copies;
+        summary->animatedPrimitives = animatedPrimitives;
+    }
+    return glb;
+}
+
+}  // namespace qsgi
