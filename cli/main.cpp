@@ -301,6 +301,9 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "qsgi: every frame is already complete in %s\n", out.c_str());
         else if (!o.quiet)
             std::fprintf(stderr, "qsgi: %s\n", display.summary(out, outcome).c_str());
+        if (!o.quiet && outcome.assetBytes > 0)
+            std::fprintf(stderr, "qsgi: wrote %s/asset.glb: %.1f MB, of which the bake %.1f MB (%.2f s to assemble and write)\n",
+                         out.c_str(), double(outcome.assetBytes) * 1e-6, double(outcome.assetBakeBytes) * 1e-6, outcome.assetSeconds);
         if (!o.quiet && outcome.filesReplaced > 0)
             std::fprintf(stderr, "qsgi: --overwrite: unlinked %d files of another run from %s before rendering\n",
                          outcome.filesReplaced, out.c_str());

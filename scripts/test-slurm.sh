@@ -2,7 +2,8 @@
 # The Slurm job arrays tested for real on a single-node cluster started here
 # (scripts/slurm/local-cluster.sh; needs root or sudo):
 #   1. a render split into 4 frame chunks writes every PLY, EXR and PNG byte for byte as one
-#      sequential run, and the merged timing.json lists every frame once, in order;
+#      sequential run, and the merged timing.json lists every frame once, in order; --gltf-out's
+#      asset.glb, made after the merge from all the frames, is the sequential run's too;
 #   2. an array task killed mid-chunk (scancel) leaves the merge undone; submitting the same
 #      command again runs only that chunk (resumed from its last complete frame) and the merge,
 #      and the result is again byte-identical;
@@ -49,11 +50,14 @@ logged_frames() { /usr/bin/python3 -c "import json,sys; print(' '.join(str(f['fr
 scene=("$root/data/cornell/cornell.gltf" --animation "$root/data/cornell/animation.json" --width 64 --height 48 --png --quiet)
 
 echo "== 1. chunked render == sequential render"
-"$qsgi" render "${scene[@]}" --photons 100000 --frames 0:11 --out "$work/sequential"
-scripts/slurm/render.py --out "$work/chunked" --frames 0:11 --chunks 4 --qsgi "$qsgi" -- "${scene[@]}" --photons 100000
+"$qsgi" render "${scene[@]}" --photons 100000 --frames 0:11 --gltf-out --out "$work/sequential"
+scripts/slurm/render.py --out "$work/chunked" --frames 0:11 --chunks 4 --qsgi "$qsgi" -- "${scene[@]}" --photons 100000 --gltf-out
 wait_for_queue
 [ "$(logged_frames "$work/chunked/timing.json")" = "$(seq -s ' ' 0 11)" ] || fail "merged timing.json lists other frames"
 same_frames "$work/sequential" "$work/chunked"
+# The one-file animation (--gltf-out) is made after the merge from all the frames: the sequential run's bytes.
+cmp -s "$work/sequential/asset.glb" "$work/chunked/asset.glb" || fail "the merged folder's asset.glb differs from the sequential run's"
+echo "test-slurm: the merged folder's asset.glb equals the sequential run's"
 
 echo "== 2. a killed array task, resubmitted"
 "$qsgi" render "${scene[@]}" --photons 400000 --frames 0:17 --out "$work/sequential-big"

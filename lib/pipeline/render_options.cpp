@@ -507,13 +507,13 @@ std::vector<RenderOption> declareOptions() {
                  "also write asset.glb: the scene's own glTF file, every object kept, with the bake on each rendered "
                  "primitive as _RADIANCE (B/pi) and _IRRADIANCE (E, before the albedo); an animation's frames as "
                  "morph targets a STEP weights animation plays (docs/outputs.md)",
-                 true, false,
+                 false, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.writeGltf = v; },
                  [](const RenderSettings& s) { return json(s.writeGltf); }});
     o.push_back({"gltf_colour", "--gltf-colour", T::Integer, 0, 255, "", {}, true, "N", "none",
                  "with --gltf-out, also add the vertex colour set COLOR_N = min(1, exposure * B/pi) (the first frame's "
                  "99th percentile at 1); N must be the primitives' next free set: an existing one is never overwritten",
-                 true, false,
+                 false, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.gltfColourSet = v.get<int>(); },
                  [](const RenderSettings& s) { return s.gltfColourSet >= 0 ? json(s.gltfColourSet) : json(nullptr); }});
     o.push_back({"exposure", "--exposure", T::Number, 0, 1e30, "", {}, true, "X",

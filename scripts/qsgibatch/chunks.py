@@ -109,6 +109,17 @@ def task_command(out: str, index: int, threads: int) -> list:
         "--frames", f"{first}:{last}", "--out", chunk, "--resume", "--threads", str(threads)]
 
 
+def finish_command(out: str) -> list:
+    """After the merge: the render again over the plan's whole range with --resume. It finds every
+    frame complete (verifying each against the merged timing.json) and computes nothing, but writes
+    what qsgi makes from all the frames at once: with --gltf-out, OUT/asset.glb, the one file of the
+    whole animation."""
+    p = load_plan(out)
+    first, last = p["chunks"][0][0], p["chunks"][-1][1]
+    return [p["qsgi"], "render"] + p["arguments"] + [
+        "--frames", f"{first}:{last}", "--out", out, "--resume", "--threads", str(p["cpus"]), "--quiet"]
+
+
 # Verifying a chunk --------------------------------------------------------------------------------
 
 def _frame_records(log: dict, first: int, last: int) -> list:

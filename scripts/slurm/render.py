@@ -14,6 +14,7 @@ run or merge holds OUT/.qsgi-lock (try again later), 74 the machine failed (no s
 import argparse
 import os
 import shlex
+import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -97,7 +98,8 @@ def main(argv):
             os.execv(command[0], command)
         if args.merge:
             print(f"render: merged {chunks.merge(out)} frames into {out}")
-            return 0
+            # What is made from all the frames (--gltf-out's asset.glb), by qsgi itself.
+            return subprocess.run(chunks.finish_command(out)).returncode
         return submit(args)
     except output_folder.FolderError as e:  # 2 a refusal, 75 another run holds the folder, 74 the machine failed
         print(f"render: {e}", file=sys.stderr)
