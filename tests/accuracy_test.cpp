@@ -67,11 +67,14 @@ TEST(Accuracy, CompareCommandReadsPlysAndRejectsMismatches) {
     VertexRadiosity a, b;
     a.radiosity.assign(scene.vertexCount(), Vec3f(1.0f));
     b.radiosity.assign(scene.vertexCount(), Vec3f(1.1f));
+    a.irradiance.assign(scene.vertexCount(), Vec3f(2.0f));
+    b.irradiance.assign(scene.vertexCount(), Vec3f(2.2f));
     writeFileAtomically(dir / "a.ply", encodeVertexRadiosityPly(scene, a, PreviewTonemap{}));
     writeFileAtomically(dir / "b.ply", encodeVertexRadiosityPly(scene, b, PreviewTonemap{}));
     const VertexRadiosityPly back = readVertexRadiosityPly((dir / "b.ply").string());
     ASSERT_EQ(back.radiosity.size(), scene.vertexCount());
     EXPECT_EQ(back.radiosity[5], Vec3f(1.1f));
+    EXPECT_EQ(back.irradiance[5], Vec3f(2.2f));
     EXPECT_EQ(back.normals[5], scene.normals[5]);
 
     const CommandResult r = runQsgi("compare " + (dir / "b.ply").string() + " " + (dir / "a.ply").string() + " --json");
@@ -81,6 +84,7 @@ TEST(Accuracy, CompareCommandReadsPlysAndRejectsMismatches) {
     Scene other = testscenes::plane(1.0f, 4, Vec3f(0.5f));
     VertexRadiosity c;
     c.radiosity.assign(other.vertexCount(), Vec3f(1.0f));
+    c.irradiance.assign(other.vertexCount(), Vec3f(2.0f));
     writeFileAtomically(dir / "c.ply", encodeVertexRadiosityPly(other, c, PreviewTonemap{}));
     const CommandResult mismatch = runQsgi("compare " + (dir / "c.ply").string() + " " + (dir / "a.ply").string());
     EXPECT_EQ(mismatch.exitCode, 2);

@@ -311,6 +311,18 @@ TEST(GltfOut, ATransformFilesMotionBecomesTheAssetsNodeAnimation) {
             const Transform a = file.localsAt(frame)[size_t(node)], b = played.localsAt(frame)[size_t(node)];
             for (int i = 0; i < 16; ++i) EXPECT_NEAR(a.m[size_t(i)], b.m[size_t(i)], 1e-6) << "frame " << frame << ", node " << node;
         }
+
+    // One frame of it: no motion to animate, but the asset's nodes stand where the transform file
+    // put them for the frame baked.
+    const CommandResult single = runQsgi("render " + c.scene.string() + " --animation " + (sourceDir() / "data/cornell/animation.json").string() +
+                                         " --frames 2:2 --photons 2000 --gltf-out --no-exr --quiet --out " + (out / "single").string());
+    ASSERT_EQ(single.exitCode, 0) << single.output;
+    const Scene still = loadGltfScene((out / "single" / "asset.glb").string(), w);
+    EXPECT_TRUE(still.animations.empty());
+    for (const int node : file.movedNodes()) {
+        const Transform a = file.localsAt(2)[size_t(node)], b = still.nodes[size_t(node)].local;
+        for (int i = 0; i < 16; ++i) EXPECT_NEAR(a.m[size_t(i)], b.m[size_t(i)], 1e-9) << "node " << node;
+    }
 }
 
 // One mesh shown by four nodes: two lit differently, two under the floor in the dark (equal bakes,
@@ -417,7 +429,7 @@ TEST(GltfOut, AColourSetIsNeverOverwrittenAndABakedAssetIsNotBakedAgain) {
     const std::string baked = (out / "a" / "asset.glb").string();
     const CommandResult again = runQsgi("render " + baked + " --gltf-out --photons 1000 --out " + (out / "b").string());
     EXPECT_EQ(again.exitCode, 2) << again.output;
-    EXPECT_NE(again.output.find("_RADIANCE: is already there"), std::string::npos) << again.output;
+    EXPECT_NE(again.output.find("attributes._RADIANCE: is already there"), std::string::npos) << again.output;
 }
 
 // The matrix a transform file gives becomes glTF's translation, rotation and scale.
@@ -432,4 +444,8 @@ TEST(GltfOut, AMatrixDecomposesToTheTrsThatComposeIt) {
         const Transform back = trs.matrix();
         for (int i = 0; i < 16; ++i) EXPECT_NEAR(back.m[size_t(i)], m.m[size_t(i)], 1e-9 * 1000) << i;
     }
+    // Flattened on one axis and rotated: the other two axes keep their directions.
+    const Transform flat = Transform::fromTRS(Vec3d(0.5, 0, 0), q, Vec3d(0, 2, 3));
+    const Transform back = decomposeTrs(flat).matrix();
+    for (int i = 0; i < 16; ++i) EXPECT_NEAR(back.m[size_t(i)], flat.m[size_t(i)], 1e-9) << i;
 }

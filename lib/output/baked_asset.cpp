@@ -5,10 +5,12 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <filesystem>
 
 namespace qsgi {
 
 using nlohmann::json;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -99,10 +101,21 @@ struct MeshUse {
 
 size_t primitiveCount(const json& doc, int mesh) { return doc["meshes"][size_t(mesh)]["primitives"].size(); }
 
-size_t positionCount(const json& doc, const json& primitive) {
+// A primitive's vertex count, from its POSITION or else any attribute whose accessor exists (0:
+// none tells it).
+size_t vertexCountOf(const json& doc, const json& primitive) {
+    if (!primitive.contains("attributes") || !primitive["attributes"].is_object() || !doc.contains("accessors")) return 0;
     const json& attributes = primitive["attributes"];
-    if (!attributes.contains("POSITION")) return 0;
-    return doc["accessors"][attributes["POSITION"].get<size_t>()]["count"].get<size_t>();
+    const json& accessors = doc["accessors"];
+    auto countOf = [&](const json& index) -> size_t {
+        if (!index.is_number_unsigned() || index.get<size_t>() >= accessors.size()) return 0;
+        const json& a = accessors[index.get<size_t>()];
+        return a.contains("count") && a["count"].is_number_unsigned() ? a["count"].get<size_t>() : 0;
+    };
+    if (attributes.contains("POSITION") && countOf(attributes["POSITION"]) > 0) return countOf(attributes["POSITION"]);
+    for (const auto& [name, index] : attributes.items())
+        if (countOf(index) > 0) return countOf(index);
+    return 0;
 }
 
 size_t targetCount(const json& mesh) {
@@ -112,14 +125,22 @@ size_t targetCount(const json& mesh) {
 
 // The input's buffers, images and views moved into one buffer: every bufferView's buffer becomes
 // 0 at its buffer's offset; an image's uri becomes a view of its file's bytes.
-void packBuffers(const GltfDocument& document, json& doc, BinaryBuilder& bin, Warnings& warnings, const std::string& file) {
+void packBuffers(const GltfDocument& document, json& doc, BinaryBuilder& bin, Warnings& warnings, const std::string& file,
+                 const std::string& assetFolder) {
     const tinygltf::Model& model = document.model;
     std::vector<size_t> start(model.buffers.size(), 0);
     for (size_t b = 0; b < model.buffers.size(); ++b) {
         bin.align(16);  // keeps every accessor's alignment within its buffer
         start[b] = bin.bytes().size();
-        if (!document.absentBuffers.count(int(b)))
+        if (!document.absentBuffers.count(int(b))) {
             bin.bytes().append(reinterpret_cast<const char*>(model.buffers[b].data.data()), model.buffers[b].data.size());
+        } else {
+            // No data (no uri): nothing reads it, but its views must stay inside the one buffer.
+            const size_t length = doc["buffers"][b].value("byteLength", size_t(0));
+            if (length > kMaxGlbBytes) throw InputError(file, "buffers[" + std::to_string(b) + "].byteLength", "is beyond what a GLB holds");
+            bin.bytes().append(length, '\0');
+            warnings.add(file + ": buffers[" + std::to_string(b) + "] has no data; the asset holds zeros in its place");
+        }
     }
     if (doc.contains("bufferViews"))
         for (json& view : doc["bufferViews"]) {
@@ -132,24 +153,49 @@ void packBuffers(const GltfDocument& document, json& doc, BinaryBuilder& bin, Wa
             json& image = doc["images"][i];
             if (!image.contains("uri")) continue;
             const tinygltf::Image& decoded = model.images[i];
-            std::string mime = decoded.mimeType;
-            const std::string uri = image["uri"].get<std::string>();
-            if (uri.rfind("data:", 0) == 0) mime = uri.substr(5, uri.find_first_of(";,") - 5);
+            const std::string uri = image["uri"].is_string() ? image["uri"].get<std::string>() : "";
+            // The format the bytes are (not the name's extension, which may lie).
+            const std::vector<unsigned char>& b = decoded.image;
+            auto startsWith = [&](const char* magic, size_t at = 0) {
+                const size_t n = std::strlen(magic);
+                return b.size() >= at + n && std::memcmp(b.data() + at, magic, n) == 0;
+            };
+            const std::string mime = startsWith("\x89PNG") ? "image/png" : startsWith("\xFF\xD8\xFF") ? "image/jpeg"
+                                   : startsWith("RIFF") && startsWith("WEBP", 8) ? "image/webp"
+                                   : startsWith("\xABKTX 20\xBB") ? "image/ktx2" : "";
             if (mime.empty()) {
-                std::string extension = uri.substr(uri.find_last_of('.') + 1);
-                std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-                mime = extension == "png" ? "image/png" : extension == "jpg" || extension == "jpeg" ? "image/jpeg"
-                     : extension == "webp" ? "image/webp" : extension == "ktx2" ? "image/ktx2" : "";
-            }
-            if (decoded.image.empty() || mime.empty()) {
+                // Left where it is: the uri made to reach the file from the asset's folder.
+                const fs::path target = fs::path(document.baseDir) / uri;
+                if (!uri.empty() && uri.rfind("data:", 0) != 0 && !assetFolder.empty())
+                    image["uri"] = fs::relative(fs::absolute(target), fs::absolute(assetFolder)).generic_string();
                 warnings.add(file + ": images[" + std::to_string(i) + "] ('" + uri.substr(0, 200) +
-                             "') could not be embedded and keeps its uri, relative to the scene's folder");
+                             "') is no PNG, JPEG, WebP or KTX2 file qsgi could read, so it is not embedded; asset.glb refers to it");
                 continue;
             }
             image.erase("uri");
             image["bufferView"] = bin.addView(decoded.image.data(), decoded.image.size());
             image["mimeType"] = mime;
         }
+}
+
+// A node's local transform as its JSON gives it (glTF 2.0 §5.25: a matrix, or T·R·S).
+Transform nodeTransform(const json& node) {
+    if (node.contains("matrix")) {
+        const std::vector<double> m = node["matrix"].get<std::vector<double>>();
+        return Transform::fromColumnMajor(m.data());
+    }
+    const std::vector<double> t = node.value("translation", std::vector<double>{0, 0, 0});
+    const std::vector<double> r = node.value("rotation", std::vector<double>{0, 0, 0, 1});
+    const std::vector<double> s = node.value("scale", std::vector<double>{1, 1, 1});
+    return Transform::fromTRS(Vec3d(t[0], t[1], t[2]), {r[0], r[1], r[2], r[3]}, Vec3d(s[0], s[1], s[2]));
+}
+
+// Gives the node translation, rotation and scale (instead of a matrix, which glTF does not animate).
+void setNodeTrs(json& node, const NodeTrs& trs) {
+    node.erase("matrix");
+    node["translation"] = {trs.translation.x, trs.translation.y, trs.translation.z};
+    node["rotation"] = {trs.rotation[0], trs.rotation[1], trs.rotation[2], trs.rotation[3]};
+    node["scale"] = {trs.scale.x, trs.scale.y, trs.scale.z};
 }
 
 // glTF's weights of a node at rest: its own, else its mesh's, else zeros.
@@ -208,15 +254,7 @@ void addLightingAnimation(json& doc, BinaryBuilder& bin, const Scene& scene, con
 
     for (const NodeMotion& m : motion) {
         json& node = doc["nodes"][size_t(m.node)];
-        if (node.contains("matrix")) {
-            // glTF animates translation, rotation and scale only: the matrix becomes them.
-            const std::vector<double> values = node["matrix"].get<std::vector<double>>();
-            const NodeTrs rest = decomposeTrs(Transform::fromColumnMajor(values.data()));
-            node.erase("matrix");
-            node["translation"] = {rest.translation.x, rest.translation.y, rest.translation.z};
-            node["rotation"] = {rest.rotation[0], rest.rotation[1], rest.rotation[2], rest.rotation[3]};
-            node["scale"] = {rest.scale.x, rest.scale.y, rest.scale.z};
-        }
+        if (node.contains("matrix")) setNodeTrs(node, m.frames.front());
         std::vector<float> translation, rotation, scale;
         for (const NodeTrs& trs : m.frames) {
             for (int c = 0; c < 3; ++c) translation.push_back(float(trs.translation[c]));
@@ -232,10 +270,39 @@ void addLightingAnimation(json& doc, BinaryBuilder& bin, const Scene& scene, con
         }
     }
 
+    // An output of animation weights: sparse where most of it is 0 (the one-hot lighting part of
+    // many frames would otherwise grow with the square of the frame count).
+    auto addWeights = [&](const std::vector<float>& values) {
+        std::vector<uint32_t> indices;
+        std::vector<float> nonzero;
+        for (size_t i = 0; i < values.size(); ++i)
+            if (values[i] != 0.0f) {
+                indices.push_back(uint32_t(i));
+                nonzero.push_back(values[i]);
+            }
+        if (indices.size() * 2 >= values.size()) return bin.addFloats(values, "SCALAR", values.size());
+        json accessor = {{"componentType", kFloat}, {"count", values.size()}, {"type", "SCALAR"}};
+        if (!indices.empty())
+            accessor["sparse"] = {{"count", indices.size()},
+                                  {"indices", {{"bufferView", bin.addView(indices.data(), indices.size() * 4)}, {"componentType", kUnsignedInt}}},
+                                  {"values", {{"bufferView", bin.addView(nonzero.data(), nonzero.size() * 4)}}}};
+        return bin.addAccessor(std::move(accessor));
+    };
+    auto oneHot = [&](size_t frame, std::vector<float>& values) {
+        for (size_t i = 0; i < lighting; ++i) values.push_back(frame == i + 1 ? 1.0f : 0.0f);
+    };
     for (const auto& [node, mesh] : nodeMesh) {
         const size_t own = ownTargets.at(mesh);
         const std::vector<double> rest = restWeights(doc["nodes"][size_t(node)], doc["meshes"][size_t(mesh)], own);
-        bool drivenInPlayed = false;
+        // The animation that shows this node's lighting: the one played, or with all played at
+        // once, the one already driving its weights (two channels on them would fight).
+        size_t home = played;
+        if (settings.playedAll)
+            for (size_t a = 0; a < fileAnimations; ++a)
+                if (animations[a].contains("channels"))
+                    for (const json& c : animations[a]["channels"])
+                        if (c.contains("target") && c["target"].value("node", -1) == node && c["target"].value("path", "") == "weights") home = a;
+        bool drivenInHome = false;
         for (size_t a = 0; a < animations.size(); ++a) {
             json& animation = animations[a];
             if (!animation.contains("channels")) continue;
@@ -243,28 +310,38 @@ void addLightingAnimation(json& doc, BinaryBuilder& bin, const Scene& scene, con
                 if (!channel.contains("target") || channel["target"].value("node", -1) != node ||
                     channel["target"].value("path", "") != "weights")
                     continue;
+                const json& sampler = animation["samplers"][channel["sampler"].get<size_t>()];
                 const KeyframeTrack* track = weightsTrack(scene, a, node);
+                KeyframeTrack zeros;  // a channel the loader did not keep (its data all zeros by default)
                 if (!track) {
-                    warnings.add(file + ": animations[" + std::to_string(a) + "]'s weights channel on nodes[" + std::to_string(node) +
-                                 "] was not read, so its output could not be given the baked frames' weights");
-                    continue;
+                    zeros.interpolation = sampler.value("interpolation", "LINEAR") == "STEP" ? Interpolation::Step
+                                        : sampler.value("interpolation", "LINEAR") == "CUBICSPLINE" ? Interpolation::CubicSpline
+                                                                                                   : Interpolation::Linear;
+                    zeros.components = int(own);
+                    const json& input = doc["accessors"][sampler["input"].get<size_t>()];
+                    zeros.times.assign(input.value("count", size_t(1)), 0.0);
+                    for (size_t k = 0; k < zeros.times.size(); ++k) zeros.times[k] = double(k);  // placeholders: only their count is used
+                    zeros.values.assign(zeros.times.size() * own * (zeros.interpolation == Interpolation::CubicSpline ? 3 : 1), 0.0);
+                    track = &zeros;
                 }
                 std::vector<float> keys(track->times.begin(), track->times.end());
                 std::vector<float> values;
                 Interpolation interpolation = track->interpolation;
-                if (a != played) {
-                    // Another animation: our targets stay at 0 while it plays (frame 0's lighting).
+                int input = sampler["input"].get<int>();
+                if (a != home || track == &zeros) {
+                    // Our targets stay at 0 while it plays (the first frame's lighting).
                     const size_t groups = interpolation == Interpolation::CubicSpline ? 3 : 1;
                     for (size_t k = 0; k < keys.size(); ++k)
                         for (size_t g = 0; g < groups; ++g) {
                             for (size_t i = 0; i < own; ++i) values.push_back(float(track->values[(k * groups + g) * own + i]));
                             values.insert(values.end(), lighting, 0.0f);
                         }
+                    if (a == home) continue;  // replaced below by the lighting's own channel
                 } else {
-                    // The played animation: its keys and the frames' merged. A cubic spline is
-                    // resampled as LINEAR there (exact at the keys); a LINEAR sampler gains a key just
-                    // before each frame so that the lighting steps rather than fades.
-                    drivenInPlayed = true;
+                    // Its keys and the frames' merged. A cubic spline is resampled LINEAR there
+                    // (exact at the keys); a LINEAR sampler gains a key just before each frame so
+                    // that the lighting steps rather than fades.
+                    drivenInHome = true;
                     if (interpolation == Interpolation::CubicSpline) {
                         warnings.add(file + ": animations[" + std::to_string(a) + "]'s cubic-spline weights on nodes[" +
                                      std::to_string(node) + "] are written LINEAR between their keys and the frames");
@@ -278,32 +355,39 @@ void addLightingAnimation(json& doc, BinaryBuilder& bin, const Scene& scene, con
                         }
                     std::sort(keys.begin(), keys.end());
                     keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-                    std::vector<double> own_(std::max<size_t>(own, 1));
+                    std::vector<double> sampled(std::max<size_t>(own, 1));
                     for (const float t : keys) {
-                        track->sample(double(t), false, own_.data());
-                        for (size_t i = 0; i < own; ++i) values.push_back(float(own_[i]));
-                        const size_t f = frameAtTime(t);
-                        for (size_t i = 0; i < lighting; ++i) values.push_back(f == i + 1 ? 1.0f : 0.0f);
+                        track->sample(double(t), false, sampled.data());
+                        for (size_t i = 0; i < own; ++i) values.push_back(float(sampled[i]));
+                        oneHot(frameAtTime(t), values);
                     }
+                    input = bin.addScalars(keys, true);
                 }
-                // Keys unchanged: the channel's own input accessor serves.
-                const int input = keys == std::vector<float>(track->times.begin(), track->times.end())
-                                      ? animation["samplers"][channel["sampler"].get<size_t>()]["input"].get<int>()
-                                      : bin.addScalars(keys, true);
-                channel["sampler"] = addSampler(animation, input, bin.addFloats(values, "SCALAR", values.size()), interpolation);
+                channel["sampler"] = addSampler(animation, input, addWeights(values), interpolation);
             }
         }
-        if (!drivenInPlayed) {
+        if (!drivenInHome) {
+            // A channel of its own, or (a channel the loader did not keep, in its animation) in
+            // place of that one: the node's weights are driven once an animation.
             std::vector<float> values;
             for (size_t f = 0; f < frames; ++f) {
                 for (size_t i = 0; i < own; ++i) values.push_back(float(rest[i]));
-                for (size_t i = 0; i < lighting; ++i) values.push_back(f == i + 1 ? 1.0f : 0.0f);
+                oneHot(f, values);
             }
-            json& animation = animations[played];
-            const int sampler = addSampler(animation, frameTimesIndex(), bin.addFloats(values, "SCALAR", values.size()), Interpolation::Step);
-            animation["channels"].push_back({{"sampler", sampler}, {"target", {{"node", node}, {"path", "weights"}}}});
+            json& animation = animations[home];
+            const int sampler = addSampler(animation, frameTimesIndex(), addWeights(values), Interpolation::Step);
+            bool replaced = false;
+            for (json& c : animation["channels"])
+                if (c.contains("target") && c["target"].value("node", -1) == node && c["target"].value("path", "") == "weights") {
+                    c["sampler"] = sampler;
+                    replaced = true;
+                }
+            if (!replaced) animation["channels"].push_back({{"sampler", sampler}, {"target", {{"node", node}, {"path", "weights"}}}});
         }
     }
+    // glTF forbids an animation without channels, and an empty list of them.
+    if (animations.size() > fileAnimations && animations.back()["channels"].empty()) animations.erase(animations.size() - 1);
+    if (animations.empty()) doc.erase("animations");
 }
 
 }  // namespace
@@ -311,19 +395,21 @@ void addLightingAnimation(json& doc, BinaryBuilder& bin, const Scene& scene, con
 void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const BakedAssetSettings& settings,
                          const std::string& sceneFile) {
     const json& doc = document.json;
+    if (doc.contains("extensionsUsed") && doc["extensionsUsed"].is_array())
+        for (const json& e : doc["extensionsUsed"])
+            if (e == "EXT_meshopt_compression")
+                throw InputError(sceneFile, "extensionsUsed", "has EXT_meshopt_compression, whose buffers --gltf-out cannot repack");
+    std::set<int> meshes;
     for (const MeshInstance& instance : scene.instances) {
         if (instance.mesh < 0) throw InputError(kOption, "", "needs a scene read from a glTF file");
+        meshes.insert(instance.mesh);
         const json& primitive = doc["meshes"][size_t(instance.mesh)]["primitives"][size_t(instance.primitive)];
         const std::string place = "meshes[" + std::to_string(instance.mesh) + "].primitives[" + std::to_string(instance.primitive) + "]";
-        if (instance.vertexCount != positionCount(doc, primitive))
+        if (instance.vertexCount != vertexCountOf(doc, primitive))
             throw InputError(kOption, "",
                              "cannot be combined with --subdivide yet: the refined meshes would need every attribute of the "
                              "asset (texture coordinates, tangents, colours) refined with them");
         const json& attributes = primitive["attributes"];
-        for (const char* name : {"_RADIANCE", "_IRRADIANCE"})
-            if (attributes.contains(name))
-                throw InputError(sceneFile, place + ".attributes." + name,
-                                 "is already there (a baked asset?): --gltf-out adds it, so bake the original asset");
         if (settings.colourSet >= 0) {
             if (attributes.contains(colourName(settings.colourSet)))
                 throw InputError(sceneFile, place + ".attributes." + colourName(settings.colourSet),
@@ -334,6 +420,15 @@ void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const
                                      std::to_string(settings.colourSet) + " would leave a gap (glTF numbers colour sets from 0 without gaps)");
         }
     }
+    // Every primitive of a baked mesh, rendered or not, may gain the two attributes.
+    for (const int mesh : meshes) {
+        const json& primitives = doc["meshes"][size_t(mesh)]["primitives"];
+        for (size_t p = 0; p < primitives.size(); ++p)
+            for (const char* name : {"_RADIANCE", "_IRRADIANCE"})
+                if (primitives[p].contains("attributes") && primitives[p]["attributes"].contains(name))
+                    throw InputError(sceneFile, "meshes[" + std::to_string(mesh) + "].primitives[" + std::to_string(p) + "].attributes." + name,
+                                     "is already there (a baked asset?): --gltf-out adds it, so bake the original asset");
+    }
 }
 
 std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, size_t frameCount,
@@ -342,7 +437,7 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
     const std::string file = scene.sourcePath;
     json doc = document.json;
     BinaryBuilder bin(doc);
-    packBuffers(document, doc, bin, warnings, file);
+    packBuffers(document, doc, bin, warnings, file, settings.assetFolder);
     const size_t assetBytes = bin.bytes().size();
 
     // Which nodes show which glTF mesh, in the order the scene placed them.
@@ -404,6 +499,19 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
             list = std::move(split);
         }
     }
+    // A primitive without a vertex count (no attribute with an accessor) cannot take the targets
+    // every primitive of a morphing mesh must have: its mesh keeps frame 0's lighting.
+    for (auto& [mesh, list] : groups)
+        for (Group& g : list) {
+            if (!g.animated) continue;
+            const auto& instances = instancesOf(mesh, g.nodes[0]);
+            for (size_t p = 0; p < instances.size(); ++p)
+                if (!instances[p] && vertexCountOf(doc, doc["meshes"][size_t(mesh)]["primitives"][p]) == 0) {
+                    g.animated = false;
+                    warnings.add(file + ": meshes[" + std::to_string(mesh) + "].primitives[" + std::to_string(p) +
+                                 "] has no vertices to give morph targets, so the mesh shows only the first frame's lighting");
+                }
+        }
     // The first group keeps the mesh; the others get copies, their nodes pointed at them.
     size_t copies = 0;
     for (auto& [mesh, list] : groups)
@@ -431,7 +539,10 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
     };
     std::map<std::pair<int, size_t>, std::vector<Target>> targets;  // (output mesh, primitive) → per later frame
     size_t animatedPrimitives = 0;
-    for (size_t k = 0; k < frameCount; ++k) {
+    const bool anyAnimated = std::any_of(groups.begin(), groups.end(), [](const auto& entry) {
+        return std::any_of(entry.second.begin(), entry.second.end(), [](const Group& g) { return g.animated; });
+    });
+    for (size_t k = 0; k < (anyAnimated ? frameCount : 1); ++k) {
         const BakedFrame frame = k == 0 ? first : frameAt(k);
         for (const auto& [mesh, list] : groups)
             for (const Group& g : list) {
@@ -441,13 +552,17 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                 for (size_t p = 0; p < instances.size(); ++p) {
                     const MeshInstance* instance = instances[p];
                     json& primitive = out["primitives"][p];
-                    const size_t count = instance ? instance->vertexCount : positionCount(doc, primitive);
+                    const size_t count = instance ? instance->vertexCount : vertexCountOf(doc, primitive);
                     if (k == 0) {
                         json& attributes = primitive["attributes"];
-                        if (!instance) {  // not rendered (points, lines): zeros, as every primitive of a morphing mesh needs the base
-                            attributes["_RADIANCE"] = bin.addZeroVec3(count);
-                            attributes["_IRRADIANCE"] = bin.addZeroVec3(count);
-                            if (colour) attributes[colourName(settings.colourSet)] = bin.addZeroVec3(count);
+                        if (!instance) {
+                            // Not rendered (points, lines): no bake, but where the mesh gains
+                            // targets, zeros, as every primitive of a morphing mesh has the targets'
+                            // attributes; never a colour set (it would paint its own over).
+                            if (g.animated) {
+                                attributes["_RADIANCE"] = bin.addZeroVec3(count);
+                                attributes["_IRRADIANCE"] = bin.addZeroVec3(count);
+                            }
                             continue;
                         }
                         attributes["_RADIANCE"] = bin.addVec3(&frame.radiance[instance->firstVertex], count);
@@ -462,7 +577,7 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                     }
                     Target target{};
                     if (!instance) {
-                        target = {bin.addZeroVec3(count), bin.addZeroVec3(count), colour ? bin.addZeroVec3(count) : -1};
+                        target = {bin.addZeroVec3(count), bin.addZeroVec3(count), -1};
                     } else {
                         std::vector<uint32_t> changed;
                         std::vector<Vec3f> dRadiance, dIrradiance, dColour;
@@ -526,6 +641,25 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                 for (size_t i = 0; i < lighting; ++i) node["weights"].push_back(0.0);
         }
 
+    // A transform file's first pose, where it differs from the file's (the pose the bake is of).
+    for (size_t n = 0; n < settings.firstPose.size() && doc.contains("nodes") && n < doc["nodes"].size(); ++n) {
+        const Transform given = nodeTransform(doc["nodes"][n]);
+        double largest = 1, difference = 0;
+        for (int i = 0; i < 16; ++i) {
+            largest = std::max(largest, std::fabs(given.m[size_t(i)]));
+            difference = std::max(difference, std::fabs(given.m[size_t(i)] - settings.firstPose[n].m[size_t(i)]));
+        }
+        if (difference > 1e-12 * largest) setNodeTrs(doc["nodes"][n], decomposeTrs(settings.firstPose[n]));
+    }
+    // Key times are floats in the file: consecutive frames must stay apart there.
+    for (size_t k = 1; k < frameCount; ++k)
+        if (!(float(times[k]) > float(times[k - 1])))
+            throw InputError(kOption, "", "frames " + std::to_string(k - 1) + " and " + std::to_string(k) + " of the run fall on the same "
+                                          "single-precision time (glTF key times are floats): render fewer frames or at a lower --fps");
+    if (document.json.contains("extensionsUsed") && document.json["extensionsUsed"].is_array())
+        for (const json& e : document.json["extensionsUsed"])
+            if (e == "KHR_animation_pointer")
+                warnings.add(file + ": KHR_animation_pointer channels on morph weights are not given the baked frames' weights");
     // The animation the lighting (and a transform file's motion) goes into.
     if (!animatedMeshes.empty() || !motion.empty()) 
         addLightingAnimation(doc, bin, scene, times, ownTargets, nodeMesh, motion, settings, warnings, file);
@@ -536,7 +670,9 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
     bin.align(4);
     buffer["byteLength"] = bin.bytes().size();
     doc["buffers"] = json::array({std::move(buffer)});
-    if (!doc.contains("extras") || doc["extras"].is_object())
+    if (doc.contains("extras") && !doc["extras"].is_object())
+        warnings.add(file + ": the root's extras is no object, so asset.glb does not record the bake's units and exposure there");
+    else
         doc["extras"]["qsgi"] = {{"units", "_RADIANCE: W m^-2 sr^-1 (B/pi); _IRRADIANCE: W m^-2 (before the albedo)"},
                                  {"frames", frameCount},
                                  {"color", colour ? colourName(settings.colourSet) + " = min(1, exposure * _RADIANCE)" : ""},

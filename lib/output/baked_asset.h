@@ -49,6 +49,11 @@ struct BakedAssetSettings {
     int colourSet = -1;      // COLOR_n to add, or -1
     double exposure = 1;     // COLOR_n = min(1, exposure · B/π)
     int playedAnimation = -1;  // the glTF animation the frames show, or -1 (none, all, or a transform file)
+    bool playedAll = false;    // the file's animations played together (each node's lighting joins the one driving its weights)
+    // With a transform file: every node's local transform at the first frame, which the asset's
+    // nodes are given where the file's differ (the pose the bake is of); empty otherwise.
+    std::vector<Transform> firstPose;
+    std::string assetFolder;   // where the asset goes: an image left outside is referred to from there
 };
 
 // What the encoding came to, for the run's log and the user.

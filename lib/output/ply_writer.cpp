@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 #include "output/srgb.h"
 
@@ -36,6 +37,8 @@ void put(std::string& buf, T v) {
 }  // namespace
 
 std::string encodeVertexRadiosityPly(const Scene& scene, const VertexRadiosity& result, const PreviewTonemap& tonemap) {
+    if (result.radiosity.size() != scene.vertexCount() || result.irradiance.size() != scene.vertexCount())
+        throw std::logic_error("encodeVertexRadiosityPly: the result does not hold every vertex's radiosity and irradiance");
     std::ostringstream header;
     header << "ply\nformat binary_little_endian 1.0\ncomment qsgi " << QSGI_VERSION
            << " vertex radiosity (W/m^2)\nelement vertex " << scene.vertexCount()

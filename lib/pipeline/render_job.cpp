@@ -114,11 +114,13 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         refineMesh(scene_, settings_.subdivide);
     }
     if (settings_.writeGltf) {
-        // Refused now, not after the render, if the asset cannot take the bake.
+        // Refused now, not after the render, if the asset cannot take the bake; kept, so that the
+        // asset is the file the render read even if it changes on disk meanwhile.
         Warnings ignored;  // the loader has said what the file's oddities are
+        assetDocument_ = std::make_shared<const GltfDocument>(readGltfDocument(settings_.scenePath, ignored));
         BakedAssetSettings asset;
         asset.colourSet = settings_.gltfColourSet;
-        checkAssetTakesBake(readGltfDocument(settings_.scenePath, ignored), scene_, asset, settings_.scenePath);
+        checkAssetTakesBake(*assetDocument_, scene_, asset, settings_.scenePath);
     }
     scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
@@ -295,6 +297,8 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     outcome.framesRemoved = 0;
     for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames)
         if (failed.frame < start || failed.frame > last_) ++outcome.framesRemoved;
+    // An asset of earlier frames would no longer be the folder's: gone before any frame changes.
+    if (start <= last_) out.remove(kBakedAssetName);
     if (start > last_) {  // resumed with nothing left to do
         if (settings_.writeGltf) writeBakedAsset(out, outcome, warn);
         return outcome;
@@ -429,7 +433,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
 
 void RenderJob::writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const std::function<void(const std::string&)>& warn) const {
     Warnings warnings;
-    const GltfDocument document = readGltfDocument(settings_.scenePath, warnings);
+    const GltfDocument& document = *assetDocument_;
     const double fps = animation_.fps();
     auto frameAt = [&](size_t k) {
         const int frame = first_ + int(k);
@@ -449,13 +453,17 @@ void RenderJob::writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const
     BakedAssetSettings asset;
     asset.colourSet = settings_.gltfColourSet;
     asset.playedAnimation = playedGltfAnimation_;
+    asset.assetFolder = settings_.outDir;
     // COLOR_n's exposure puts the first frame's 99th percentile of B/π at 1, as the PLY previews
     // do with frame 0's.
     const BakedFrame firstFrame = frameAt(0);
     asset.exposure = double(PreviewTonemap::fromPercentile(firstFrame.radiance).scale);
     // A transform file's motion becomes the asset's node animation; a glTF animation is the file's already.
     std::vector<NodeMotion> motion;
-    const bool transformFile = !settings_.animationPath.empty() && !gltfAnimationSelector(settings_.animationPath, "").has_value();
+    const std::optional<int> gltfAnimation = gltfAnimationSelector(settings_.animationPath, "");
+    const bool transformFile = !settings_.animationPath.empty() && !gltfAnimation.has_value();
+    asset.playedAll = gltfAnimation.has_value() && *gltfAnimation < 0 && playedGltfAnimation_ < 0;
+    if (transformFile) asset.firstPose = animation_.localsAt(first_);
     if (transformFile && last_ > first_) {
         for (const int node : animation_.movedNodes()) motion.push_back(NodeMotion{node, {}});
         for (int frame = first_; frame <= last_; ++frame) {

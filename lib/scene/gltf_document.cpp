@@ -464,6 +464,7 @@ GltfDocument parseGltfDocument(const std::string& path, std::string bytes, const
 
     GltfDocument out;
     out.json = std::move(original);
+    out.baseDir = baseDir;
     out.findings = findReferenceProblems(doc);
     // Document-level slips that leave the file readable: warnings, refused under --strict.
     if (jsonText.size() >= 3 && jsonText.compare(0, 3, "\xEF\xBB\xBF") == 0)

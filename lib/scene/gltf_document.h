@@ -29,6 +29,7 @@ struct GltfDocument {
     // The JSON as the file holds it, before any repair made for tinygltf's sake: what --gltf-out
     // writes back (lib/output/baked_asset.h), every property kept.
     nlohmann::json json;
+    std::string baseDir;  // where its uris are relative to
     std::set<int> absentBuffers;  // buffers that have no data (no uri, not the BIN chunk)
     // Broken references, empty arrays and cameras with two projections, wherever they are: the
     // loader refuses those in objects the render reads and warns about the others.

@@ -32,11 +32,27 @@ NodeTrs decomposeTrs(const Transform& t) {
     NodeTrs trs;
     trs.translation = Vec3d(t.at(0, 3), t.at(1, 3), t.at(2, 3));
     Vec3d axis[3];
+    int zero = 0;
     for (int c = 0; c < 3; ++c) {
         const Vec3d column(t.at(0, c), t.at(1, c), t.at(2, c));
         trs.scale[c] = length(column);
-        axis[c] = trs.scale[c] > 0 ? column / trs.scale[c] : Vec3d(double(c == 0), double(c == 1), double(c == 2));
+        axis[c] = trs.scale[c] > 0 ? column / trs.scale[c] : Vec3d(0.0);
+        zero += trs.scale[c] > 0 ? 0 : 1;
     }
+    // A flattened axis (scale 0) takes the direction that completes the others to a rotation, so
+    // the rotation stays that of the axes that remain.
+    if (zero == 3) axis[0] = Vec3d(1, 0, 0);
+    for (int c = 0; zero >= 2 && c < 3; ++c)
+        if (length(axis[c]) > 0) {
+            const Vec3d a = axis[c];
+            const Vec3d helper = std::fabs(a.x) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0);
+            axis[(c + 1) % 3] = normalize(cross(a, helper));
+            axis[(c + 2) % 3] = cross(a, axis[(c + 1) % 3]);
+            break;
+        }
+    if (zero == 1)
+        for (int c = 0; c < 3; ++c)
+            if (!(length(axis[c]) > 0)) axis[c] = normalize(cross(axis[(c + 1) % 3], axis[(c + 2) % 3]));
     if (dot(cross(axis[0], axis[1]), axis[2]) < 0) {
         trs.scale.x = -trs.scale.x;
         axis[0] = -axis[0];
