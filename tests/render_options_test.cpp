@@ -308,7 +308,7 @@ TEST(RenderOptions, AnUnknownKeyNamesTheNearestKnownKeyMisspeltOrInOtherWords) {
         {"estimater", "estimator"},     {"gltf_output", "gltf_out"},   {"detp_boundry", "detp_boundary"}};
     for (const auto& [typo, key] : typos)
         EXPECT_EQ(didYouMean(typo, keys), " (did you mean \"" + key + "\"?)") << typo;
-    for (const char* unrelated : {"resolution", "quality", "colour_space"}) EXPECT_EQ(didYouMean(unrelated, keys), "") << unrelated;
+    for (const char* unrelated : {"resolution", "quality", "tone_curve"}) EXPECT_EQ(didYouMean(unrelated, keys), "") << unrelated;
     // The same rule for flags, choices and node names.
     EXPECT_EQ(didYouMean("--photon-count", {"--photons", "--out", "--threads"}), " (did you mean \"--photons\"?)");
     EXPECT_EQ(didYouMean("photon_mapping", {"impact-count", "photon-map", "detp"}), " (did you mean \"photon-map\"?)");
