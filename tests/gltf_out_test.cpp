@@ -77,7 +77,9 @@ std::string frameName(int frame, const char* extension) {
 
 // Takes out of `out` what --gltf-out adds to `in` and checks, as it goes, that the added parts
 // are where they belong; what is left must equal `in`. `colourSet` is --gltf-colour's (-1: none).
-json withoutTheBake(json out, const json& in, int colourSet) {
+// With `refined` (--subdivide), a primitive's attributes, indices and targets are new accessors of
+// the refined mesh: only their names are compared here (the values by loading the asset).
+json withoutTheBake(json out, const json& in, int colourSet, bool refined = false) {
     // One buffer; the input's views keep their order and lengths (their buffer and offset move);
     // accessors are appended, never edited.
     EXPECT_EQ(out["buffers"].size(), 1u);
@@ -115,6 +117,17 @@ json withoutTheBake(json out, const json& in, int colourSet) {
             }
             if (before.contains("targets")) primitive["targets"].erase(primitive["targets"].begin() + std::ptrdiff_t(before["targets"].size()), primitive["targets"].end());
             else primitive.erase("targets");
+            if (refined) {
+                for (const char* part : {"attributes", "indices"}) {
+                    if (!before.contains(part)) continue;
+                    if (before[part].is_object()) {
+                        for (const auto& [name, index] : before[part].items()) EXPECT_TRUE(primitive[part].contains(name)) << name;
+                    }
+                    primitive[part] = before[part];
+                }
+                if (before.contains("targets")) primitive["targets"] = before["targets"];
+                if (before.contains("mode")) primitive["mode"] = before["mode"];
+            }
         }
         if (original.contains("weights")) mesh["weights"].erase(mesh["weights"].begin() + std::ptrdiff_t(original["weights"].size()), mesh["weights"].end());
         return mesh;
@@ -246,6 +259,7 @@ struct AssetCase {
     double fps = 24;
     std::string lightingAnimation;  // the name of the animation driving the lighting ("" also: none, a still)
     int colourSet = -1;
+    bool refined = false;  // --subdivide: the asset's meshes are the refined ones
 };
 
 void expectAssetIsTheInputWithTheBake(const AssetCase& c, const fs::path& out) {
@@ -261,9 +275,12 @@ void expectAssetIsTheInputWithTheBake(const AssetCase& c, const fs::path& out) {
     for (const std::string& code : after) EXPECT_TRUE(before.count(code)) << "new validator error " << code << ": " << asset["validator"].dump(1).substr(0, 3000);
 
     const json in = documentJson(c.scene), baked = documentJson(out / "asset.glb");
-    EXPECT_EQ(withoutTheBake(baked, in, c.colourSet), in);
+    EXPECT_EQ(withoutTheBake(baked, in, c.colourSet, c.refined), in);
 
-    EXPECT_GT(expectFramesReadBack(c.scene, out, c.firstFrame, c.lastFrame, c.fps, c.lightingAnimation, c.colourSet), 0u);
+    // Where the PLY's vertices are in the asset: as the input placed them, or as the asset itself
+    // (the refined meshes) does.
+    EXPECT_GT(expectFramesReadBack(c.refined ? out / "asset.glb" : c.scene, out, c.firstFrame, c.lastFrame, c.fps,
+                                   c.lightingAnimation, c.colourSet), 0u);
 }
 
 }  // namespace
@@ -285,6 +302,35 @@ TEST(GltfOut, TheWalkersAssetIsItsGltfWithEveryFrameBakedIntoItsAnimation) {
                                       (out / "b").string());
     ASSERT_EQ(one.exitCode, 0) << one.output;
     EXPECT_EQ(readFileBytes(out / "a" / "asset.glb"), readFileBytes(out / "b" / "asset.glb"));
+}
+
+// --subdivide: the asset holds the refined meshes the PLYs hold — every attribute refined alike
+// (the walker's skin included), the file's own vertices first and unchanged — and qsgi reading the
+// asset back finds the refined scene.
+TEST(GltfOut, WithSubdivideTheAssetHoldsTheRefinedMeshes) {
+    const fs::path out = testScratchDir("gltf-out-subdivide");
+    AssetCase c;
+    c.scene = sourceDir() / "data/walker/walker.gltf";
+    c.options = "--animation gltf --frames 0:1 --photons 20000 --subdivide 0.25" + std::string(kCheapSecondPass);
+    c.lastFrame = 1;
+    c.lightingAnimation = "Walk";
+    c.refined = true;
+    expectAssetIsTheInputWithTheBake(c, out);
+
+    Warnings w;
+    const Scene input = loadGltfScene(c.scene.string(), w);
+    const Scene asset = loadGltfScene((out / "asset.glb").string(), w);
+    const VertexRadiosityPly ply = readVertexRadiosityPly((out / "frame_0000.ply").string());
+    EXPECT_EQ(asset.vertexCount(), ply.positions.size());
+    EXPECT_EQ(asset.triangleCount(), ply.triangles.size());
+    EXPECT_GT(asset.vertexCount(), input.vertexCount());
+    ASSERT_EQ(asset.instances.size(), input.instances.size());
+    for (size_t i = 0; i < input.instances.size(); ++i) {
+        const MeshInstance &a = asset.instances[i], &b = input.instances[i];
+        ASSERT_GE(a.vertexCount, b.vertexCount);
+        for (uint32_t v = 0; v < b.vertexCount; ++v) EXPECT_EQ(a.objectPositions[v], b.objectPositions[v]) << "instance " << i << ", vertex " << v;
+        EXPECT_EQ(a.skin, b.skin);
+    }
 }
 
 // data/cornell moved by a transform file: the motion is written as the asset's node animation

@@ -1,5 +1,7 @@
 #include "output/baked_asset.h"
 
+#include "scene/gltf_accessor.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -14,7 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kFloat = 5126, kUnsignedInt = 5125, kArrayBuffer = 34962;
+constexpr int kFloat = 5126, kUnsignedInt = 5125, kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 // A GLB's length is a uint32 (glTF 2.0 §4.4.3.1).
 constexpr uint64_t kMaxGlbBytes = 0xFFFFFFFFull;
 const char* const kOption = "gltf_out (--gltf-out)";
@@ -390,6 +392,89 @@ void addLightingAnimation(json& doc, BinaryBuilder& bin, const Scene& scene, con
     if (animations.empty()) doc.erase("animations");
 }
 
+// glTF's element type names as tinygltf numbers them.
+int elementType(const std::string& type) {
+    return type == "SCALAR" ? TINYGLTF_TYPE_SCALAR : type == "VEC2" ? TINYGLTF_TYPE_VEC2 : type == "VEC3" ? TINYGLTF_TYPE_VEC3
+         : type == "VEC4" ? TINYGLTF_TYPE_VEC4 : -1;
+}
+
+// A primitive as --subdivide refined it (MeshInstance::refinedFrom): every attribute and morph
+// target the file gives, its own vertices as they are and each new vertex the mean of its edge's
+// two (normals renormalised, a tangent's handedness its first corner's), written as floats; the
+// skin's joints and weights as the refinement blended them; the refined triangles as indices.
+json refinedPrimitive(json primitive, const json& doc, BinaryBuilder& bin, const AccessorReader& reader,
+                      const Scene& scene, const MeshInstance& inst, const std::string& place) {
+    const size_t own = inst.vertexCount - inst.refinedFrom.size();
+    auto refined = [&](int index, const std::string& usedBy, bool unit, bool tangent, bool bounds) {
+        const json& a = doc["accessors"][size_t(index)];
+        const std::string type = a.value("type", "");
+        const AccessorFormat format{elementType(type), {{a.value("componentType", 0), a.value("normalized", false)}}, {}};
+        const AccessorData data = reader.readUnbounded(index, usedBy, format);
+        const size_t c = size_t(data.components);
+        if (data.count != own) throw InputError(scene.sourcePath, usedBy, "has " + std::to_string(data.count) + " elements, not the primitive's " + std::to_string(own));
+        std::vector<float> out(size_t(inst.vertexCount) * c);
+        for (size_t i = 0; i < own * c; ++i) out[i] = float(data.values[i]);
+        for (size_t j = 0; j < inst.refinedFrom.size(); ++j) {
+            const size_t p = inst.refinedFrom[j].first, q = inst.refinedFrom[j].second;
+            float* o = &out[(own + j) * c];
+            for (size_t k = 0; k < c; ++k) o[k] = float(0.5 * (double(out[p * c + k]) + double(out[q * c + k])));
+            if (unit && c >= 3) {
+                const double n = std::sqrt(double(o[0]) * o[0] + double(o[1]) * o[1] + double(o[2]) * o[2]);
+                for (size_t k = 0; k < 3; ++k) o[k] = n > 0 ? float(o[k] / n) : out[p * c + k];
+            }
+            if (tangent && c == 4) o[3] = out[p * c + 3];
+        }
+        json accessor = {{"bufferView", bin.addView(out.data(), out.size() * 4, kArrayBuffer)}, {"componentType", kFloat},
+                         {"count", inst.vertexCount}, {"type", type}};
+        if (bounds) {
+            std::vector<float> lo(c, INFINITY), hi(c, -INFINITY);
+            for (size_t i = 0; i < out.size(); ++i) {
+                lo[i % c] = std::min(lo[i % c], out[i]);
+                hi[i % c] = std::max(hi[i % c], out[i]);
+            }
+            accessor["min"] = lo;
+            accessor["max"] = hi;
+        }
+        return bin.addAccessor(std::move(accessor));
+    };
+    json& attributes = primitive["attributes"];
+    for (auto& [name, index] : attributes.items()) {
+        if (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) continue;  // below
+        index = refined(index.get<int>(), place + ".attributes." + name, name == "NORMAL", name == "TANGENT", name == "POSITION");
+    }
+    // The joints and weights the refinement blended (four influences a set).
+    const size_t influences = size_t(inst.influences);
+    for (size_t set = 0; set * 4 < influences; ++set) {
+        std::vector<uint16_t> joints(size_t(inst.vertexCount) * 4);
+        std::vector<float> weights(size_t(inst.vertexCount) * 4);
+        for (size_t v = 0; v < inst.vertexCount; ++v)
+            for (size_t k = 0; k < 4; ++k) {
+                joints[v * 4 + k] = inst.skinJoints[v * influences + set * 4 + k];
+                weights[v * 4 + k] = inst.skinWeights[v * influences + set * 4 + k];
+            }
+        attributes["JOINTS_" + std::to_string(set)] = bin.addAccessor(
+            {{"bufferView", bin.addView(joints.data(), joints.size() * 2, kArrayBuffer)}, {"componentType", 5123}, {"count", inst.vertexCount}, {"type", "VEC4"}});
+        attributes["WEIGHTS_" + std::to_string(set)] = bin.addAccessor(
+            {{"bufferView", bin.addView(weights.data(), weights.size() * 4, kArrayBuffer)}, {"componentType", kFloat}, {"count", inst.vertexCount}, {"type", "VEC4"}});
+    }
+    if (primitive.contains("targets"))
+        for (size_t t = 0; t < primitive["targets"].size(); ++t)
+            for (auto& [name, index] : primitive["targets"][t].items())
+                index = refined(index.get<int>(), place + ".targets[" + std::to_string(t) + "]." + name, false, false, name == "POSITION");
+    // The refined triangles, in the file's winding (the scene turned a mirrored instance's).
+    std::vector<uint32_t> indices;
+    indices.reserve(size_t(inst.triangleCount) * 3);
+    for (uint32_t t = 0; t < inst.triangleCount; ++t) {
+        Triangle tri = scene.triangles[inst.firstTriangle + t];
+        if (inst.mirrored) std::swap(tri.v[1], tri.v[2]);
+        for (const uint32_t v : tri.v) indices.push_back(v - inst.firstVertex);
+    }
+    primitive["indices"] = bin.addAccessor({{"bufferView", bin.addView(indices.data(), indices.size() * 4, kElementArrayBuffer)},
+                                            {"componentType", kUnsignedInt}, {"count", indices.size()}, {"type", "SCALAR"}});
+    if (primitive.contains("mode")) primitive["mode"] = 4;  // strips and fans come back as triangles
+    return primitive;
+}
+
 }  // namespace
 
 void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const BakedAssetSettings& settings,
@@ -405,10 +490,8 @@ void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const
         meshes.insert(instance.mesh);
         const json& primitive = doc["meshes"][size_t(instance.mesh)]["primitives"][size_t(instance.primitive)];
         const std::string place = "meshes[" + std::to_string(instance.mesh) + "].primitives[" + std::to_string(instance.primitive) + "]";
-        if (instance.vertexCount != vertexCountOf(doc, primitive))
-            throw InputError(kOption, "",
-                             "cannot be combined with --subdivide yet: the refined meshes would need every attribute of the "
-                             "asset (texture coordinates, tangents, colours) refined with them");
+        if (instance.vertexCount - instance.refinedFrom.size() != vertexCountOf(doc, primitive))
+            throw InputError(sceneFile, place, "does not hold the vertices the scene was read with");
         const json& attributes = primitive["attributes"];
         if (settings.colourSet >= 0) {
             if (attributes.contains(colourName(settings.colourSet)))
@@ -478,7 +561,7 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                         const auto& b = instancesOf(mesh, other.nodes[0]);
                         for (size_t p = 0; p < a.size(); ++p) {
                             if (!a[p] != !b[p]) return false;
-                            if (a[p] && !sameBake(frame, *a[p], *b[p])) return false;
+                            if (a[p] && (a[p]->refinedFrom != b[p]->refinedFrom || !sameBake(frame, *a[p], *b[p]))) return false;
                         }
                         return true;
                     };
@@ -539,6 +622,7 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
     };
     std::map<std::pair<int, size_t>, std::vector<Target>> targets;  // (output mesh, primitive) → per later frame
     size_t animatedPrimitives = 0;
+    const AccessorReader reader(document, file);
     const bool anyAnimated = std::any_of(groups.begin(), groups.end(), [](const auto& entry) {
         return std::any_of(entry.second.begin(), entry.second.end(), [](const Group& g) { return g.animated; });
     });
@@ -553,6 +637,9 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                     const MeshInstance* instance = instances[p];
                     json& primitive = out["primitives"][p];
                     const size_t count = instance ? instance->vertexCount : vertexCountOf(doc, primitive);
+                    if (k == 0 && instance && !instance->refinedFrom.empty())
+                        primitive = refinedPrimitive(primitive, doc, bin, reader, scene, *instance,
+                                                     "meshes[" + std::to_string(mesh) + "].primitives[" + std::to_string(p) + "]");
                     if (k == 0) {
                         json& attributes = primitive["attributes"];
                         if (!instance) {

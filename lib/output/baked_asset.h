@@ -66,9 +66,9 @@ struct BakedAssetSummary {
 
 // Throws InputError (naming "gltf_out (--gltf-out)" or the scene file) when the asset cannot take
 // the bake: a primitive already holding _RADIANCE or _IRRADIANCE (a baked asset: bake the
-// original), COLOR_n already there or not following COLOR_(n−1), instances refined by
-// --subdivide. Called before the render, so that nothing is computed for an asset that cannot be
-// written.
+// original), COLOR_n already there or not following COLOR_(n−1), EXT_meshopt_compression (whose
+// buffers cannot be repacked). Called before the render, so that nothing is computed for an asset
+// that cannot be written.
 void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const BakedAssetSettings& settings,
                          const std::string& sceneFile);
 

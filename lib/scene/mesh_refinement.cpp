@@ -63,6 +63,7 @@ public:
         inst.skinWeights = std::move(weights_);
         inst.morphPositions = std::move(morphPositions_);
         inst.morphNormals = std::move(morphNormals_);
+        inst.refinedFrom.insert(inst.refinedFrom.end(), refinedFrom_.begin(), refinedFrom_.end());
         for (uint32_t i = 0; i < inst.vertexCount; ++i) {
             scene.positions.push_back(Vec3f(0.0f));
             scene.normals.push_back(Vec3f(0.0f));
@@ -98,6 +99,7 @@ private:
         if (found != midpoints_.end()) return found->second;
         const uint32_t m = uint32_t(positions_.size());
         midpoints_.emplace(pair, m);
+        refinedFrom_.push_back({a, b});
         auto mean = [](const Vec3f& x, const Vec3f& y) { return Vec3f((Vec3d(x) + Vec3d(y)) * 0.5); };
         positions_.push_back(mean(positions_[a], positions_[b]));
         world_.push_back((world_[a] + world_[b]) * 0.5);
@@ -146,6 +148,7 @@ private:
     std::vector<Vec3d> world_;  // the current pose's, for lengths
     std::vector<LocalTriangle> triangles_;
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints_;
+    std::vector<std::pair<uint32_t, uint32_t>> refinedFrom_;  // per new vertex, in order
 };
 
 }  // namespace

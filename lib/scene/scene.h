@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scene/camera.h"
@@ -90,6 +91,11 @@ struct MeshInstance {
     std::vector<float> skinWeights;    // the same layout; each vertex's weights sum to 1
     std::vector<std::vector<Vec3f>> morphPositions, morphNormals;  // per target, per vertex (deltas)
     std::vector<double> morphRest;     // the rest pose's target weights
+
+    // --subdivide's new vertices, after the primitive's own: vertex (vertexCount − size + j) is the
+    // midpoint of refinedFrom[j]'s two vertices (earlier ones, own or new), so that every attribute
+    // of the file can be refined alike (lib/output/baked_asset.cpp).
+    std::vector<std::pair<uint32_t, uint32_t>> refinedFrom;
 
     bool deforms() const { return skin >= 0 || !morphPositions.empty(); }
 };
