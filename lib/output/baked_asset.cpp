@@ -81,18 +81,12 @@ private:
     std::string bin_;
 };
 
-// The values a primitive shows in one frame: its block of scene vertices.
-struct PrimitiveValues {
-    const Vec3f* radiance = nullptr;
-    const Vec3f* irradiance = nullptr;
-    size_t count = 0;
-};
-
-bool sameBake(const BakedFrame& frame, const MeshInstance& a, const MeshInstance& b) {
+// Whether instance a's bake in frame x equals instance b's in frame y, bit for bit.
+bool sameBake(const BakedFrame& x, const MeshInstance& a, const BakedFrame& y, const MeshInstance& b) {
     if (a.vertexCount != b.vertexCount) return false;
     const size_t bytes = size_t(a.vertexCount) * sizeof(Vec3f);
-    return std::memcmp(&frame.radiance[a.firstVertex], &frame.radiance[b.firstVertex], bytes) == 0 &&
-           std::memcmp(&frame.irradiance[a.firstVertex], &frame.irradiance[b.firstVertex], bytes) == 0;
+    return std::memcmp(&x.radiance[a.firstVertex], &y.radiance[b.firstVertex], bytes) == 0 &&
+           std::memcmp(&x.irradiance[a.firstVertex], &y.irradiance[b.firstVertex], bytes) == 0;
 }
 
 // The rendered nodes of one glTF mesh, each with its instances by primitive (nullptr: skipped).
@@ -561,7 +555,7 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                         const auto& b = instancesOf(mesh, other.nodes[0]);
                         for (size_t p = 0; p < a.size(); ++p) {
                             if (!a[p] != !b[p]) return false;
-                            if (a[p] && (a[p]->refinedFrom != b[p]->refinedFrom || !sameBake(frame, *a[p], *b[p]))) return false;
+                            if (a[p] && (a[p]->refinedFrom != b[p]->refinedFrom || !sameBake(frame, *a[p], frame, *b[p]))) return false;
                         }
                         return true;
                     };
@@ -573,11 +567,7 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
             for (Group& g : split) {
                 if (g.animated || k == 0) continue;
                 for (const MeshInstance* instance : instancesOf(mesh, g.nodes[0]))
-                    if (instance && !(std::memcmp(&frame.radiance[instance->firstVertex], &first.radiance[instance->firstVertex],
-                                                  instance->vertexCount * sizeof(Vec3f)) == 0 &&
-                                      std::memcmp(&frame.irradiance[instance->firstVertex], &first.irradiance[instance->firstVertex],
-                                                  instance->vertexCount * sizeof(Vec3f)) == 0))
-                        g.animated = true;
+                    if (instance && !sameBake(frame, *instance, first, *instance)) g.animated = true;
             }
             list = std::move(split);
         }

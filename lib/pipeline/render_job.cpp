@@ -435,7 +435,9 @@ void RenderJob::writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const
     Warnings warnings;
     const GltfDocument& document = *assetDocument_;
     const double fps = animation_.fps();
+    std::optional<BakedFrame> firstFrame;  // read once: for the exposure here and by the encoder
     auto frameAt = [&](size_t k) {
+        if (k == 0 && firstFrame) return *firstFrame;
         const int frame = first_ + int(k);
         const std::string name = frameFileName(frame, "ply");
         const VertexRadiosityPly ply = readVertexRadiosityPly((out.path() / name).string());
@@ -456,8 +458,8 @@ void RenderJob::writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const
     asset.assetFolder = settings_.outDir;
     // COLOR_n's exposure puts the first frame's 99th percentile of B/π at 1, as the PLY previews
     // do with frame 0's.
-    const BakedFrame firstFrame = frameAt(0);
-    asset.exposure = double(PreviewTonemap::fromPercentile(firstFrame.radiance).scale);
+    firstFrame = frameAt(0);
+    asset.exposure = double(PreviewTonemap::fromPercentile(firstFrame->radiance).scale);
     // A transform file's motion becomes the asset's node animation; a glTF animation is the file's already.
     std::vector<NodeMotion> motion;
     const std::optional<int> gltfAnimation = gltfAnimationSelector(settings_.animationPath, "");
