@@ -11,8 +11,12 @@ deterministic bytes):
 - sweeping-panel/: data/cornell's box with a wall-sized panel (1.8 x 1.8 m, 2 cm thick) that sweeps
   from the back wall to the open front, 8 cm a frame: nearly every path meets it, so every frame
   should be computed from scratch (the fallback's case, issue 34).
+- dense-floor/dense-floor.gltf: a floor of 22 x 22 instanced tiles (one mesh of 32 x 32 cells,
+  2,048 triangles, 4 mm between vertices) under a point lamp, with a block standing on it: about
+  10^6 triangles and 5.3 * 10^5 vertices, the dense asset of issue 45 (instanced, as artists'
+  floors are). `--tiles N` makes an N x N crop of it.
 
-Run: python3 scripts/make_bench_scenes.py OUT_DIR
+Run: python3 scripts/make_bench_scenes.py OUT_DIR [--tiles N]
 """
 import json
 import math
@@ -102,12 +106,57 @@ def sweeping_panel(folder):
         f.write("\n")
 
 
+TILE_CELLS = 32
+TILE_SIZE = 0.128  # 4 mm cells
+
+
+def dense_floor(folder, tiles=22, stem="dense-floor"):
+    g = GltfBuilder()
+    g.doc["asset"]["generator"] = "qsgi scripts/make_bench_scenes.py"
+    g.doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    white = g.material("White", [0.7, 0.7, 0.7])
+    grey = g.material("Grey", [0.5, 0.5, 0.5])
+    positions, normals, indices = grid([0, 0, TILE_SIZE], [TILE_SIZE, 0, 0], [0, 0, -TILE_SIZE], TILE_CELLS)
+    tile = g.mesh("Tile", positions, normals, indices, white)
+    half = tiles * TILE_SIZE / 2
+    for j in range(tiles):
+        for i in range(tiles):
+            g.node({"name": "Tile_%d_%d" % (i, j), "mesh": tile,
+                    "translation": [round(-half + i * TILE_SIZE, 6), 0, round(-half + j * TILE_SIZE, 6)]})
+    # A block standing on the floor: contacts and a shadow, as an artist's scene has.
+    side = min(0.3, half / 3)
+    p, n, i = box_faces([side, side, side], 8)
+    g.node({"name": "Block", "mesh": g.mesh("Block", p, n, i, grey), "translation": [round(-half / 4, 6), 0, 0]})
+    g.doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"name": "Lamp", "type": "point",
+                                                               "intensity": round(12.0 * half * half, 6)}]}}
+    g.node({"name": "Lamp", "translation": [round(half / 3, 6), round(1.2 * half, 6), round(half / 5, 6)],
+            "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    g.doc["cameras"].append({"name": "Above", "type": "perspective",
+                             "perspective": {"yfov": 0.9, "aspectRatio": 4 / 3, "znear": 0.05}})
+    tilt = math.radians(-45)
+    g.node({"name": "Camera", "camera": 0, "translation": [0, round(1.6 * half, 6), round(1.6 * half, 6)],
+            "rotation": [round(math.sin(tilt / 2), 9), 0, 0, round(math.cos(tilt / 2), 9)]})
+    out = os.path.join(folder, stem)
+    os.makedirs(out, exist_ok=True)
+    g.write(out, stem)
+
+
 def main():
-    folder = sys.argv[1] if len(sys.argv) > 1 else "out/bench/scenes"
+    args = sys.argv[1:]
+    tiles = None
+    if "--tiles" in args:
+        k = args.index("--tiles")
+        tiles = int(args[k + 1])
+        del args[k:k + 2]
+    folder = args[0] if args else "out/bench/scenes"
     os.makedirs(folder, exist_ok=True)
+    if tiles is not None:  # the dense floor alone, cropped
+        dense_floor(folder, tiles, "dense-floor-%d" % tiles)
+        return
     sheet(folder)
     flying_block(folder)
     sweeping_panel(folder)
+    dense_floor(folder)
 
 
 if __name__ == "__main__":

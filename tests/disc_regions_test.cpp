@@ -6,11 +6,14 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "estimate/disc_regions.h"
 #include "estimate/own_surface.h"
+#include "estimate/own_surface_tree.h"
 #include "scene/animation.h"
 #include "scene/gltf_loader.h"
+#include "scene/mesh_refinement.h"
 #include "scene/mesh_topology.h"
 #include "test_support.h"
 
@@ -84,6 +87,123 @@ TEST(OwnSurface, HeightsAreZeroOnFlatSurfacesAndTheSagittaOnCurvedOnes) {
     const OwnSurface ceiling = ownSurfaceOf(cornell, nearestVertex(cornell, Vec3f(0, 2, 0)), 0.05f);
     EXPECT_FALSE(ceiling.empty);
     EXPECT_LT(ceiling.epsAbove, 1e-4f) << "the light panel 1 mm below must not widen the ceiling's band";
+}
+
+// ε⁺ is a whole number of scene epsilons: on a tilted plane, whose corners lie a rounding error
+// above or below it, every vertex has exactly one (the walk and the tree agree), while inside a
+// sphere the sagitta is kept to half an epsilon.
+TEST(OwnSurface, RisesCountInWholeSceneEpsilons) {
+    const Transform tilt = Transform::fromTRS(Vec3d(0.3, 0.2, -0.1), {0.2, 0.3, 0.1, 0.927362}, Vec3d(1.0));
+    const Scene floor = testscenes::tiledFloor(2, 16, tilt, Vec3f(0.5f));
+    const double eps = floor.sceneEpsilon();
+    const MeshTopology topology(floor.positions, floor.triangles);
+    const std::vector<Vec3f> frontNormals = floor.frontFaceNormals();
+    const OwnSurfaceTree tree(floor, frontNormals);
+    OwnSurfaceScratch scratch;
+    size_t checked = 0, proved = 0;
+    double largestNoise = 0;
+    for (uint32_t v = 0; v < (2 * 17) * (2 * 17) / 2; ++v) {  // floor vertices (the box's come after)
+        OwnSurfaceQuery walk;
+        walk.depthBelow = false;
+        OwnSurfaceQuery quick = walk;
+        quick.tree = &tree;
+        const OwnSurface a = findOwnSurface(v, floor, topology, frontNormals, 0.03f, scratch, walk);
+        const OwnSurface b = findOwnSurface(v, floor, topology, frontNormals, 0.03f, scratch, quick);
+        const OwnSurface full = findOwnSurface(v, floor, topology, frontNormals, 0.03f, scratch);
+        if (a.empty) continue;
+        ASSERT_EQ(a.epsAbove, float(eps)) << "vertex " << v;
+        ASSERT_EQ(b.epsAbove, a.epsAbove) << "vertex " << v;
+        ASSERT_EQ(full.epsAbove, a.epsAbove) << "vertex " << v;
+        largestNoise = std::max(largestNoise, double(full.epsBelow) - eps);
+        ++checked;
+        proved += b.provedByTree;
+    }
+    EXPECT_GT(checked, 400u);
+    EXPECT_GT(proved, checked * 9 / 10);
+    // The tilt is real: depths below the plane are rounding, not zero, and far under an epsilon.
+    EXPECT_GT(largestNoise, 0.0);
+    EXPECT_LT(largestNoise, 0.25 * eps);
+
+    const Scene inside = testscenes::closedSphere(1.0f, 5, Vec3f(0.5f), true);
+    const OwnSurface cap = ownSurfaceOf(inside, 0, 0.1f);
+    const double e = inside.sceneEpsilon();
+    const double steps = (double(cap.epsAbove) - e) / e;
+    EXPECT_NEAR(steps, std::round(steps), 1e-3) << "a whole number of epsilons";
+}
+
+// The own-surface shortcut (OwnSurfaceTree) spares the walk, never changes an answer: every start
+// point, ε⁺ and disc equals the one found by walking every own surface whole — on dense meshes
+// (data/cornell refined to 2.5 cm at frame 30, its block turned; a tiled floor, flat and tilted)
+// and on curved ones (data/walker, data/tree, inside and outside a sphere); start points only
+// (the second pass under the defaults) and DETP's full regions.
+TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
+    struct Case {
+        std::string name;
+        Scene scene;
+        float radius;
+        enum { Most, Some, None } proved;  // how many vertices the tree should prove
+    };
+    std::vector<Case> cases;
+    {
+        Warnings w;
+        Scene cornell = loadGltfScene((sourceDir() / "data/cornell/cornell.gltf").string(), w);
+        const Animation animation =
+            Animation::fromTransformFile((sourceDir() / "data/cornell/animation.json").string(), cornell);
+        refineMesh(cornell, 0.025);
+        cornell.markDynamic(animation.movedNodes());
+        sweepAnimationBounds(cornell, animation);
+        cornell.applyPose(animation.localsAt(30));
+        cases.push_back({"cornell refined to 0.025, frame 30", std::move(cornell), 0.05f, Case::Most});
+    }
+    cases.push_back({"tiled floor", testscenes::tiledFloor(3, 32, Transform(), Vec3f(0.5f)), 0.03f, Case::Most});
+    cases.push_back({"tilted tiled floor",
+                     testscenes::tiledFloor(3, 32, Transform::fromTRS(Vec3d(0.0), {0.1, 0.2, 0.05, 0.972111}, Vec3d(1.0)),
+                                            Vec3f(0.5f)),
+                     0.03f, Case::Most});
+    for (const char* name : {"walker", "tree"}) {
+        Warnings w;
+        cases.push_back({name, loadGltfScene((sourceDir() / "data" / name / (std::string(name) + ".gltf")).string(), w), 0.05f,
+                         Case::Some});
+    }
+    // Inside, the surface rises all round (the walk always runs); outside, it falls away.
+    cases.push_back({"inside a sphere", testscenes::closedSphere(1.0f, 5, Vec3f(0.5f), true), 0.1f, Case::None});
+    cases.push_back({"outside a sphere", testscenes::closedSphere(1.0f, 5, Vec3f(0.5f), false), 0.1f, Case::Most});
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        EmbreeDevice device;
+        const SceneBvh bvh(device, c.scene);
+        DiscRegions quick = DiscRegions::startsOnly(c.radius), reference = DiscRegions::startsOnly(c.radius);
+        reference.useOwnSurfaceShortcut(false);
+        quick.computeAll(c.scene, bvh);
+        reference.computeAll(c.scene, bvh);
+        for (uint32_t v = 0; v < c.scene.vertexCount(); ++v) {
+            ASSERT_TRUE(quick[v] == reference[v]) << "vertex " << v << ": eps+ " << quick[v].epsAbove << " against "
+                                                  << reference[v].epsAbove << ", area " << quick[v].reachableArea << " against "
+                                                  << reference[v].reachableArea;
+            const Vec3f a = vertexRayStart(c.scene, quick[v], v), b = vertexRayStart(c.scene, reference[v], v);
+            ASSERT_EQ(std::memcmp(&a, &b, sizeof(Vec3f)), 0) << "vertex " << v;
+        }
+        EXPECT_EQ(reference.lastWork().ownSurfacesProved, 0u);
+        const uint64_t proved = quick.lastWork().ownSurfacesProved;
+        std::printf("%s: %zu vertices, %llu own surfaces proved by the tree\n", c.name.c_str(), c.scene.vertexCount(),
+                    static_cast<unsigned long long>(proved));
+        switch (c.proved) {
+            case Case::Most: EXPECT_GT(proved, c.scene.vertexCount() * 9 / 10); break;
+            case Case::Some: EXPECT_GT(proved, c.scene.vertexCount() / 2); break;
+            case Case::None: EXPECT_EQ(proved, 0u); break;
+        }
+    }
+    // DETP's regions (no coverage) read ε⁺ through the same search.
+    Warnings w;
+    const Scene cornell = loadGltfScene((sourceDir() / "data/cornell/cornell.gltf").string(), w);
+    EmbreeDevice device;
+    const SceneBvh bvh(device, cornell);
+    DiscRegions quick(0.05f, false), reference(0.05f, false);
+    reference.useOwnSurfaceShortcut(false);
+    quick.computeAll(cornell, bvh);
+    reference.computeAll(cornell, bvh);
+    for (size_t v = 0; v < cornell.vertexCount(); ++v) ASSERT_TRUE(quick[v] == reference[v]) << "DETP, vertex " << v;
+    EXPECT_GT(quick.lastWork().ownSurfacesProved, cornell.vertexCount() / 2);
 }
 
 // Same bytes for one thread and for two: each vertex's regions depend on the geometry alone.

@@ -200,6 +200,25 @@ Scene plane(float halfSize, int cells, Vec3f albedo) {
     return s;
 }
 
+Scene tiledFloor(int tiles, int cells, const Transform& placement, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    const int floor = s.addNode("Floor", placement);
+    const float tile = 0.004f * float(cells), half = 0.5f * tile * float(tiles);
+    for (int j = 0; j < tiles; ++j)
+        for (int i = 0; i < tiles; ++i) {
+            const int node = s.addNode("Tile" + std::to_string(i) + "_" + std::to_string(j),
+                                       Transform::fromTRS(Vec3d(-half + tile * float(i), 0, -half + tile * float(j)), {0, 0, 0, 1},
+                                                          Vec3d(1.0)),
+                                       floor);
+            addGrid(s, node, {0, 0, tile}, {tile, 0, 0}, {0, 0, -tile}, cells, m);
+        }
+    addBoxOnFloor(s, s.addNode("Box", Transform::fromTRS(Vec3d(0.3 * half, 0, 0.2 * half), {0, 0, 0, 1}, Vec3d(1.0)), floor),
+                  0.05f, 0.1f, 8, m);
+    s.finalize();
+    return s;
+}
+
 Scene plateAndSliver(float half, int cells, float width, float offset, Vec3f albedo) {
     Scene s;
     const uint32_t m = addMaterial(s, albedo);

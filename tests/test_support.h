@@ -105,6 +105,11 @@ qsgi::Scene creasedSheet(int cells, bool welded, qsgi::Vec3f albedo);
 // A square plate y = 0 (half size `half`, `cells` per side, facing up) and, `offset` along x
 // from its centre, a sliver y = 0 (`width` along x, 1 along z, 10 cells, facing up).
 qsgi::Scene plateAndSliver(float half, int cells, float width, float offset, qsgi::Vec3f albedo);
+// A floor of tiles x tiles square tiles (each its own instance of `cells` x `cells` cells, 4 mm
+// apart, welded to its neighbours by position only), as scripts/make_bench_scenes.py's dense
+// floor, placed by `placement` (a tilt makes every height rounding noise), with a 0.1 m box of
+// 8 cells a face standing on it off-centre.
+qsgi::Scene tiledFloor(int tiles, int cells, const qsgi::Transform& placement, qsgi::Vec3f albedo);
 void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
 // Writes a small glTF (a quad; emissive if lit) with an embedded buffer.
 void writeQuadGltf(const std::string& path, bool lit);

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "estimate/own_surface.h"
+#include "estimate/own_surface_tree.h"
 #include "scene/mesh_topology.h"
 
 namespace qsgi {
@@ -198,12 +199,17 @@ bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v,
 
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
-                             OwnSurfaceScratch& scratch, DiscRegions::Work& tally, DiscRegions::StaticAnswers* answers,
-                             bool staticShortcut, bool startOnly = false) {
+                             OwnSurfaceScratch& scratch, const OwnSurfaceTree* tree, DiscRegions::Work& tally,
+                             DiscRegions::StaticAnswers* answers, bool staticShortcut, bool startOnly = false) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
     discFrame(normal, disc.tangent, disc.bitangent);
-    const OwnSurface own = findOwnSurface(v, scene, topology, frontNormals, radius, scratch);
+    // Only the photon map's coverage reads ε_v⁻; without it the search may stop early.
+    OwnSurfaceQuery query;
+    query.depthBelow = withCoverage;
+    query.tree = tree;
+    const OwnSurface own = findOwnSurface(v, scene, topology, frontNormals, radius, scratch, query);
+    tally.ownSurfacesProved += own.provedByTree;
     if (own.empty) {
         disc.fallback = true;
         return disc;
@@ -221,8 +227,8 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
             return disc;
         }
         // Nothing reachable from any centre: decide exactly as the full regions do, keep the start.
-        VertexDisc full =
-            computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tally, nullptr, staticShortcut);
+        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tree, tally,
+                                            nullptr, staticShortcut);
         disc.start = full.start;
         disc.reachableArea = full.reachableArea;
         return disc;
@@ -313,6 +319,11 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
     std::vector<uint8_t> changed(vertices.size(), 0);
     const MeshTopology topology(scene.positions, scene.triangles);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    // The own-surface shortcut's tree costs about what walking the own surfaces of a few
+    // vertices in a hundred costs: worth building for a frame's worth of vertices, not for a
+    // handful (the answers are the same either way).
+    std::optional<OwnSurfaceTree> tree;
+    if (ownSurfaceShortcut_ && !withCoverage_ && vertices.size() * 16 >= scene.triangleCount()) tree.emplace(scene, frontNormals);
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;
     tbb::enumerable_thread_specific<Work> tallies;
@@ -323,7 +334,8 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
             StaticAnswers* answers = keepAnswers ? &answers_[size_t(answerSlot_[vertices[i]])] : nullptr;
             if (answers && scene.vertexDynamic[vertices[i]]) answers = nullptr;
             VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local,
-                                                tally, startsOnly_ ? nullptr : answers, staticShortcut_, startsOnly_);
+                                                tree ? &*tree : nullptr, tally, startsOnly_ ? nullptr : answers, staticShortcut_,
+                                                startsOnly_);
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);
         }

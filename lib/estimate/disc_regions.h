@@ -30,7 +30,7 @@ namespace qsgi {
 struct VertexDisc {
     Vec3f tangent{0.0f}, bitangent{0.0f};  // discFrame(n_v)
     Vec3f start{0.0f};                       // s_v
-    float epsAbove = 0, epsBelow = 0;        // ε_v⁺, ε_v⁻ (own surface)
+    float epsAbove = 0, epsBelow = 0;        // ε_v⁺, ε_v⁻ (own surface; ε_v⁻ only with coverage, else 0)
     CellMask reachable;                      // DETP `clip` / `linear`: reachable, centre and corners
     CellMask mixed;                          // corners disagree: decide per point
     CellMask covered;                        // photon map (only with coverage): reachable or mixed,
@@ -112,18 +112,23 @@ public:
     // or the whole scene (corners, centres, sub-points, coverage probes, start searches; not the
     // dynamic halves, which the movers' bounds clip away first almost always), and the vertices
     // whose static rays were skipped (no static triangle near rises to their height, design.md §5).
+    // And the vertices whose ε_v⁺ OwnSurfaceTree proved without walking their own surface.
     struct Work {
         uint64_t rays = 0;
         uint64_t staticRaysSkipped = 0;
+        uint64_t ownSurfacesProved = 0;
         Work& operator+=(const Work& o) {
             rays += o.rays;
             staticRaysSkipped += o.staticRaysSkipped;
+            ownSurfacesProved += o.ownSurfacesProved;
             return *this;
         }
     };
     const Work& lastWork() const { return lastWork_; }
     // Off: every static ray is traced, the shortcut never taken (the reference its tests compare with).
     void useStaticShortcut(bool on) { staticShortcut_ = on; }
+    // Off: every own surface is walked whole, OwnSurfaceTree never asked (the same reference).
+    void useOwnSurfaceShortcut(bool on) { ownSurfaceShortcut_ = on; }
     // Bytes of the static answers kept for recomputed vertices.
     size_t keptAnswerBytes() const { return answers_.capacity() * sizeof(StaticAnswers) + answerSlot_.capacity() * sizeof(int32_t); }
 
@@ -151,6 +156,7 @@ private:
     std::vector<StaticAnswers> answers_;
     Work lastWork_;
     bool staticShortcut_ = true;
+    bool ownSurfaceShortcut_ = true;
 };
 
 }  // namespace qsgi

@@ -1,5 +1,7 @@
 #include "estimate/own_surface.h"
 
+#include "estimate/own_surface_tree.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -55,6 +57,7 @@ bool insideConvex(const Polygon& poly, double x, double y) {
 // convex region lie at polygon corners inside the disc, where edges cross the circle, or where
 // the circle touches the height's gradient direction.
 bool clippedHeightRange(const Local tri[3], double r, double& lo, double& hi) {
+    const double cornerLo = std::min({tri[0].h, tri[1].h, tri[2].h}), cornerHi = std::max({tri[0].h, tri[1].h, tri[2].h});
     // Cheap rejection first: all corners on one side of the cylinder's bounding box.
     for (int axis = 0; axis < 3; ++axis) {
         auto coord = [&](const Local& l) { return axis == 0 ? l.x : axis == 1 ? l.y : l.h; };
@@ -69,8 +72,8 @@ bool clippedHeightRange(const Local tri[3], double r, double& lo, double& hi) {
     for (int i = 0; i < 3; ++i)
         inside = inside && tri[i].x * tri[i].x + tri[i].y * tri[i].y <= inner2 && std::fabs(tri[i].h) < r;
     if (inside) {
-        lo = std::min({tri[0].h, tri[1].h, tri[2].h});
-        hi = std::max({tri[0].h, tri[1].h, tri[2].h});
+        lo = cornerLo;
+        hi = cornerHi;
         return true;
     }
     Polygon poly;
@@ -113,13 +116,18 @@ bool clippedHeightRange(const Local tri[3], double r, double& lo, double& hi) {
                 if (std::fabs(h) <= r && insideConvex(poly, x, y)) consider(h);
             }
     }
+    // The height is affine over the triangle, so the clipped part's lies within the corners';
+    // rounding (a sliver's gradient) may not take it out: OwnSurfaceTree bounds corners only.
+    lo = std::max(lo, cornerLo);
+    hi = std::min(hi, cornerHi);
     return lo <= hi;
 }
 
 }  // namespace
 
 OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& topology,
-                          const std::vector<Vec3f>& frontNormals, float radius, OwnSurfaceScratch& scratch) {
+                          const std::vector<Vec3f>& frontNormals, float radius, OwnSurfaceScratch& scratch,
+                          const OwnSurfaceQuery& query) {
     OwnSurface own;
     const Vec3d origin(scene.positions[v]), n(scene.normals[v]);
     Vec3d t, b;
@@ -179,6 +187,34 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
     own.empty = frontier.empty();
     const double eps = scene.sceneEpsilon();
     if (own.empty) return own;
+    // ε⁺ counts whole scene epsilons: a height below half of one is 0 (see OwnSurface).
+    auto level = [&](double height) { return std::floor(height / eps + 0.5); };
+    auto finish = [&] {
+        own.epsAbove = float(std::min(level(highest) * eps, r) + eps);
+        own.epsBelow = query.depthBelow ? float(std::min(-lowest, r) + eps) : 0.0f;
+        if (areaSum > 0) {
+            const Vec3d toCentroid = centroidSum / areaSum - origin;
+            const Vec3d tangential = toCentroid - n * dot(toCentroid, n);
+            // Below ~1e-9 of the radius the direction is rounding noise: no preferred side.
+            if (length(tangential) > 1e-9 * r) own.towardSurface = Vec3f(normalize(tangential));
+        }
+        return own;
+    };
+    // The shortcut: if no triangle near v that could belong to its own surface (facing within
+    // 45°, within the cylinder's ball of radius r√2) rises to the next level, the walk below
+    // could only find what the incident triangles gave. The tree bounds corners; a triangle it
+    // cannot rule out is judged exactly as the walk judges it.
+    if (query.tree && !query.depthBelow) {
+        const double current = level(highest);
+        const bool rises = query.tree->anyRising(origin, n, double(kOwnSurfaceCos), r * std::sqrt(2.0), (current + 0.5) * eps,
+                                                 [&](uint32_t tri) {
+                                                     if (scratch.visitedStamp[tri] == stamp) return false;
+                                                     double lo, hi;
+                                                     return qualifies(tri, lo, hi) && level(hi) > current;
+                                                 });
+        own.provedByTree = !rises;
+        if (!rises) return finish();
+    }
     // A corner's triangles are looked at once, whichever reached triangle shares it.
     for (size_t i = 0; i < frontier.size(); ++i) {
         const Triangle& T = scene.triangles[frontier[i]];
@@ -196,15 +232,7 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
             }
         }
     }
-    own.epsAbove = float(std::min(highest, r) + eps);
-    own.epsBelow = float(std::min(-lowest, r) + eps);
-    if (areaSum > 0) {
-        const Vec3d toCentroid = centroidSum / areaSum - origin;
-        const Vec3d tangential = toCentroid - n * dot(toCentroid, n);
-        // Below ~1e-9 of the radius the direction is rounding noise: no preferred side.
-        if (length(tangential) > 1e-9 * r) own.towardSurface = Vec3f(normalize(tangential));
-    }
-    return own;
+    return finish();
 }
 
 }  // namespace qsgi
