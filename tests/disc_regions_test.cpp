@@ -98,7 +98,7 @@ TEST(OwnSurface, RisesCountInWholeSceneEpsilons) {
     const double eps = floor.sceneEpsilon();
     const MeshTopology topology(floor.positions, floor.triangles);
     const std::vector<Vec3f> frontNormals = floor.frontFaceNormals();
-    const OwnSurfaceTree tree(floor, frontNormals);
+    const OwnSurfaceTree tree(floor, frontNormals, topology);
     OwnSurfaceScratch scratch;
     size_t checked = 0, proved = 0;
     double largestNoise = 0;

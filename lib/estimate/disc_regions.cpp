@@ -227,8 +227,10 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
             return disc;
         }
         // Nothing reachable from any centre: decide exactly as the full regions do, keep the start.
+        const uint64_t proved = tally.ownSurfacesProved;
         VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tree, tally,
                                             nullptr, staticShortcut);
+        tally.ownSurfacesProved = proved;  // the same own surface again: counted once
         disc.start = full.start;
         disc.reachableArea = full.reachableArea;
         return disc;
@@ -323,7 +325,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
     // vertices in a hundred costs: worth building for a frame's worth of vertices, not for a
     // handful (the answers are the same either way).
     std::optional<OwnSurfaceTree> tree;
-    if (ownSurfaceShortcut_ && !withCoverage_ && vertices.size() * 16 >= scene.triangleCount()) tree.emplace(scene, frontNormals);
+    if (ownSurfaceShortcut_ && !withCoverage_ && vertices.size() * 16 >= scene.triangleCount()) tree.emplace(scene, frontNormals, topology);
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;
     tbb::enumerable_thread_specific<Work> tallies;

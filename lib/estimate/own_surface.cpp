@@ -200,13 +200,13 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
         }
         return own;
     };
-    // The shortcut: if no triangle near v that could belong to its own surface (facing within
-    // 45°, within the cylinder's ball of radius r√2) rises to the next level, the walk below
+    // The shortcut: if no triangle near v that could belong to its own surface (of v's piece,
+    // facing within 45°, within the cylinder's ball of radius r√2) rises to the next level, the walk below
     // could only find what the incident triangles gave. The tree bounds corners; a triangle it
     // cannot rule out is judged exactly as the walk judges it.
     if (query.tree && !query.depthBelow) {
         const double current = level(highest);
-        const bool rises = query.tree->anyRising(origin, n, double(kOwnSurfaceCos), r * std::sqrt(2.0), (current + 0.5) * eps,
+        const bool rises = query.tree->anyRising(query.tree->pieceOfVertex(v), origin, n, double(kOwnSurfaceCos), r * std::sqrt(2.0), (current + 0.5) * eps,
                                                  [&](uint32_t tri) {
                                                      if (scratch.visitedStamp[tri] == stamp) return false;
                                                      double lo, hi;

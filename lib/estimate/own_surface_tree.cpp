@@ -20,7 +20,24 @@ double boxMaxDot(const Bounds3f& box, const Vec3d& d) {
 }
 }  // namespace
 
-OwnSurfaceTree::OwnSurfaceTree(const Scene& scene, const std::vector<Vec3f>& frontNormals) {
+OwnSurfaceTree::OwnSurfaceTree(const Scene& scene, const std::vector<Vec3f>& frontNormals, const MeshTopology& topology) {
+    // Pieces: union–find over welded vertices, each triangle joining its three corners; a piece
+    // is named by its smallest welded vertex id, so the numbering depends on the geometry alone.
+    std::vector<uint32_t> parent(scene.vertexCount());
+    for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = topology.weldedId(v);
+    auto root = [&](uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (const Triangle& T : scene.triangles)
+        for (int k = 1; k < 3; ++k) {
+            const uint32_t a = root(T.v[0]), b = root(T.v[k]);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+    vertexPiece_.resize(scene.vertexCount());
+    for (uint32_t v = 0; v < vertexPiece_.size(); ++v) vertexPiece_[v] = root(v);
+    trianglePiece_.resize(scene.triangleCount());
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t) trianglePiece_[t] = vertexPiece_[scene.triangles[t].v[0]];
     if (scene.triangleCount() == 0) return;
     std::vector<Vec3f> centroids(scene.triangleCount());
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
@@ -48,6 +65,9 @@ uint32_t OwnSurfaceTree::build(uint32_t begin, uint32_t end, const Scene& scene,
         }
         node.axis = length(normalSum) > 0 ? normalize(normalSum) : Vec3d(0, 0, 1);
         node.centre = (Vec3d(node.box.lower) + Vec3d(node.box.upper)) * 0.5;
+        node.piece = trianglePiece_[order_[begin]];
+        for (uint32_t i = begin; i < end; ++i)
+            if (trianglePiece_[order_[i]] != node.piece) node.piece = kMixed;
         node.slabLo = std::numeric_limits<double>::max();
         node.slabHi = -std::numeric_limits<double>::max();
         for (uint32_t i = begin; i < end; ++i)
@@ -63,6 +83,7 @@ uint32_t OwnSurfaceTree::build(uint32_t begin, uint32_t end, const Scene& scene,
         node.right = build(middle, end, scene, frontNormals);
         const Node& a = nodes_[node.left];
         const Node& b = nodes_[node.right];
+        node.piece = a.piece == b.piece ? a.piece : kMixed;
         node.box = a.box;
         node.box.extend(b.box);
         node.normals = a.normals;
@@ -79,27 +100,31 @@ uint32_t OwnSurfaceTree::build(uint32_t begin, uint32_t end, const Scene& scene,
     return index;
 }
 
-double OwnSurfaceTree::maxDot(const Node& node, const Vec3d& d) {
+double OwnSurfaceTree::slabMaxDot(const Node& node, const Vec3d& d) {
     const double along = dot(d, node.axis);
     const Vec3d across = d - node.axis * along;
-    const double slab = std::max(along * node.slabLo, along * node.slabHi) + dot(across, node.centre) + length(across) * node.radius;
-    return std::min(boxMaxDot(node.box, d), slab);
+    return std::max(along * node.slabLo, along * node.slabHi) + dot(across, node.centre) + length(across) * node.radius;
 }
+
+double OwnSurfaceTree::maxDot(const Node& node, const Vec3d& d) { return std::min(boxMaxDot(node.box, d), slabMaxDot(node, d)); }
 
 bool OwnSurfaceTree::mayRise(const Node& node, const Vec3d& centre, const Vec3d& normal, double minNormalDot, double reach,
                              double height) const {
     // Rounding: the bounds are sums of a few products of coordinates; 2^-40 of their size is far
     // more than double precision loses, and far less than any height the callers compare.
-    const double margin = std::ldexp(maxAbs(centre) + maxAbs(node.centre) + node.radius + reach, -40);
+    const double margin = 0x1p-40 * (maxAbs(centre) + maxAbs(node.centre) + node.radius + reach);
     double gap2 = 0;
     for (int a = 0; a < 3; ++a) {
         const double gap = std::max({double(node.box.lower[a]) - centre[a], centre[a] - double(node.box.upper[a]), 0.0});
         gap2 += gap * gap;
     }
-    if (std::sqrt(gap2) > reach + margin) return false;
+    if (gap2 > (reach + margin) * (reach + margin)) return false;
     // Front normals are floats, their dot with n_v is taken in float: a margin of 1e-6.
     if (boxMaxDot(node.normals, normal) + 1e-6 <= minNormalDot) return false;
-    return maxDot(node, normal) - dot(normal, centre) + margin >= height;
+    // The box first: exact on axis-aligned geometry, and cheaper than the slab.
+    const double base = dot(normal, centre) - margin;
+    if (boxMaxDot(node.box, normal) - base < height) return false;
+    return slabMaxDot(node, normal) - base >= height;
 }
 
 }  // namespace qsgi

@@ -7,6 +7,10 @@
 // rises no higher proves it; this tree answers that question by descending only where a node's
 // bounds say a triangle might rise, so its cost follows what is near v, not the mesh density.
 //
+// Only v's own piece of surface can hold its own surface: the triangles joined to v through
+// shared (welded) vertices. Each triangle's piece is numbered, so a light panel hung under a
+// ceiling or a block standing on a floor — other pieces — never makes the walk run.
+//
 // A binary tree over the triangles in Morton order of their centroids, eight to a leaf. Each
 // node bounds its triangles' corners twice — an axis-aligned box, and a slab along the node's
 // mean front normal inside a ball, which stays tight on tilted planes where the box does not —
@@ -17,22 +21,26 @@
 #include <cstdint>
 #include <vector>
 
+#include "scene/mesh_topology.h"
 #include "scene/scene.h"
 
 namespace qsgi {
 
 class OwnSurfaceTree {
 public:
-    // frontNormals: Scene::frontFaceNormals(), for the scene's current pose.
-    OwnSurfaceTree(const Scene& scene, const std::vector<Vec3f>& frontNormals);
+    // frontNormals: Scene::frontFaceNormals(), for the scene's current pose; topology: its welding.
+    OwnSurfaceTree(const Scene& scene, const std::vector<Vec3f>& frontNormals, const MeshTopology& topology);
 
-    // Calls visit(triangle) for every triangle that may (a) have a front normal whose dot with
-    // `normal` exceeds `minNormalDot`, (b) come within `reach` of `centre`, and (c) have a corner
-    // at `height` or more above `centre` along `normal` — and for some others besides (the bounds
-    // are conservative). Stops, returning true, as soon as visit returns true.
+    // The piece of surface vertex v belongs to (triangles joined through welded vertices).
+    uint32_t pieceOfVertex(uint32_t v) const { return vertexPiece_[v]; }
+
+    // Calls visit(triangle) for every triangle of `piece` that may (a) have a front normal whose
+    // dot with `normal` exceeds `minNormalDot`, (b) come within `reach` of `centre`, and (c) have
+    // a corner at `height` or more above `centre` along `normal` — and for some others besides
+    // (the bounds are conservative). Stops, returning true, as soon as visit returns true.
     template <typename Visit>
-    bool anyRising(const Vec3d& centre, const Vec3d& normal, double minNormalDot, double reach, double height,
-                   Visit&& visit) const;
+    bool anyRising(uint32_t piece, const Vec3d& centre, const Vec3d& normal, double minNormalDot, double reach,
+                   double height, Visit&& visit) const;
 
     size_t nodeCount() const { return nodes_.size(); }
 
@@ -46,30 +54,35 @@ private:
         double radius = 0;   // no corner farther from `centre`
         uint32_t begin = 0, end = 0;    // triangles order_[begin, end)
         uint32_t left = 0, right = 0;  // children; 0: a leaf
+        uint32_t piece = kMixed;       // the piece all its triangles belong to, or kMixed
     };
+    static constexpr uint32_t kMixed = UINT32_MAX;
     uint32_t build(uint32_t begin, uint32_t end, const Scene& scene, const std::vector<Vec3f>& frontNormals);
-    // Largest direction · p over the node's corners p, or more.
+    // Largest direction · p over the node's corners p, or more: by the slab and ball, and by both.
+    static double slabMaxDot(const Node& node, const Vec3d& direction);
     static double maxDot(const Node& node, const Vec3d& direction);
     bool mayRise(const Node& node, const Vec3d& centre, const Vec3d& normal, double minNormalDot, double reach,
                  double height) const;
 
     std::vector<uint32_t> order_;  // triangles in Morton order
     std::vector<Node> nodes_;      // nodes_[0]: the root
+    std::vector<uint32_t> trianglePiece_, vertexPiece_;
 };
 
 template <typename Visit>
-bool OwnSurfaceTree::anyRising(const Vec3d& centre, const Vec3d& normal, double minNormalDot, double reach,
-                               double height, Visit&& visit) const {
+bool OwnSurfaceTree::anyRising(uint32_t piece, const Vec3d& centre, const Vec3d& normal, double minNormalDot,
+                               double reach, double height, Visit&& visit) const {
     if (nodes_.empty()) return false;
     uint32_t stack[64];
     int depth = 0;
     stack[depth++] = 0;
     while (depth > 0) {
         const Node& node = nodes_[stack[--depth]];
+        if (node.piece != kMixed && node.piece != piece) continue;
         if (!mayRise(node, centre, normal, minNormalDot, reach, height)) continue;
         if (node.left == 0) {
             for (uint32_t i = node.begin; i < node.end; ++i)
-                if (visit(order_[i])) return true;
+                if (trianglePiece_[order_[i]] == piece && visit(order_[i])) return true;
         } else {
             stack[depth++] = node.right;
             stack[depth++] = node.left;

@@ -45,6 +45,7 @@ void VertexGeometry::recordWork(uint64_t vertices, double seconds, FrameTiming& 
     stats.discRegionsSeconds = seconds;
     stats.discRegionsRays = regions_->lastWork().rays;
     stats.discRegionsStaticSkipped = regions_->lastWork().staticRaysSkipped;
+    stats.ownSurfacesProved = regions_->lastWork().ownSurfacesProved;
 }
 
 void VertexGeometry::report(FrameTiming& stats) const {

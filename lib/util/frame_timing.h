@@ -51,6 +51,7 @@ struct FrameTiming {
     uint64_t discRegionsUpdated = 0;
     uint64_t discRegionsRays = 0;           // rays they traced (DiscRegions::Work)
     uint64_t discRegionsStaticSkipped = 0;  // vertices whose static rays needed no asking
+    uint64_t ownSurfacesProved = 0;         // vertices whose ε⁺ OwnSurfaceTree proved without the walk
     uint64_t ownSurfaceFallbacks = 0, buriedVertices = 0;
     // The second pass (--direct exact, --gather M; docs/design.md §5.1): time and rays cast this
     // frame for exact direct light and for the final gather (which includes combining the passes).
@@ -97,6 +98,7 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("disc_regions_updated", f.discRegionsUpdated);
     visit("disc_regions_rays", f.discRegionsRays);
     visit("disc_regions_static_skipped", f.discRegionsStaticSkipped);
+    visit("own_surfaces_proved", f.ownSurfacesProved);
     visit("own_surface_fallbacks", f.ownSurfaceFallbacks);
     visit("buried_vertices", f.buriedVertices);
     visit("direct_s", f.directSeconds);
