@@ -18,6 +18,7 @@
 #include <map>
 #include <memory>
 
+#include "embree_scenes.h"
 #include "estimate/accuracy.h"
 #include "estimate/detp.h"
 #include "estimate/estimator.h"
@@ -172,24 +173,7 @@ void BM_DecodeRayCache(benchmark::State& state) {
 void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
     CornellFixture& f = fixture();
     const std::vector<Segment>& segments = f.decoded(uint64_t(state.range(0)));
-    RTCScene scene = rtcNewScene(f.device.get());
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry geometry = rtcNewGeometry(f.device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_HIGH);
-    rtcSetGeometryIntersectFilterFunction(geometry, lowestPrimitiveOnTies);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                 3 * sizeof(float), f.scene.positions.size()));
-    for (size_t v = 0; v < f.scene.positions.size(); ++v)
-        for (int c = 0; c < 3; ++c) vertices[3 * v + c] = f.scene.positions[v][c];
-    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                   3 * sizeof(uint32_t), f.scene.triangles.size()));
-    for (size_t t = 0; t < f.scene.triangles.size(); ++t)
-        for (int c = 0; c < 3; ++c) indices[3 * t + c] = f.scene.triangles[t].v[c];
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometry(scene, geometry);
-    rtcReleaseGeometry(geometry);
-    rtcCommitScene(scene);
+    const WholeEmbreeScene scene(f.device, f.scene, WholeEmbreeScene::Config::AsSceneBvh);
     const float epsilon = f.bvh->rayEpsilon();
     for (auto _ : state) {
         const size_t hits = tbb::parallel_reduce(
@@ -206,7 +190,7 @@ void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
                     rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
                     TieBreakContext context;
                     rtcInitIntersectContext(&context.base);
-                    rtcIntersect1(scene, &context.base, &rayHit);
+                    rtcIntersect1(scene.get(), &context.base, &rayHit);
                     count += rayHit.hit.geomID != RTC_INVALID_GEOMETRY_ID;
                 }
                 return count;
@@ -214,7 +198,6 @@ void BM_EmbreeClosestHitCeiling(benchmark::State& state) {
             std::plus<size_t>());
         benchmark::DoNotOptimize(hits);
     }
-    rtcReleaseScene(scene);
     state.counters["rays_per_s"] =
         benchmark::Counter(double(segments.size()), benchmark::Counter::kIsIterationInvariantRate);
 }

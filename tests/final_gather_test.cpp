@@ -295,3 +295,55 @@ TEST(TwoPassLighting, BitIdenticalWithOneAndTwoThreads) {
     }
     std::printf("threads: %.2f s\n", seconds(start));
 }
+
+// A solve that keeps nothing for updates (the last frame, --full-recompute) sums each ray's hit as
+// it is found instead of keeping M hits a vertex: the same bits as a solve that keeps them, for 1
+// and 2 threads, with almost none of the memory. The floor under an emitter and a point light of
+// the test above; the photons' answer a fixed function of position.
+TEST(TwoPassLighting, ASolveThatKeepsNoHitsGivesTheSameBits) {
+    Scene scene = testscenes::floorUnderEmitter(64, {0.1f, 0.5f, -0.05f}, 0.3f, 0.2f, Vec3f(4.0f, 3.0f, 2.0f), Vec3f(0.6f));
+    testscenes::addPointLight(scene, Vec3f(-0.5f, 0.8f, 0.4f), Vec3f(1.0f));
+    const Rig rig(scene);
+    VertexRadiosity photons;
+    photons.irradiance.resize(scene.vertexCount());
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
+        const Vec3f& p = scene.positions[v];
+        photons.irradiance[v] = Vec3f(0.3f + 0.1f * p.x * p.x, 0.2f + 0.05f * p.z, 0.1f);
+    }
+    LightingSettings lighting;
+    lighting.direct = DirectLighting::Exact;
+    lighting.directSamples = 16;
+    lighting.gatherRays = 64;
+    struct Run {
+        VertexRadiosity out;
+        size_t bytes;
+        uint64_t rays;
+        bool solved;
+    };
+    auto run = [&](int threads, bool keep) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        TwoPassLighting second(lighting, 9);
+        Run r;
+        FrameTiming stats;
+        second.solve(scene, rig.bvh, rig.regions, photons, r.out, stats, nullptr, keep);
+        r.bytes = second.stateBytes();
+        r.rays = stats.gatherRays;
+        r.solved = second.solved();
+        return r;
+    };
+    const Run kept = run(2, true);
+    for (int threads : {1, 2}) {
+        const Run streamed = run(threads, false);
+        EXPECT_TRUE(sameBits(kept.out.irradiance, streamed.out.irradiance)) << threads << " threads";
+        EXPECT_TRUE(sameBits(kept.out.radiosity, streamed.out.radiosity)) << threads << " threads";
+        EXPECT_EQ(streamed.rays, kept.rays);
+        EXPECT_FALSE(streamed.solved) << "nothing kept: the next frame must solve from scratch";
+        // What stays is the starts and the direct light, 36 bytes a vertex, not 16 a ray.
+        EXPECT_LE(streamed.bytes, scene.vertexCount() * 36 + 4096);
+        EXPECT_GE(kept.bytes, streamed.bytes + scene.vertexCount() * lighting.gatherRays * sizeof(GatherHit));
+    }
+    EXPECT_TRUE(kept.solved);
+    double sum = 0;
+    for (const Vec3f& e : kept.out.irradiance) sum += e.y;
+    EXPECT_GT(sum, 0.0);
+}

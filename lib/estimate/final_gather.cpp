@@ -62,6 +62,8 @@ private:
     Vec3f n_, t_, b_;
 };
 
+Vec3f FinalGather::rayDirection(const GatherHit& hit) { return decodeOctahedral(hit.octU, hit.octV); }
+
 GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                                const Vec3f& direction) const {
     GatherHit out;
@@ -87,13 +89,17 @@ void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const Vert
         return;
     }
     const Directions direction(starts, v, seed_);
-    for (uint32_t j = 0; j < rays_; ++j) {
-        uint16_t u, w;
-        encodeOctahedral(direction(j), u, w);
-        hits[j] = castRay(bvh, frontNormals, starts.point(v), decodeOctahedral(u, w));
-        hits[j].octU = u;
-        hits[j].octV = w;
-    }
+    for (uint32_t j = 0; j < rays_; ++j) hits[j] = castVertexRay(bvh, frontNormals, starts.point(v), direction(j));
+}
+
+GatherHit FinalGather::castVertexRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
+                                     const Vec3f& direction) const {
+    uint16_t u, w;
+    encodeOctahedral(direction, u, w);
+    GatherHit hit = castRay(bvh, frontNormals, origin, decodeOctahedral(u, w));
+    hit.octU = u;
+    hit.octV = w;
+    return hit;
 }
 
 void FinalGather::castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
@@ -163,6 +169,14 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
     return recast;
 }
 
+Vec3d FinalGather::firstPassAt(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit& h) {
+    if (h.triangle >= GatherHit::kBackFace) return Vec3d(0.0);
+    const Triangle& tri = scene.triangles[h.triangle];
+    const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
+    const double w0 = std::max(0.0, 1.0 - w1 - w2);
+    return Vec3d(firstPass[tri.v[0]]) * w0 + Vec3d(firstPass[tri.v[1]]) * w1 + Vec3d(firstPass[tri.v[2]]) * w2;
+}
+
 void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const {
     out.assign(scene.vertexCount(), Vec3f(0.0f));
     if (rays_ == 0) return;
@@ -171,17 +185,32 @@ void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass
             // In ray order, in one thread: the same bits for any schedule.
             Vec3d sum(0.0);
             const GatherHit* hits = &hits_[size_t(v) * rays_];
-            for (uint32_t j = 0; j < rays_; ++j) {
-                const GatherHit& h = hits[j];
-                if (h.triangle >= GatherHit::kBackFace) continue;
-                const Triangle& tri = scene.triangles[h.triangle];
-                const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
-                const double w0 = std::max(0.0, 1.0 - w1 - w2);
-                sum += Vec3d(firstPass[tri.v[0]]) * w0 + Vec3d(firstPass[tri.v[1]]) * w1 + Vec3d(firstPass[tri.v[2]]) * w2;
-            }
+            for (uint32_t j = 0; j < rays_; ++j) sum += firstPassAt(scene, firstPass, hits[j]);
             out[v] = Vec3f(sum / double(rays_));
         }
     });
+}
+
+void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                                const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out, WorkCounter* progress) {
+    hits_.clear();
+    hits_.shrink_to_fit();
+    out.assign(scene.vertexCount(), Vec3f(0.0f));
+    raysCast_ = 0;
+    if (rays_ == 0) return;
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    if (progress) progress->setTotal(scene.vertexCount());
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t v = r.begin(); v != r.end(); ++v) {
+            if (scene.vertexHidden[v]) continue;  // castVertex's hits would all be misses: 0
+            const Directions direction(starts, v, seed_);
+            Vec3d sum(0.0);
+            for (uint32_t j = 0; j < rays_; ++j) sum += firstPassAt(scene, firstPass, castVertexRay(bvh, frontNormals, starts.point(v), direction(j)));
+            out[v] = Vec3f(sum / double(rays_));
+        }
+        if (progress) progress->add(r.size());
+    });
+    raysCast_ = uint64_t(scene.vertexCount()) * rays_;
 }
 
 }  // namespace qsgi

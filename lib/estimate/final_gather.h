@@ -52,8 +52,16 @@ public:
 
     // Each vertex's gathered irradiance from the first pass F (per vertex, the current pose's).
     void gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const;
+    // castAll and gather at once, keeping no hit: each ray's hit is summed as it is found, in ray
+    // order — the same bits as castAll then gather — when no frame will update from this one (the
+    // last frame, --full-recompute), so that a frame needs no M hits a vertex of memory. Leaves
+    // nothing to update: hit() and the re-casts need a castAll first.
+    void castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                       const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out, WorkCounter* progress = nullptr);
 
     uint32_t raysPerVertex() const { return rays_; }
+    // The direction a kept hit's ray was cast along (decoded from its 16-bit octahedral form).
+    static Vec3f rayDirection(const GatherHit& hit);
     const GatherHit& hit(uint32_t v, uint32_t ray) const { return hits_[size_t(v) * rays_ + ray]; }
     // Rays cast by the last castAll(), or by cast() and recastMeeting() since the last castAll().
     uint64_t raysCast() const { return raysCast_; }
@@ -62,10 +70,16 @@ public:
 
 private:
     class Directions;
+    // F interpolated at a kept hit (0 for a miss or a back face), in double.
+    static Vec3d firstPassAt(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit& hit);
     GatherHit castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                       const Vec3f& direction) const;
     void castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                     const std::vector<Vec3f>& frontNormals, uint32_t v);
+    // One of a vertex's rays along its Sobol direction, as kept: the direction stored in 16-bit
+    // octahedral form and the ray cast along that decoded direction.
+    GatherHit castVertexRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
+                            const Vec3f& direction) const;
 
     uint32_t rays_;
     uint64_t seed_;

@@ -14,7 +14,7 @@ size_t TwoPassLighting::stateBytes() const {
 }
 
 void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const VertexRadiosity& photons,
-                            VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress) {
+                            VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress, bool keepForUpdates) {
     Stopwatch clock;
     starts_.refreshAll(scene, regions);
     if (progress) progress->start("direct", scene.vertexCount());
@@ -22,6 +22,15 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     stats.directSeconds = clock.seconds();
     stats.shadowRays = direct_.raysCast();
     clock.restart();
+    if (settings_.gathers() && !keepForUpdates) {
+        if (progress) progress->start("gathering", scene.vertexCount());
+        gather_.castAndGather(scene, bvh, starts_, firstPass(scene, photons), out.irradiance, progress);
+        stats.gatherRays = gather_.raysCast();
+        addDirect(scene, out);
+        stats.gatherSeconds = clock.seconds();
+        solved_ = false;  // nothing kept to update
+        return;
+    }
     if (settings_.gathers()) {
         if (progress) progress->start("gathering", scene.vertexCount());
         gather_.castAll(scene, bvh, starts_, progress);
@@ -64,21 +73,32 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Disc
     stats.gatherSeconds = clock.seconds();
 }
 
+std::vector<Vec3f> TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons) const {
+    const std::vector<Vec3f>& direct = direct_.irradiance();
+    std::vector<Vec3f> first(scene.vertexCount());
+    for (size_t v = 0; v < first.size(); ++v) {
+        const Material& m = scene.materials[scene.vertexMaterial[v]];
+        first[v] = scene.vertexHidden[v] ? Vec3f(0.0f) : m.albedo * (direct[v] + photons.irradiance[v]);
+    }
+    return first;
+}
+
+void TwoPassLighting::addDirect(const Scene& scene, VertexRadiosity& out) const {
+    const std::vector<Vec3f>& direct = direct_.irradiance();
+    for (size_t v = 0; v < scene.vertexCount(); ++v) out.irradiance[v] = direct[v] + out.irradiance[v];
+    computeRadiosity(scene, out);
+}
+
 void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const {
     const std::vector<Vec3f>& direct = direct_.irradiance();
     const size_t n = scene.vertexCount();
     out.irradiance.resize(n);
     if (settings_.gathers()) {
-        std::vector<Vec3f> firstPass(n);
-        for (size_t v = 0; v < n; ++v) {
-            const Material& m = scene.materials[scene.vertexMaterial[v]];
-            firstPass[v] = scene.vertexHidden[v] ? Vec3f(0.0f) : m.albedo * (direct[v] + photons.irradiance[v]);
-        }
-        gather_.gather(scene, firstPass, out.irradiance);
-        for (size_t v = 0; v < n; ++v) out.irradiance[v] = direct[v] + out.irradiance[v];
-    } else {
-        for (size_t v = 0; v < n; ++v) out.irradiance[v] = direct[v] + photons.irradiance[v];
+        gather_.gather(scene, firstPass(scene, photons), out.irradiance);
+        addDirect(scene, out);
+        return;
     }
+    for (size_t v = 0; v < n; ++v) out.irradiance[v] = direct[v] + photons.irradiance[v];
     computeRadiosity(scene, out);
 }
 

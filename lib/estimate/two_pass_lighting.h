@@ -37,9 +37,11 @@ public:
     TwoPassLighting(const LightingSettings& settings, uint64_t seed);
 
     // From scratch for the current pose (bvh and regions hold it). photons: the estimator's answer
-    // (after the first bounce).
+    // (after the first bounce). keepForUpdates false: no frame will update from this one (the
+    // last frame, --full-recompute), so the gather keeps no hits — the same bits, without M hits
+    // a vertex of memory — and the next frame solves from scratch.
     void solve(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const VertexRadiosity& photons,
-               VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress = nullptr);
+               VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress = nullptr, bool keepForUpdates = true);
     // The last solve's or update's state brought to the current pose.
     void update(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const MovedGeometry& moved,
                 const VertexRadiosity& photons, VertexRadiosity& out, FrameTiming& stats);
@@ -51,6 +53,10 @@ public:
 
 private:
     void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const;
+    // F_u = ρ_u (D_u + I_u), 0 at hidden vertices.
+    std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons) const;
+    // E = D + the gathered mean, and B.
+    void addDirect(const Scene& scene, VertexRadiosity& out) const;
 
     LightingSettings settings_;
     VertexStarts starts_;

@@ -207,7 +207,7 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
         }
     }
     stats.estimationSeconds += regionSeconds;
-    if (lighting_) secondPass(change, changed, stats);
+    if (lighting_) secondPass(change, changed, updateFollows, stats);
     if (mode_ == Mode::Tracking) {
         stats.trackedPaths = tracked_->trackedPaths();
         stats.trackedSegments = tracked_->trackedSegments();
@@ -290,9 +290,12 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
 
 namespace qsgi {
 
-void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, FrameTiming& stats) {
+void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, bool updateFollows,
+                             FrameTiming& stats) {
     if (!lighting_->solved() || settings_.update.fullRecompute) {
-        lighting_->solve(scene_, bvh_, *geometry_.regions(), photons_, result_, stats, &work_);
+        // Keep what an update reads only if one may come.
+        const bool keep = updateFollows && !settings_.update.fullRecompute;
+        lighting_->solve(scene_, bvh_, *geometry_.regions(), photons_, result_, stats, &work_, keep);
         return;
     }
     stage("gathering");

@@ -121,7 +121,7 @@ private:
     VertexRadiosity& estimate() { return lighting_ ? photons_ : result_; }
     // The second pass for this frame: from scratch the first time and under --full-recompute,
     // else brought from the last frame's. `changed`: the vertices whose rays may start elsewhere.
-    void secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, FrameTiming& stats);
+    void secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, bool updateFollows, FrameTiming& stats);
 
     Scene& scene_;
     FrameSolverSettings settings_;
