@@ -18,6 +18,7 @@
 #include "estimate/vertex_starts.h"
 #include "pipeline/frame_solver.h"
 #include "test_support.h"
+#include "util/rounding.h"
 #include "trace/scene_bvh.h"
 
 using namespace qsgi;
@@ -346,4 +347,17 @@ TEST(TwoPassLighting, ASolveThatKeepsNoHitsGivesTheSameBits) {
     double sum = 0;
     for (const Vec3f& e : kept.out.irradiance) sum += e.y;
     EXPECT_GT(sum, 0.0);
+}
+
+// The kept hits' 16-bit quantities round as std::lround did, without its call: at every
+// half-integer of [0, 65535], the floats just below and above it, and a sweep between.
+TEST(FinalGather, RoundingToSixteenBitsMatchesLround) {
+    for (int k = 0; k < 65535; ++k) {
+        const float half = float(k) + 0.5f;
+        for (float x : {half, std::nextafter(half, 0.0f), std::nextafter(half, 65536.0f), float(k), std::nextafter(float(k), 65536.0f)})
+            ASSERT_EQ(roundToUint16(x), uint16_t(std::lround(x))) << x;
+    }
+    for (float x = 0.0f; x < 4.0f; x = std::nextafter(x, 5.0f) + 1e-7f) ASSERT_EQ(roundToUint16(x), uint16_t(std::lround(x))) << x;
+    EXPECT_EQ(roundToUint16(1e-30f), 0);
+    EXPECT_EQ(roundToUint16(65535.0f), 65535);
 }

@@ -8,12 +8,13 @@
 
 #include "estimate/vertex_samples.h"
 #include "trace/sampling.h"
+#include "util/rounding.h"
 
 namespace qsgi {
 
 namespace {
 constexpr float kBarycentricScale = 65535.0f;
-uint16_t quantised(float b) { return uint16_t(std::lround(std::clamp(b, 0.0f, 1.0f) * kBarycentricScale)); }
+uint16_t quantised(float b) { return roundToUint16(std::clamp(b, 0.0f, 1.0f) * kBarycentricScale); }
 
 // Octahedral encoding of a unit direction (Meyer et al. 2010), 16 bits a coordinate, and its
 // decoding: the decoded direction is the one cast, whenever the ray is cast.
@@ -26,8 +27,8 @@ void encodeOctahedral(const Vec3f& d, uint16_t& u, uint16_t& v) {
         px = qx;
         py = qy;
     }
-    u = uint16_t(std::lround((std::clamp(px, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f));
-    v = uint16_t(std::lround((std::clamp(py, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f));
+    u = roundToUint16((std::clamp(px, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f);
+    v = roundToUint16((std::clamp(py, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f);
 }
 Vec3f decodeOctahedral(uint16_t u, uint16_t v) {
     float px = float(u) / 65535.0f * 2 - 1, py = float(v) / 65535.0f * 2 - 1;
@@ -46,19 +47,21 @@ Vec3f decodeOctahedral(uint16_t u, uint16_t v) {
 class FinalGather::Directions {
 public:
     Directions(const VertexStarts& starts, uint32_t v, uint64_t seed)
-        : numbers_(seed, v, VertexStream::Gather), n_(starts.normal(v)) {
+        : radius_(VertexSamples(seed, v, VertexStream::Gather).dimension(0)),
+          angle_(VertexSamples(seed, v, VertexStream::Gather).dimension(1)),
+          n_(starts.normal(v)) {
         orthonormalBasis(n_, t_, b_);
     }
     // Cosine-weighted about n_v (pdf cosθ/π), as cosineHemisphere.
     Vec3f operator()(uint32_t ray) const {
-        const float u0 = numbers_.uniform(ray, 0), u1 = numbers_.uniform(ray, 1);
+        const float u0 = radius_.uniform(ray), u1 = angle_.uniform(ray);
         const float r = std::sqrt(u0), phi = 2 * kPi * u1;
         const float z = std::sqrt(std::max(0.0f, 1 - u0));
         return normalize(t_ * (r * std::cos(phi)) + b_ * (r * std::sin(phi)) + n_ * z);
     }
 
 private:
-    VertexSamples numbers_;
+    VertexSamples::Dimension radius_, angle_;  // dimensions 0 and 1 of v's points
     Vec3f n_, t_, b_;
 };
 
@@ -205,7 +208,8 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
             if (scene.vertexHidden[v]) continue;  // castVertex's hits would all be misses: 0
             const Directions direction(starts, v, seed_);
             Vec3d sum(0.0);
-            for (uint32_t j = 0; j < rays_; ++j) sum += firstPassAt(scene, firstPass, castVertexRay(bvh, frontNormals, starts.point(v), direction(j)));
+            for (uint32_t j = 0; j < rays_; ++j)
+                sum += firstPassAt(scene, firstPass, castVertexRay(bvh, frontNormals, starts.point(v), direction(j)));
             out[v] = Vec3f(sum / double(rays_));
         }
         if (progress) progress->add(r.size());

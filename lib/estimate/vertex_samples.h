@@ -21,12 +21,25 @@ public:
     VertexSamples(uint64_t seed, uint32_t vertex, VertexStream stream)
         : key_(mix64(mix64(seed ^ 0x5ca1ab1e0ddba11ull) ^ (uint64_t(vertex) << 8 | uint64_t(stream)))) {}
 
+    // One dimension of the vertex's points, its scrambling drawn once: what a loop over many
+    // points of the same dimension (a vertex's gather rays) reads.
+    class Dimension {
+    public:
+        Dimension(int dimension, uint32_t scramble) : dimension_(dimension), scramble_(scramble) {}
+        // Point i, in [0, 1) with 24 bits (exact as a float, never 1).
+        float uniform(uint32_t i) const {
+            const uint32_t x = owenScrambleReversed(SobolSequence::instance().reversedBits(i, dimension_), scramble_);
+            return float(reverseBits32(x) >> 8) * 0x1p-24f;
+        }
+
+    private:
+        int dimension_;
+        uint32_t scramble_;
+    };
+    Dimension dimension(int d) const { return Dimension(d, uint32_t(mix64(key_ + uint64_t(d)))); }
+
     // Dimension d of point i, in [0, 1) with 24 bits (exact as a float, never 1).
-    float uniform(uint32_t i, int dimension) const {
-        const uint32_t scramble = uint32_t(mix64(key_ + uint64_t(dimension)));
-        const uint32_t x = owenScrambleReversed(SobolSequence::instance().reversedBits(i, dimension), scramble);
-        return float(reverseBits32(x) >> 8) * 0x1p-24f;
-    }
+    float uniform(uint32_t i, int d) const { return dimension(d).uniform(i); }
 
 private:
     uint64_t key_;
