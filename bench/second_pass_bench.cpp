@@ -2,6 +2,7 @@
 // vertex's M cosine-distributed rays from its start point s_v, as FinalGather casts them: the same
 // origins and directions, tnear 0, tfar ∞, in vertex order — traced five ways in one run:
 //   gather     FinalGather::castAll itself (directions made, hits kept: what a frame pays);
+//   streamed   FinalGather::castAndGather (hits summed as cast, none kept: the last frame's way);
 //   scene_bvh  SceneBvh::intersect on the prepared rays (our tracing alone: static and dynamic
 //              parts, robust, the tie filter);
 //   ceiling    Embree configured as SceneBvh configures it (robust, tie filter) on one scene
@@ -111,8 +112,8 @@ size_t overRays(size_t rays, const std::function<size_t(size_t, size_t)>& traceC
         std::plus<size_t>());
 }
 
-enum Form { kGather = 0, kSceneBvh = 1, kCeiling = 2, kRaw1 = 3, kRaw16 = 4 };
-const char* kFormNames[] = {"gather", "scene_bvh", "ceiling", "raw1", "raw16"};
+enum Form { kGather = 0, kSceneBvh = 1, kCeiling = 2, kRaw1 = 3, kRaw16 = 4, kStreamed = 5 };
+const char* kFormNames[] = {"gather", "scene_bvh", "ceiling", "raw1", "raw16", "streamed"};
 
 void BM_GatherRays(benchmark::State& state) {
     GatherRays* g = gatherRays(state);
@@ -123,8 +124,15 @@ void BM_GatherRays(benchmark::State& state) {
     if (form == kCeiling) whole = std::make_unique<WholeEmbreeScene>(g->device, g->scene, WholeEmbreeScene::Config::AsSceneBvh);
     if (form == kRaw1 || form == kRaw16) whole = std::make_unique<WholeEmbreeScene>(g->device, g->scene, WholeEmbreeScene::Config::Raw);
     size_t hits = 0;
+    std::vector<Vec3f> firstPass(g->scene.vertexCount(), Vec3f(0.5f)), gathered;
     for (auto _ : state) {
         switch (form) {
+            case kStreamed: {
+                FinalGather streamed(kRaysPerVertex, 1);
+                streamed.castAndGather(g->scene, *g->bvh, g->starts, firstPass, gathered);
+                hits = rays;
+                break;
+            }
             case kGather:
                 g->gather->castAll(g->scene, *g->bvh, g->starts);
                 hits = rays;
@@ -186,7 +194,7 @@ void BM_GatherRays(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_GatherRays)
-    ->ArgsProduct({{kCornell, kCornellRefined, kDenseFloor, kEngine}, {kGather, kSceneBvh, kCeiling, kRaw1, kRaw16}})
+    ->ArgsProduct({{kCornell, kCornellRefined, kDenseFloor, kEngine}, {kGather, kStreamed, kSceneBvh, kCeiling, kRaw1, kRaw16}})
     ->ArgNames({"scene", "form"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

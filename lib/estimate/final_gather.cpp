@@ -204,12 +204,16 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
     if (progress) progress->setTotal(scene.vertexCount());
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), [&](const tbb::blocked_range<uint32_t>& r) {
+        // One vertex's hits at a time: cast them all, then sum them, as castAll and gather do
+        // (summing as each ray returns interleaves the first pass's scattered reads with
+        // Embree's, measured 15 % slower on data/cornell refined).
+        std::vector<GatherHit> hits(rays_);
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             if (scene.vertexHidden[v]) continue;  // castVertex's hits would all be misses: 0
             const Directions direction(starts, v, seed_);
+            for (uint32_t j = 0; j < rays_; ++j) hits[j] = castVertexRay(bvh, frontNormals, starts.point(v), direction(j));
             Vec3d sum(0.0);
-            for (uint32_t j = 0; j < rays_; ++j)
-                sum += firstPassAt(scene, firstPass, castVertexRay(bvh, frontNormals, starts.point(v), direction(j)));
+            for (uint32_t j = 0; j < rays_; ++j) sum += firstPassAt(scene, firstPass, hits[j]);
             out[v] = Vec3f(sum / double(rays_));
         }
         if (progress) progress->add(r.size());
