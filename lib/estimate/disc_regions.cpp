@@ -199,7 +199,7 @@ bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v,
 
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
-                             OwnSurfaceScratch& scratch, const OwnSurfaceTree* tree, DiscRegions::Work& tally,
+                             OwnSurfaceScratch& scratch, const OwnSurfaceTree* tree, bool treeForOwnSurface, DiscRegions::Work& tally,
                              DiscRegions::StaticAnswers* answers, bool staticShortcut, bool startOnly = false) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
@@ -207,7 +207,7 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     // Only the photon map's coverage reads ε_v⁻; without it the search may stop early.
     OwnSurfaceQuery query;
     query.depthBelow = withCoverage;
-    query.tree = tree;
+    query.tree = treeForOwnSurface ? tree : nullptr;
     const OwnSurface own = findOwnSurface(v, scene, topology, frontNormals, radius, scratch, query);
     tally.ownSurfacesProved += own.provedByTree;
     if (own.empty) {
@@ -228,7 +228,7 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
         }
         // Nothing reachable from any centre: decide exactly as the full regions do, keep the start.
         const uint64_t proved = tally.ownSurfacesProved;
-        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tree, tally,
+        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tree, treeForOwnSurface, tally,
                                             nullptr, staticShortcut);
         tally.ownSurfacesProved = proved;  // the same own surface again: counted once
         disc.start = full.start;
@@ -259,8 +259,21 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
         const double margin = std::ldexp(std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) + double(radius) +
                                              double(own.epsAbove),
                                          -20);
-        shortcuts.nothingNear = !bvh.staticGeometryRises(
-            scene.positions[v], float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon(), normal, lowest - margin);
+        const Vec3f& centre = scene.positions[v];
+        const float reach = float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon();
+        const double height = lowest - margin;
+        // The same question, asked of the tree where there is one (it prunes what cannot rise;
+        // Embree's point query visits every triangle near and gives up past 2048).
+        shortcuts.nothingNear =
+            tree ? !tree->anyRising(OwnSurfaceTree::kAnyPiece, Vec3d(centre), n, -2.0, double(reach), height,
+                                    [&](uint32_t tri) {
+                                        if (scene.triangleDynamic[tri]) return false;
+                                        const Triangle& T = scene.triangles[tri];
+                                        const Vec3f corners[3] = {scene.positions[T.v[0]], scene.positions[T.v[1]],
+                                                                  scene.positions[T.v[2]]};
+                                        return triangleRisesNear(corners, centre, reach, n, height);
+                                    })
+                 : !bvh.staticGeometryRises(centre, reach, normal, height);
         tally.staticRaysSkipped += shortcuts.nothingNear;
     }
     // The kept answers hold while the rays are the same: same start and lift (a static vertex's
@@ -325,7 +338,8 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
     // vertices in a hundred costs: worth building for a frame's worth of vertices, not for a
     // handful (the answers are the same either way).
     std::optional<OwnSurfaceTree> tree;
-    if (ownSurfaceShortcut_ && !withCoverage_ && vertices.size() * 16 >= scene.triangleCount()) tree.emplace(scene, frontNormals, topology);
+    if ((ownSurfaceShortcut_ || staticShortcut_) && vertices.size() * 16 >= scene.triangleCount())
+        tree.emplace(scene, frontNormals, topology);
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;
     tbb::enumerable_thread_specific<Work> tallies;
@@ -336,7 +350,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
             StaticAnswers* answers = keepAnswers ? &answers_[size_t(answerSlot_[vertices[i]])] : nullptr;
             if (answers && scene.vertexDynamic[vertices[i]]) answers = nullptr;
             VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local,
-                                                tree ? &*tree : nullptr, tally, startsOnly_ ? nullptr : answers, staticShortcut_,
+                                                tree ? &*tree : nullptr, ownSurfaceShortcut_, tally, startsOnly_ ? nullptr : answers, staticShortcut_,
                                                 startsOnly_);
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);

@@ -6,6 +6,9 @@
 // the own surface (every triangle near v that faces within 45° of n_v, connected or not) that
 // rises no higher proves it; this tree answers that question by descending only where a node's
 // bounds say a triangle might rise, so its cost follows what is near v, not the mesh density.
+// The disc regions ask it the same kind of question for their static shortcut (any static
+// triangle near v rising to their rays' height), where Embree's point query visits every
+// triangle near and gave up on dense meshes.
 //
 // Only v's own piece of surface can hold its own surface: the triangles joined to v through
 // shared (welded) vertices. Each triangle's piece is numbered, so a light panel hung under a
@@ -33,8 +36,10 @@ public:
 
     // The piece of surface vertex v belongs to (triangles joined through welded vertices).
     uint32_t pieceOfVertex(uint32_t v) const { return vertexPiece_[v]; }
+    // For anyRising: triangles of every piece.
+    static constexpr uint32_t kAnyPiece = UINT32_MAX;
 
-    // Calls visit(triangle) for every triangle of `piece` that may (a) have a front normal whose
+    // Calls visit(triangle) for every triangle of `piece` (or of any, kAnyPiece) that may (a) have a front normal whose
     // dot with `normal` exceeds `minNormalDot`, (b) come within `reach` of `centre`, and (c) have
     // a corner at `height` or more above `centre` along `normal` — and for some others besides
     // (the bounds are conservative). Stops, returning true, as soon as visit returns true.
@@ -78,11 +83,11 @@ bool OwnSurfaceTree::anyRising(uint32_t piece, const Vec3d& centre, const Vec3d&
     stack[depth++] = 0;
     while (depth > 0) {
         const Node& node = nodes_[stack[--depth]];
-        if (node.piece != kMixed && node.piece != piece) continue;
+        if (piece != kAnyPiece && node.piece != kMixed && node.piece != piece) continue;
         if (!mayRise(node, centre, normal, minNormalDot, reach, height)) continue;
         if (node.left == 0) {
             for (uint32_t i = node.begin; i < node.end; ++i)
-                if (trianglePiece_[order_[i]] == piece && visit(order_[i])) return true;
+                if ((piece == kAnyPiece || trianglePiece_[order_[i]] == piece) && visit(order_[i])) return true;
         } else {
             stack[depth++] = node.right;
             stack[depth++] = node.left;

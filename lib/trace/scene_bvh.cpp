@@ -222,7 +222,7 @@ constexpr uint32_t kMostTrianglesVisited = 2048;
 
 // Called for the static triangles whose BVH boxes meet the query ball: one whose own box does,
 // with a corner at the query's height or above, ends the search.
-bool triangleRisesNear(RTCPointQueryFunctionArguments* args) {
+bool risesNear(RTCPointQueryFunctionArguments* args) {
     auto* q = static_cast<NearQuery*>(args->userPtr);
     if (q->found) return false;
     if (++q->visited > kMostTrianglesVisited) {
@@ -230,26 +230,34 @@ bool triangleRisesNear(RTCPointQueryFunctionArguments* args) {
         args->query->radius = 0;
         return true;
     }
-    Bounds3f box;
-    double highest = -std::numeric_limits<double>::infinity();
+    Vec3f corners[3];
     for (size_t k = 0; k < 3; ++k) {
         const float* p = q->vertex + 3 * size_t(q->index[3 * size_t(args->primID) + k]);
-        box.extend(Vec3f(p[0], p[1], p[2]));
-        highest = std::max(highest, dot(Vec3d(p[0], p[1], p[2]) - Vec3d(q->centre), q->normal));
+        corners[k] = Vec3f(p[0], p[1], p[2]);
     }
-    if (highest < q->height) return false;
-    double squared = 0;
-    for (int a = 0; a < 3; ++a) {
-        const double below = double(box.lower[a]) - double(q->centre[a]), above = double(q->centre[a]) - double(box.upper[a]);
-        const double gap = std::max({below, above, 0.0});
-        squared += gap * gap;
-    }
-    if (squared > double(q->radius) * double(q->radius)) return false;
+    if (!triangleRisesNear(corners, q->centre, q->radius, q->normal, q->height)) return false;
     q->found = true;
     args->query->radius = 0;  // nothing more to look for
     return true;
 }
 }  // namespace
+
+bool triangleRisesNear(const Vec3f corners[3], const Vec3f& centre, float radius, const Vec3d& normal, double height) {
+    Bounds3f box;
+    double highest = -std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < 3; ++k) {
+        box.extend(corners[k]);
+        highest = std::max(highest, dot(Vec3d(corners[k]) - Vec3d(centre), normal));
+    }
+    if (highest < height) return false;
+    double squared = 0;
+    for (int a = 0; a < 3; ++a) {
+        const double below = double(box.lower[a]) - double(centre[a]), above = double(centre[a]) - double(box.upper[a]);
+        const double gap = std::max({below, above, 0.0});
+        squared += gap * gap;
+    }
+    return squared <= double(radius) * double(radius);
+}
 
 bool SceneBvh::staticGeometryRises(const Vec3f& centre, float radius, const Vec3f& normal, double height) const {
     if (static_.empty()) return false;
@@ -265,7 +273,7 @@ bool SceneBvh::staticGeometryRises(const Vec3f& centre, float radius, const Vec3
     query.time = 0;
     RTCPointQueryContext context;
     rtcInitPointQueryContext(&context);
-    rtcPointQuery(staticScene_.get(), &query, &context, triangleRisesNear, &q);
+    rtcPointQuery(staticScene_.get(), &query, &context, risesNear, &q);
     return q.found;
 }
 

@@ -34,6 +34,11 @@ struct TieBreakContext {
 };
 void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args);
 
+// staticGeometryRises' test of one triangle: its box comes within `radius` of `centre`, and a
+// corner lies at `height` or more above `centre` along `normal`. Shared with OwnSurfaceTree's
+// answer to the same question, so that both say the same of every triangle they look at.
+bool triangleRisesNear(const Vec3f corners[3], const Vec3f& centre, float radius, const Vec3d& normal, double height);
+
 class SceneBvh {
 public:
     // Build it from the rest pose (before any frame is applied), so that every run — whatever
