@@ -14,9 +14,10 @@ namespace qsgi {
 
 class WholeEmbreeScene {
 public:
-    enum class Config { AsSceneBvh, Raw };
+    // RobustOnly: the robust flag without the filter, to tell their costs apart.
+    enum class Config { AsSceneBvh, RobustOnly, Raw };
     WholeEmbreeScene(const EmbreeDevice& device, const Scene& scene, Config config) : scene_(rtcNewScene(device.get())) {
-        if (config == Config::AsSceneBvh) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+        if (config != Config::Raw) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
         rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
         RTCGeometry geometry = rtcNewGeometry(device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
         rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_HIGH);

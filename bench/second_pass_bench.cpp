@@ -7,6 +7,8 @@
 //              parts, robust, the tie filter);
 //   ceiling    Embree configured as SceneBvh configures it (robust, tie filter) on one scene
 //              holding every triangle, rtcIntersect1: BM_EmbreeClosestHitCeiling's configuration;
+//   robust1    the same scene with the robust flag and no filter, rtcIntersect1 (what the tie
+//              filter costs: ceiling against this; what robust traversal costs: this against raw1);
 //   raw1       one scene, build quality high, no robust flag, no filter, rtcIntersect1;
 //   raw16      the same, rtcIntersect16, each packet 16 consecutive rays of one vertex (coherent).
 // Every form runs on all cores over the same rays; rays_per_s is the counter to read, and a form's
@@ -112,8 +114,8 @@ size_t overRays(size_t rays, const std::function<size_t(size_t, size_t)>& traceC
         std::plus<size_t>());
 }
 
-enum Form { kGather = 0, kSceneBvh = 1, kCeiling = 2, kRaw1 = 3, kRaw16 = 4, kStreamed = 5 };
-const char* kFormNames[] = {"gather", "scene_bvh", "ceiling", "raw1", "raw16", "streamed"};
+enum Form { kGather = 0, kSceneBvh = 1, kCeiling = 2, kRaw1 = 3, kRaw16 = 4, kStreamed = 5, kRobust1 = 6 };
+const char* kFormNames[] = {"gather", "scene_bvh", "ceiling", "raw1", "raw16", "streamed", "robust1"};
 
 void BM_GatherRays(benchmark::State& state) {
     GatherRays* g = gatherRays(state);
@@ -122,6 +124,7 @@ void BM_GatherRays(benchmark::State& state) {
     const size_t rays = g->origins.size();
     std::unique_ptr<WholeEmbreeScene> whole;
     if (form == kCeiling) whole = std::make_unique<WholeEmbreeScene>(g->device, g->scene, WholeEmbreeScene::Config::AsSceneBvh);
+    if (form == kRobust1) whole = std::make_unique<WholeEmbreeScene>(g->device, g->scene, WholeEmbreeScene::Config::RobustOnly);
     if (form == kRaw1 || form == kRaw16) whole = std::make_unique<WholeEmbreeScene>(g->device, g->scene, WholeEmbreeScene::Config::Raw);
     size_t hits = 0;
     std::vector<Vec3f> firstPass(g->scene.vertexCount(), Vec3f(0.5f)), gathered;
@@ -146,6 +149,7 @@ void BM_GatherRays(benchmark::State& state) {
                 });
                 break;
             case kCeiling:
+            case kRobust1:
             case kRaw1:
                 hits = overRays(rays, [&](size_t begin, size_t end) {
                     size_t n = 0;
@@ -194,7 +198,7 @@ void BM_GatherRays(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_GatherRays)
-    ->ArgsProduct({{kCornell, kCornellRefined, kDenseFloor, kEngine}, {kGather, kStreamed, kSceneBvh, kCeiling, kRaw1, kRaw16}})
+    ->ArgsProduct({{kCornell, kCornellRefined, kDenseFloor, kEngine}, {kGather, kStreamed, kSceneBvh, kCeiling, kRobust1, kRaw1, kRaw16}})
     ->ArgNames({"scene", "form"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
