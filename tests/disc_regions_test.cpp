@@ -173,6 +173,7 @@ TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
         EmbreeDevice device;
         const SceneBvh bvh(device, c.scene);
         DiscRegions quick = DiscRegions::startsOnly(c.radius), reference = DiscRegions::startsOnly(c.radius);
+        quick.alwaysBuildTree(true);  // coarse scenes too: the tree's answers against the walk's
         reference.useOwnSurfaceShortcut(false);
         quick.computeAll(c.scene, bvh);
         reference.computeAll(c.scene, bvh);
@@ -199,6 +200,7 @@ TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
     EmbreeDevice device;
     const SceneBvh bvh(device, cornell);
     DiscRegions quick(0.05f, false), reference(0.05f, false);
+    quick.alwaysBuildTree(true);
     reference.useOwnSurfaceShortcut(false);
     quick.computeAll(cornell, bvh);
     reference.computeAll(cornell, bvh);
@@ -309,24 +311,29 @@ TEST(DiscRegions, UniformCellsAgreeWithASingleRayToTheirCentre) {
 }
 
 // The shortcut spares rays, never changes an answer: every disc (masks, mixed shares, start,
-// areas, coverage) equals the one found with every static ray traced, with and without
-// coverage, on every scene above.
+// areas, coverage) equals the one found with every static ray traced and every own surface
+// walked, with and without coverage, on every scene above — with the static question put to
+// Embree's point query and to OwnSurfaceTree.
 TEST(DiscRegions, TheStaticShortcutChangesNoDisc) {
     for (const ShortcutScene& c : kShortcutScenes) {
         const Scene scene = shortcutScene(c);
         EmbreeDevice device;
         const SceneBvh bvh(device, scene);
-        for (bool coverage : {false, true}) {
-            SCOPED_TRACE(std::string(c.name) + (coverage ? ", with coverage" : ""));
-            DiscRegions quick(c.radius, coverage), reference(c.radius, coverage);
-            reference.useStaticShortcut(false);
-            quick.computeAll(scene, bvh);
-            reference.computeAll(scene, bvh);
-            for (size_t v = 0; v < scene.vertexCount(); ++v) ASSERT_TRUE(quick[v] == reference[v]) << "vertex " << v;
-            EXPECT_GT(quick.lastWork().staticRaysSkipped, 0u);
-            EXPECT_EQ(reference.lastWork().staticRaysSkipped, 0u);
-            EXPECT_LT(quick.lastWork().rays, reference.lastWork().rays);
-        }
+        for (bool coverage : {false, true})
+            for (bool tree : {false, true}) {
+                SCOPED_TRACE(std::string(c.name) + (coverage ? ", with coverage" : "") +
+                             (tree ? ", asking OwnSurfaceTree" : ", asking Embree's point query"));
+                DiscRegions quick(c.radius, coverage), reference(c.radius, coverage);
+                quick.alwaysBuildTree(tree);
+                reference.useStaticShortcut(false);
+                reference.useOwnSurfaceShortcut(false);
+                quick.computeAll(scene, bvh);
+                reference.computeAll(scene, bvh);
+                for (size_t v = 0; v < scene.vertexCount(); ++v) ASSERT_TRUE(quick[v] == reference[v]) << "vertex " << v;
+                EXPECT_GT(quick.lastWork().staticRaysSkipped, 0u);
+                EXPECT_EQ(reference.lastWork().staticRaysSkipped, 0u);
+                EXPECT_LT(quick.lastWork().rays, reference.lastWork().rays);
+            }
     }
 }
 

@@ -183,6 +183,21 @@ VertexDisc discFrom(const Vec3f& startPoint, VertexDisc disc, uint32_t v, const 
     return disc;
 }
 
+// The mean count of triangles in the own surfaces of 256 of the vertices, evenly spaced: what a
+// walk costs here.
+double meanOwnSurfaceTriangles(const Scene& scene, const MeshTopology& topology, const std::vector<Vec3f>& frontNormals,
+                               const std::vector<uint32_t>& vertices, float radius) {
+    constexpr size_t kSample = 256;
+    const size_t step = std::max<size_t>(1, vertices.size() / kSample);
+    OwnSurfaceScratch scratch;
+    OwnSurfaceQuery walk;
+    walk.depthBelow = false;
+    uint64_t triangles = 0, walked = 0;
+    for (size_t i = 0; i < vertices.size(); i += step, ++walked)
+        triangles += findOwnSurface(vertices[i], scene, topology, frontNormals, radius, scratch, walk).trianglesWalked;
+    return walked ? double(triangles) / double(walked) : 0;
+}
+
 // Whether some cell centre of v's disc is reachable from `start`: then the full regions keep that
 // start (they look further only when nothing is reachable from it).
 bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
@@ -264,9 +279,12 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
         const double height = lowest - margin;
         // The same question, asked of the tree where there is one (it prunes what cannot rise;
         // Embree's point query visits every triangle near and gives up past 2048).
+        // Past 2048 triangles near, both say "rises" (trace the rays), as Embree's query does.
+        int budget = 2048;
         shortcuts.nothingNear =
             tree ? !tree->anyRising(OwnSurfaceTree::kAnyPiece, Vec3d(centre), n, -2.0, double(reach), height,
                                     [&](uint32_t tri) {
+                                        if (--budget < 0) return true;
                                         if (scene.triangleDynamic[tri]) return false;
                                         const Triangle& T = scene.triangles[tri];
                                         const Vec3f corners[3] = {scene.positions[T.v[0]], scene.positions[T.v[1]],
@@ -334,11 +352,16 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
     std::vector<uint8_t> changed(vertices.size(), 0);
     const MeshTopology topology(scene.positions, scene.triangles);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
-    // The own-surface shortcut's tree costs about what walking the own surfaces of a few
-    // vertices in a hundred costs: worth building for a frame's worth of vertices, not for a
-    // handful (the answers are the same either way).
+    // The tree pays where own surfaces hold many triangles — a dense mesh, where walking them or
+    // visiting every triangle near (Embree's point query) is what costs — and costs about what
+    // walking the own surfaces of a few vertices in a hundred does: it is built for a frame's
+    // worth of vertices whose own surfaces, sampled, hold 64 triangles or more on average. Where
+    // they hold fewer (data/cornell: about 20; 2CylinderEngine, whose parts crowd the tree's
+    // nodes) the walk is the cheaper way. The answers are the same either way.
     std::optional<OwnSurfaceTree> tree;
-    if ((ownSurfaceShortcut_ || staticShortcut_) && vertices.size() * 16 >= scene.triangleCount())
+    if ((ownSurfaceShortcut_ || staticShortcut_) &&
+        (alwaysBuildTree_ || (vertices.size() * 16 >= scene.triangleCount() &&
+                              meanOwnSurfaceTriangles(scene, topology, frontNormals, vertices, radius_) >= 64)))
         tree.emplace(scene, frontNormals, topology);
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;

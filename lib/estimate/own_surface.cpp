@@ -203,8 +203,10 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
     // The shortcut: if no triangle near v that could belong to its own surface (of v's piece,
     // facing within 45°, within the cylinder's ball of radius r√2) rises to the next level, the walk below
     // could only find what the incident triangles gave. The tree bounds corners; a triangle it
-    // cannot rule out is judged exactly as the walk judges it.
-    if (query.tree && !query.depthBelow) {
+    // cannot rule out is judged exactly as the walk judges it. Where the incident triangles
+    // already rise a whole epsilon, v sits in a hollow whose wall the tree would find only to
+    // send v to the walk: it goes there at once. The answer is the walk's either way.
+    if (query.tree && !query.depthBelow && level(highest) == 0) {
         const double current = level(highest);
         const bool rises = query.tree->anyRising(query.tree->pieceOfVertex(v), origin, n, double(kOwnSurfaceCos), r * std::sqrt(2.0), (current + 0.5) * eps,
                                                  [&](uint32_t tri) {
@@ -232,6 +234,7 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
             }
         }
     }
+    own.trianglesWalked = uint32_t(frontier.size());
     return finish();
 }
 

@@ -35,6 +35,8 @@ struct OwnSurface {
     Vec3f towardSurface{0.0f};
     // ε_v⁺ was proved by OwnSurfaceQuery::tree without walking the own surface (for the counts).
     bool provedByTree = false;
+    // Triangles of the own surface the walk visited (0 when the tree proved it): its cost.
+    uint32_t trianglesWalked = 0;
 };
 
 // Cosine of the 45° limit between a face normal and n_v (strict: dot > this).
