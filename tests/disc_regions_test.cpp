@@ -102,7 +102,7 @@ TEST(OwnSurface, RisesCountInWholeSceneEpsilons) {
     OwnSurfaceScratch scratch;
     size_t checked = 0, proved = 0;
     double largestNoise = 0;
-    for (uint32_t v = 0; v < (2 * 17) * (2 * 17) / 2; ++v) {  // floor vertices (the box's come after)
+    for (uint32_t v = 0; v < 4 * 17 * 17; ++v) {  // the floor's vertices, 2 x 2 tiles (the box's come after)
         OwnSurfaceQuery walk;
         walk.depthBelow = false;
         OwnSurfaceQuery quick = walk;
@@ -173,7 +173,7 @@ TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
         EmbreeDevice device;
         const SceneBvh bvh(device, c.scene);
         DiscRegions quick = DiscRegions::startsOnly(c.radius), reference = DiscRegions::startsOnly(c.radius);
-        quick.alwaysBuildTree(true);  // coarse scenes too: the tree's answers against the walk's
+        quick.setTreeUse(DiscRegions::TreeUse::Always);  // coarse scenes too: the tree's answers against the walk's
         reference.useOwnSurfaceShortcut(false);
         quick.computeAll(c.scene, bvh);
         reference.computeAll(c.scene, bvh);
@@ -200,7 +200,7 @@ TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
     EmbreeDevice device;
     const SceneBvh bvh(device, cornell);
     DiscRegions quick(0.05f, false), reference(0.05f, false);
-    quick.alwaysBuildTree(true);
+    quick.setTreeUse(DiscRegions::TreeUse::Always);
     reference.useOwnSurfaceShortcut(false);
     quick.computeAll(cornell, bvh);
     reference.computeAll(cornell, bvh);
@@ -324,7 +324,7 @@ TEST(DiscRegions, TheStaticShortcutChangesNoDisc) {
                 SCOPED_TRACE(std::string(c.name) + (coverage ? ", with coverage" : "") +
                              (tree ? ", asking OwnSurfaceTree" : ", asking Embree's point query"));
                 DiscRegions quick(c.radius, coverage), reference(c.radius, coverage);
-                quick.alwaysBuildTree(tree);
+                quick.setTreeUse(tree ? DiscRegions::TreeUse::Always : DiscRegions::TreeUse::Never);
                 reference.useStaticShortcut(false);
                 reference.useOwnSurfaceShortcut(false);
                 quick.computeAll(scene, bvh);

@@ -284,8 +284,8 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
         shortcuts.nothingNear =
             tree ? !tree->anyRising(OwnSurfaceTree::kAnyPiece, Vec3d(centre), n, -2.0, double(reach), height,
                                     [&](uint32_t tri) {
-                                        if (--budget < 0) return true;
                                         if (scene.triangleDynamic[tri]) return false;
+                                        if (--budget < 0) return true;
                                         const Triangle& T = scene.triangles[tri];
                                         const Vec3f corners[3] = {scene.positions[T.v[0]], scene.positions[T.v[1]],
                                                                   scene.positions[T.v[2]]};
@@ -359,9 +359,9 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
     // they hold fewer (data/cornell: about 20; 2CylinderEngine, whose parts crowd the tree's
     // nodes) the walk is the cheaper way. The answers are the same either way.
     std::optional<OwnSurfaceTree> tree;
-    if ((ownSurfaceShortcut_ || staticShortcut_) &&
-        (alwaysBuildTree_ || (vertices.size() * 16 >= scene.triangleCount() &&
-                              meanOwnSurfaceTriangles(scene, topology, frontNormals, vertices, radius_) >= 64)))
+    const bool treePays = treeUse_ == TreeUse::WhereItPays && vertices.size() * 16 >= scene.triangleCount() &&
+                          meanOwnSurfaceTriangles(scene, topology, frontNormals, vertices, radius_) >= 64;
+    if ((ownSurfaceShortcut_ || staticShortcut_) && (treeUse_ == TreeUse::Always || treePays))
         tree.emplace(scene, frontNormals, topology);
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;

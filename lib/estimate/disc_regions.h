@@ -129,9 +129,10 @@ public:
     void useStaticShortcut(bool on) { staticShortcut_ = on; }
     // Off: every own surface is walked whole, OwnSurfaceTree never asked (the same reference).
     void useOwnSurfaceShortcut(bool on) { ownSurfaceShortcut_ = on; }
-    // The tree is built where it pays (dense meshes, many vertices); tests build it always, so
-    // that its answers are compared with the walk's and the point query's on any scene.
-    void alwaysBuildTree(bool on) { alwaysBuildTree_ = on; }
+    // OwnSurfaceTree is built where it pays (dense meshes, many vertices); tests build it always
+    // or never, so that its answers are compared with the walk's and the point query's on any scene.
+    enum class TreeUse { Never, WhereItPays, Always };
+    void setTreeUse(TreeUse use) { treeUse_ = use; }
     // Bytes of the static answers kept for recomputed vertices.
     size_t keptAnswerBytes() const { return answers_.capacity() * sizeof(StaticAnswers) + answerSlot_.capacity() * sizeof(int32_t); }
 
@@ -160,7 +161,7 @@ private:
     Work lastWork_;
     bool staticShortcut_ = true;
     bool ownSurfaceShortcut_ = true;
-    bool alwaysBuildTree_ = false;
+    TreeUse treeUse_ = TreeUse::WhereItPays;
 };
 
 }  // namespace qsgi

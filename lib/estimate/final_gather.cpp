@@ -188,7 +188,8 @@ void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass
             // In ray order, in one thread: the same bits for any schedule.
             Vec3d sum(0.0);
             const GatherHit* hits = &hits_[size_t(v) * rays_];
-            for (uint32_t j = 0; j < rays_; ++j) sum += firstPassAt(scene, firstPass, hits[j]);
+            for (uint32_t j = 0; j < rays_; ++j)
+                if (hits[j].triangle < GatherHit::kBackFace) sum += firstPassAt(scene, firstPass, hits[j]);
             out[v] = Vec3f(sum / double(rays_));
         }
     });
@@ -213,7 +214,8 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
             const Directions direction(starts, v, seed_);
             for (uint32_t j = 0; j < rays_; ++j) hits[j] = castVertexRay(bvh, frontNormals, starts.point(v), direction(j));
             Vec3d sum(0.0);
-            for (uint32_t j = 0; j < rays_; ++j) sum += firstPassAt(scene, firstPass, hits[j]);
+            for (uint32_t j = 0; j < rays_; ++j)  // misses and back faces add nothing, not +0
+                if (hits[j].triangle < GatherHit::kBackFace) sum += firstPassAt(scene, firstPass, hits[j]);
             out[v] = Vec3f(sum / double(rays_));
         }
         if (progress) progress->add(r.size());

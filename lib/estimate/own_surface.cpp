@@ -118,9 +118,12 @@ bool clippedHeightRange(const Local tri[3], double r, double& lo, double& hi) {
     }
     // The height is affine over the triangle, so the clipped part's lies within the corners';
     // rounding (a sliver's gradient) may not take it out: OwnSurfaceTree bounds corners only.
+    // Whether the clip is empty is decided before, as it always was.
+    if (!(lo <= hi)) return false;
     lo = std::max(lo, cornerLo);
     hi = std::min(hi, cornerHi);
-    return lo <= hi;
+    if (lo > hi) lo = cornerLo, hi = cornerHi;  // rounding beyond repair: the corners' range
+    return true;
 }
 
 }  // namespace
@@ -208,7 +211,10 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
     // send v to the walk: it goes there at once. The answer is the walk's either way.
     if (query.tree && !query.depthBelow && level(highest) == 0) {
         const double current = level(highest);
-        const bool rises = query.tree->anyRising(query.tree->pieceOfVertex(v), origin, n, double(kOwnSurfaceCos), r * std::sqrt(2.0), (current + 0.5) * eps,
+        // The walk's cylinder, in v's frame, lies within r√2 of v — but the frame is built on a
+        // float normal, a few 1e-8 off unit length: the ball is widened far past that.
+        const double reach = r * std::sqrt(2.0) * (1 + 1e-5);
+        const bool rises = query.tree->anyRising(query.tree->pieceOfVertex(v), origin, n, double(kOwnSurfaceCos), reach, (current + 0.5) * eps,
                                                  [&](uint32_t tri) {
                                                      if (scratch.visitedStamp[tri] == stamp) return false;
                                                      double lo, hi;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "estimate/morton_order.h"
 
@@ -45,7 +46,8 @@ OwnSurfaceTree::OwnSurfaceTree(const Scene& scene, const std::vector<Vec3f>& fro
         centroids[t] = (scene.positions[T.v[0]] + scene.positions[T.v[1]] + scene.positions[T.v[2]]) * (1.0f / 3.0f);
     }
     order_ = mortonOrder(centroids);
-    nodes_.reserve(2 * (order_.size() / kLeafTriangles + 1));
+    // Median splits leave 4 to 8 triangles a leaf: at most n/2 nodes.
+    nodes_.reserve(order_.size() / 2 + 1);
     build(0, uint32_t(order_.size()), scene, frontNormals);
 }
 
