@@ -164,7 +164,7 @@ void BM_GatherRays(benchmark::State& state) {
                 });
                 break;
             case kRaw16:
-                hits = overRays(rays, [&](size_t begin, size_t end) {
+                hits = overRays(rays, [&](size_t begin, size_t) {
                     RTCRayHit16 packet;
                     alignas(64) int valid[16];
                     for (size_t k = 0; k < 16; ++k) {
@@ -182,7 +182,6 @@ void BM_GatherRays(benchmark::State& state) {
                     rtcIntersect16(valid, whole->get(), &context, &packet);
                     size_t n = 0;
                     for (size_t k = 0; k < 16; ++k) n += packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
-                    (void)end;
                     return n;
                 });
                 break;

@@ -255,21 +255,40 @@ TEST(FinalGather, RaysMeetingABackFaceReturnNothing) {
     std::printf("back faces: %.2f s\n", seconds(start));
 }
 
+// A floor under an emissive rectangle and a point light, 4225 floor vertices (many parallel
+// chunks), with a photons' answer that is a fixed function of position: what the second pass's
+// determinism tests run on.
+struct SecondPassFloor {
+    Scene scene = withPointLight(
+        testscenes::floorUnderEmitter(64, {0.1f, 0.5f, -0.05f}, 0.3f, 0.2f, Vec3f(4.0f, 3.0f, 2.0f), Vec3f(0.6f)));
+    Rig rig{scene};
+    VertexRadiosity photons = photonsOf(scene);
+
+    static Scene withPointLight(Scene s) {
+        testscenes::addPointLight(s, Vec3f(-0.5f, 0.8f, 0.4f), Vec3f(1.0f));
+        return s;
+    }
+    static VertexRadiosity photonsOf(const Scene& s) {
+        VertexRadiosity out;
+        out.irradiance.resize(s.vertexCount());
+        for (uint32_t v = 0; v < s.vertexCount(); ++v) {
+            const Vec3f& p = s.positions[v];
+            out.irradiance[v] = Vec3f(0.3f + 0.1f * p.x * p.x, 0.2f + 0.05f * p.z, 0.1f);
+        }
+        return out;
+    }
+};
+
 // The second pass's bits do not depend on the thread count: each vertex's shadow and gather rays
 // are its own numbers, summed in ray order in one thread. A floor under an emissive rectangle and a
 // point light, 4225 floor vertices (many parallel chunks), with and without the gather; the
 // photons' answer is a fixed function of position.
 TEST(TwoPassLighting, BitIdenticalWithOneAndTwoThreads) {
     const auto start = std::chrono::steady_clock::now();
-    Scene scene = testscenes::floorUnderEmitter(64, {0.1f, 0.5f, -0.05f}, 0.3f, 0.2f, Vec3f(4.0f, 3.0f, 2.0f), Vec3f(0.6f));
-    testscenes::addPointLight(scene, Vec3f(-0.5f, 0.8f, 0.4f), Vec3f(1.0f));
-    const Rig rig(scene);
-    VertexRadiosity photons;
-    photons.irradiance.resize(scene.vertexCount());
-    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
-        const Vec3f& p = scene.positions[v];
-        photons.irradiance[v] = Vec3f(0.3f + 0.1f * p.x * p.x, 0.2f + 0.05f * p.z, 0.1f);
-    }
+    const SecondPassFloor floor;
+    const Scene& scene = floor.scene;
+    const Rig& rig = floor.rig;
+    const VertexRadiosity& photons = floor.photons;
     for (const uint32_t gatherRays : {0u, 64u}) {
         SCOPED_TRACE(gatherRays ? "with the gather" : "direct only");
         LightingSettings lighting;
@@ -302,15 +321,10 @@ TEST(TwoPassLighting, BitIdenticalWithOneAndTwoThreads) {
 // and 2 threads, with almost none of the memory. The floor under an emitter and a point light of
 // the test above; the photons' answer a fixed function of position.
 TEST(TwoPassLighting, ASolveThatKeepsNoHitsGivesTheSameBits) {
-    Scene scene = testscenes::floorUnderEmitter(64, {0.1f, 0.5f, -0.05f}, 0.3f, 0.2f, Vec3f(4.0f, 3.0f, 2.0f), Vec3f(0.6f));
-    testscenes::addPointLight(scene, Vec3f(-0.5f, 0.8f, 0.4f), Vec3f(1.0f));
-    const Rig rig(scene);
-    VertexRadiosity photons;
-    photons.irradiance.resize(scene.vertexCount());
-    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
-        const Vec3f& p = scene.positions[v];
-        photons.irradiance[v] = Vec3f(0.3f + 0.1f * p.x * p.x, 0.2f + 0.05f * p.z, 0.1f);
-    }
+    const SecondPassFloor floor;
+    const Scene& scene = floor.scene;
+    const Rig& rig = floor.rig;
+    const VertexRadiosity& photons = floor.photons;
     LightingSettings lighting;
     lighting.direct = DirectLighting::Exact;
     lighting.directSamples = 16;

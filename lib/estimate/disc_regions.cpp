@@ -278,14 +278,14 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
         const float reach = float(double(radius) + double(own.epsAbove) + sideStep) + bvh.rayEpsilon();
         const double height = lowest - margin;
         // The same question, asked of the tree where there is one (it prunes what cannot rise;
-        // Embree's point query visits every triangle near and gives up past 2048).
-        // Past 2048 triangles near, both say "rises" (trace the rays), as Embree's query does.
-        int budget = 2048;
+        // Embree's point query visits every triangle near), with the same limit on static
+        // triangles looked at, past which both say "rises" and the rays are traced.
+        uint32_t looked = 0;
         shortcuts.nothingNear =
             tree ? !tree->anyRising(OwnSurfaceTree::kAnyPiece, Vec3d(centre), n, -2.0, double(reach), height,
                                     [&](uint32_t tri) {
                                         if (scene.triangleDynamic[tri]) return false;
-                                        if (--budget < 0) return true;
+                                        if (++looked > SceneBvh::kMostTrianglesNear) return true;
                                         const Triangle& T = scene.triangles[tri];
                                         const Vec3f corners[3] = {scene.positions[T.v[0]], scene.positions[T.v[1]],
                                                                   scene.positions[T.v[2]]};
@@ -359,10 +359,10 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
     // they hold fewer (data/cornell: about 20; 2CylinderEngine, whose parts crowd the tree's
     // nodes) the walk is the cheaper way. The answers are the same either way.
     std::optional<OwnSurfaceTree> tree;
-    const bool treePays = treeUse_ == TreeUse::WhereItPays && vertices.size() * 16 >= scene.triangleCount() &&
+    const bool treeAsked = ownSurfaceShortcut_ || staticShortcut_;
+    const bool treePays = treeAsked && treeUse_ == TreeUse::WhereItPays && vertices.size() * 16 >= scene.triangleCount() &&
                           meanOwnSurfaceTriangles(scene, topology, frontNormals, vertices, radius_) >= 64;
-    if ((ownSurfaceShortcut_ || staticShortcut_) && (treeUse_ == TreeUse::Always || treePays))
-        tree.emplace(scene, frontNormals, topology);
+    if (treeAsked && (treeUse_ == TreeUse::Always || treePays)) tree.emplace(scene, frontNormals, topology);
     // Each vertex depends on nothing but the geometry: any schedule gives the same bytes.
     tbb::enumerable_thread_specific<OwnSurfaceScratch> scratch;
     tbb::enumerable_thread_specific<Work> tallies;

@@ -47,9 +47,8 @@ Vec3f decodeOctahedral(uint16_t u, uint16_t v) {
 class FinalGather::Directions {
 public:
     Directions(const VertexStarts& starts, uint32_t v, uint64_t seed)
-        : radius_(VertexSamples(seed, v, VertexStream::Gather).dimension(0)),
-          angle_(VertexSamples(seed, v, VertexStream::Gather).dimension(1)),
-          n_(starts.normal(v)) {
+        : Directions(VertexSamples(seed, v, VertexStream::Gather), starts.normal(v)) {}
+    Directions(const VertexSamples& numbers, const Vec3f& n) : radius_(numbers.dimension(0)), angle_(numbers.dimension(1)), n_(n) {
         orthonormalBasis(n_, t_, b_);
     }
     // Cosine-weighted about n_v (pdf cosθ/π), as cosineHemisphere.
@@ -86,23 +85,23 @@ GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& fr
 
 void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                              const std::vector<Vec3f>& frontNormals, uint32_t v) {
-    GatherHit* hits = &hits_[size_t(v) * rays_];
+    castVertexInto(scene, bvh, starts, frontNormals, v, &hits_[size_t(v) * rays_]);
+}
+
+void FinalGather::castVertexInto(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                                 const std::vector<Vec3f>& frontNormals, uint32_t v, GatherHit* hits) const {
     if (scene.vertexHidden[v]) {
         for (uint32_t j = 0; j < rays_; ++j) hits[j] = GatherHit{};
         return;
     }
     const Directions direction(starts, v, seed_);
-    for (uint32_t j = 0; j < rays_; ++j) hits[j] = castVertexRay(bvh, frontNormals, starts.point(v), direction(j));
-}
-
-GatherHit FinalGather::castVertexRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
-                                     const Vec3f& direction) const {
-    uint16_t u, w;
-    encodeOctahedral(direction, u, w);
-    GatherHit hit = castRay(bvh, frontNormals, origin, decodeOctahedral(u, w));
-    hit.octU = u;
-    hit.octV = w;
-    return hit;
+    for (uint32_t j = 0; j < rays_; ++j) {
+        uint16_t u, w;
+        encodeOctahedral(direction(j), u, w);
+        hits[j] = castRay(bvh, frontNormals, starts.point(v), decodeOctahedral(u, w));
+        hits[j].octU = u;
+        hits[j].octV = w;
+    }
 }
 
 void FinalGather::castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
@@ -172,26 +171,26 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
     return recast;
 }
 
-Vec3d FinalGather::firstPassAt(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit& h) {
-    if (h.triangle >= GatherHit::kBackFace) return Vec3d(0.0);
-    const Triangle& tri = scene.triangles[h.triangle];
-    const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
-    const double w0 = std::max(0.0, 1.0 - w1 - w2);
-    return Vec3d(firstPass[tri.v[0]]) * w0 + Vec3d(firstPass[tri.v[1]]) * w1 + Vec3d(firstPass[tri.v[2]]) * w2;
+Vec3f FinalGather::meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* hits) const {
+    // In ray order, in one thread: the same bits for any schedule. Misses and back faces add
+    // nothing (not even +0).
+    Vec3d sum(0.0);
+    for (uint32_t j = 0; j < rays_; ++j) {
+        const GatherHit& h = hits[j];
+        if (h.triangle >= GatherHit::kBackFace) continue;
+        const Triangle& tri = scene.triangles[h.triangle];
+        const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
+        const double w0 = std::max(0.0, 1.0 - w1 - w2);
+        sum += Vec3d(firstPass[tri.v[0]]) * w0 + Vec3d(firstPass[tri.v[1]]) * w1 + Vec3d(firstPass[tri.v[2]]) * w2;
+    }
+    return Vec3f(sum / double(rays_));
 }
 
 void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const {
     out.assign(scene.vertexCount(), Vec3f(0.0f));
     if (rays_ == 0) return;
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
-        for (uint32_t v = r.begin(); v != r.end(); ++v) {
-            // In ray order, in one thread: the same bits for any schedule.
-            Vec3d sum(0.0);
-            const GatherHit* hits = &hits_[size_t(v) * rays_];
-            for (uint32_t j = 0; j < rays_; ++j)
-                if (hits[j].triangle < GatherHit::kBackFace) sum += firstPassAt(scene, firstPass, hits[j]);
-            out[v] = Vec3f(sum / double(rays_));
-        }
+        for (uint32_t v = r.begin(); v != r.end(); ++v) out[v] = meanOverHits(scene, firstPass, &hits_[size_t(v) * rays_]);
     });
 }
 
@@ -210,13 +209,9 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
         // Embree's, measured 15 % slower on data/cornell refined).
         std::vector<GatherHit> hits(rays_);
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
-            if (scene.vertexHidden[v]) continue;  // castVertex's hits would all be misses: 0
-            const Directions direction(starts, v, seed_);
-            for (uint32_t j = 0; j < rays_; ++j) hits[j] = castVertexRay(bvh, frontNormals, starts.point(v), direction(j));
-            Vec3d sum(0.0);
-            for (uint32_t j = 0; j < rays_; ++j)  // misses and back faces add nothing, not +0
-                if (hits[j].triangle < GatherHit::kBackFace) sum += firstPassAt(scene, firstPass, hits[j]);
-            out[v] = Vec3f(sum / double(rays_));
+            if (scene.vertexHidden[v]) continue;  // all misses: 0
+            castVertexInto(scene, bvh, starts, frontNormals, v, hits.data());
+            out[v] = meanOverHits(scene, firstPass, hits.data());
         }
         if (progress) progress->add(r.size());
     });

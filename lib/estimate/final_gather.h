@@ -52,10 +52,10 @@ public:
 
     // Each vertex's gathered irradiance from the first pass F (per vertex, the current pose's).
     void gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const;
-    // castAll and gather at once, keeping no hit: each ray's hit is summed as it is found, in ray
-    // order — the same bits as castAll then gather — when no frame will update from this one (the
-    // last frame, --full-recompute), so that a frame needs no M hits a vertex of memory. Leaves
-    // nothing to update: hit() and the re-casts need a castAll first.
+    // castAll and gather at once, keeping no hit: each vertex's hits are cast into a buffer of M
+    // and summed at once, in ray order — the same bits as castAll then gather — when no frame will
+    // update from this one (the last frame, --full-recompute), so that a frame needs no M hits a
+    // vertex of memory. Leaves nothing to update: hit() and the re-casts need a castAll first.
     void castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                        const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out, WorkCounter* progress = nullptr);
 
@@ -70,16 +70,16 @@ public:
 
 private:
     class Directions;
-    // F interpolated at a kept hit (0 for a miss or a back face), in double.
-    static Vec3d firstPassAt(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit& hit);
+    // The mean over a vertex's M hits of F interpolated at each (gather's sum, castAndGather's).
+    Vec3f meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* hits) const;
     GatherHit castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                       const Vec3f& direction) const;
     void castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                     const std::vector<Vec3f>& frontNormals, uint32_t v);
-    // One of a vertex's rays along its Sobol direction, as kept: the direction stored in 16-bit
-    // octahedral form and the ray cast along that decoded direction.
-    GatherHit castVertexRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
-                            const Vec3f& direction) const;
+    // A vertex's M rays along its Sobol directions, into `hits`: each direction stored in 16-bit
+    // octahedral form and the ray cast along that decoded direction (a hidden vertex: misses).
+    void castVertexInto(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                        const std::vector<Vec3f>& frontNormals, uint32_t v, GatherHit* hits) const;
 
     uint32_t rays_;
     uint64_t seed_;

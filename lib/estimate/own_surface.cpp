@@ -210,15 +210,14 @@ OwnSurface findOwnSurface(uint32_t v, const Scene& scene, const MeshTopology& to
     // already rise a whole epsilon, v sits in a hollow whose wall the tree would find only to
     // send v to the walk: it goes there at once. The answer is the walk's either way.
     if (query.tree && !query.depthBelow && level(highest) == 0) {
-        const double current = level(highest);
         // The walk's cylinder, in v's frame, lies within r√2 of v — but the frame is built on a
         // float normal, a few 1e-8 off unit length: the ball is widened far past that.
         const double reach = r * std::sqrt(2.0) * (1 + 1e-5);
-        const bool rises = query.tree->anyRising(query.tree->pieceOfVertex(v), origin, n, double(kOwnSurfaceCos), reach, (current + 0.5) * eps,
+        const bool rises = query.tree->anyRising(query.tree->pieceOfVertex(v), origin, n, double(kOwnSurfaceCos), reach, 0.5 * eps,
                                                  [&](uint32_t tri) {
                                                      if (scratch.visitedStamp[tri] == stamp) return false;
                                                      double lo, hi;
-                                                     return qualifies(tri, lo, hi) && level(hi) > current;
+                                                     return qualifies(tri, lo, hi) && level(hi) > 0;
                                                  });
         own.provedByTree = !rises;
         if (!rises) return finish();

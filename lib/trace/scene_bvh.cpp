@@ -216,16 +216,13 @@ struct NearQuery {
     uint32_t visited = 0;
 };
 
-// Past this many triangles near, the query answers "rises" without looking further: where it is
-// asked (the disc regions' shortcut) tracing the rays is then the cheaper way to the same answer.
-constexpr uint32_t kMostTrianglesVisited = 2048;
 
 // Called for the static triangles whose BVH boxes meet the query ball: one whose own box does,
 // with a corner at the query's height or above, ends the search.
 bool risesNear(RTCPointQueryFunctionArguments* args) {
     auto* q = static_cast<NearQuery*>(args->userPtr);
     if (q->found) return false;
-    if (++q->visited > kMostTrianglesVisited) {
+    if (++q->visited > SceneBvh::kMostTrianglesNear) {
         q->found = true;
         args->query->radius = 0;
         return true;

@@ -78,6 +78,9 @@ public:
     // height −∞, any ray within the ball. Past 2048 triangles near it says true without looking
     // further (a bound on its cost: a conservative answer).
     bool staticGeometryRises(const Vec3f& centre, float radius, const Vec3f& normal, double height) const;
+    // How many triangles near staticGeometryRises looks at before it says "rises": where it is
+    // asked (the disc regions' shortcut) tracing the rays is then the cheaper way to the answer.
+    static constexpr uint32_t kMostTrianglesNear = 2048;
     // True if the dynamic geometry alone blocks the ray within (tnear, tfar].
     bool dynamicOccludes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // The same, counting only the triangles flagged in triangleMoved (by scene triangle).
