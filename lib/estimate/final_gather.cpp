@@ -83,46 +83,120 @@ GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& fr
     return out;
 }
 
-void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
-                             const std::vector<Vec3f>& frontNormals, uint32_t v) {
-    castVertexInto(scene, bvh, starts, frontNormals, v, &hits_[size_t(v) * rays_]);
-}
-
 void FinalGather::castVertexInto(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
-                                 const std::vector<Vec3f>& frontNormals, uint32_t v, GatherHit* hits) const {
+                                 const std::vector<Vec3f>& frontNormals, uint32_t v, uint32_t first, uint32_t count,
+                                 GatherHit* hits) const {
     if (scene.vertexHidden[v]) {
-        for (uint32_t j = 0; j < rays_; ++j) hits[j] = GatherHit{};
+        for (uint32_t j = 0; j < count; ++j) hits[j] = GatherHit{};
         return;
     }
     const Directions direction(starts, v, seed_);
-    for (uint32_t j = 0; j < rays_; ++j) {
+    for (uint32_t j = 0; j < count; ++j) {
         uint16_t u, w;
-        encodeOctahedral(direction(j), u, w);
+        encodeOctahedral(direction(first + j), u, w);
         hits[j] = castRay(bvh, frontNormals, starts.point(v), decodeOctahedral(u, w));
         hits[j].octU = u;
         hits[j].octV = w;
     }
 }
 
+void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                             const std::vector<Vec3f>& frontNormals, uint32_t v) {
+    castVertexInto(scene, bvh, starts, frontNormals, v, 0, probes_, &probeHits_[size_t(v) * probes_]);
+    if (cached() && restSlot_[v] != kNoSlot)
+        castVertexInto(scene, bvh, starts, frontNormals, v, probes_, rays_ - probes_, restOf(v));
+}
+
+void FinalGather::clear() {
+    probeHits_ = {};
+    restHits_ = {};
+    restSlot_ = {};
+    freeSlots_ = {};
+}
+
 void FinalGather::castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
-    hits_.assign(scene.vertexCount() * size_t(rays_), GatherHit{});
+    clear();
+    probeHits_.assign(scene.vertexCount() * size_t(probes_), GatherHit{});
+    if (cached()) restSlot_.assign(scene.vertexCount(), kNoSlot);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
     if (progress) progress->setTotal(scene.vertexCount());
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), [&](const tbb::blocked_range<uint32_t>& r) {
         for (uint32_t v = r.begin(); v != r.end(); ++v) castVertex(scene, bvh, starts, frontNormals, v);
         if (progress) progress->add(r.size());
     });
-    raysCast_ = uint64_t(scene.vertexCount()) * rays_;
+    raysCast_ = uint64_t(scene.vertexCount()) * probes_;
 }
 
 void FinalGather::cast(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint32_t>& vertices) {
     if (vertices.empty()) return;
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) castVertex(scene, bvh, starts, frontNormals, vertices[i]);
-    });
-    raysCast_ += uint64_t(vertices.size()) * rays_;
+    const uint64_t cast = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, vertices.size(), 4), uint64_t(0),
+        [&](const tbb::blocked_range<size_t>& r, uint64_t count) {
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                castVertex(scene, bvh, starts, frontNormals, vertices[i]);
+                count += hasAllRays(vertices[i]) ? rays_ : probes_;
+            }
+            return count;
+        },
+        [](uint64_t a, uint64_t b) { return a + b; });
+    raysCast_ += cast;
 }
+
+void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint8_t>& record) {
+    if (!cached()) return;
+    // Slots first, in vertex order (which slot a record holds changes no bit: its sum is its own).
+    std::vector<uint32_t> added;
+    for (uint32_t v = 0; v < record.size(); ++v) {
+        if (!record[v] && restSlot_[v] != kNoSlot) {
+            freeSlots_.push_back(restSlot_[v]);
+            restSlot_[v] = kNoSlot;
+        }
+    }
+    const size_t rest = rays_ - probes_;
+    for (uint32_t v = 0; v < record.size(); ++v) {
+        if (!record[v] || restSlot_[v] != kNoSlot) continue;
+        if (!freeSlots_.empty()) {
+            restSlot_[v] = freeSlots_.back();
+            freeSlots_.pop_back();
+        } else {
+            restSlot_[v] = uint32_t(restHits_.size() / rest);
+            restHits_.resize(restHits_.size() + rest);
+        }
+        added.push_back(v);
+    }
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, added.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i)
+            castVertexInto(scene, bvh, starts, frontNormals, added[i], probes_, uint32_t(rest), restOf(added[i]));
+    });
+    raysCast_ += uint64_t(added.size()) * rest;
+}
+
+namespace {
+// Re-casts the rays of `hits` (leaving `origin`, each along its kept direction) whose segment
+// meets one of `ahead`; returns how many.
+template <typename Cast>
+uint64_t recastSpanMeeting(const Vec3f& origin, const std::vector<const Bounds3f*>& ahead, GatherHit* hits, size_t count,
+                           Cast&& castRay) {
+    uint64_t recast = 0;
+    for (size_t j = 0; j < count; ++j) {
+        const Vec3f d = FinalGather::rayDirection(hits[j]);
+        bool meets = false;
+        for (const Bounds3f* box : ahead) {
+            double t0 = 0, t1 = double(hits[j].t);
+            if ((meets = box->clip(origin, d, t0, t1))) break;
+        }
+        if (!meets) continue;
+        const uint16_t u = hits[j].octU, w = hits[j].octV;
+        hits[j] = castRay(d);
+        hits[j].octU = u;
+        hits[j].octV = w;
+        ++recast;
+    }
+    return recast;
+}
+}  // namespace
 
 uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                                     const std::vector<Bounds3f>& boxes, const std::vector<uint8_t>& skip) {
@@ -148,21 +222,10 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
                     if (reach >= 0) ahead.push_back(&box);
                 }
                 if (ahead.empty()) continue;
-                GatherHit* hits = &hits_[size_t(v) * rays_];
-                for (uint32_t j = 0; j < rays_; ++j) {
-                    const Vec3f d = decodeOctahedral(hits[j].octU, hits[j].octV);
-                    bool meets = false;
-                    for (const Bounds3f* box : ahead) {
-                        double t0 = 0, t1 = double(hits[j].t);
-                        if ((meets = box->clip(origin, d, t0, t1))) break;
-                    }
-                    if (!meets) continue;
-                    const uint16_t u = hits[j].octU, w = hits[j].octV;
-                    hits[j] = castRay(bvh, frontNormals, origin, d);
-                    hits[j].octU = u;
-                    hits[j].octV = w;
-                    ++count;
-                }
+                auto recastAlong = [&](const Vec3f& d) { return castRay(bvh, frontNormals, origin, d); };
+                count += recastSpanMeeting(origin, ahead, &probeHits_[size_t(v) * probes_], probes_, recastAlong);
+                if (cached() && restSlot_[v] != kNoSlot)
+                    count += recastSpanMeeting(origin, ahead, restOf(v), rays_ - probes_, recastAlong);
             }
             return count;
         },
@@ -171,12 +234,13 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
     return recast;
 }
 
-Vec3f FinalGather::meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* hits) const {
-    // In ray order, in one thread: the same bits for any schedule. Misses and back faces add
-    // nothing (not even +0).
+Vec3f FinalGather::meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* probes,
+                                const GatherHit* rest) const {
+    // In ray order, in one thread: the same bits for any schedule, and with or without a cache.
+    // Misses and back faces add nothing (not even +0).
     Vec3d sum(0.0);
     for (uint32_t j = 0; j < rays_; ++j) {
-        const GatherHit& h = hits[j];
+        const GatherHit& h = j < probes_ ? probes[j] : rest[j - probes_];
         if (h.triangle >= GatherHit::kBackFace) continue;
         const Triangle& tri = scene.triangles[h.triangle];
         const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
@@ -190,14 +254,17 @@ void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass
     out.assign(scene.vertexCount(), Vec3f(0.0f));
     if (rays_ == 0) return;
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
-        for (uint32_t v = r.begin(); v != r.end(); ++v) out[v] = meanOverHits(scene, firstPass, &hits_[size_t(v) * rays_]);
+        for (uint32_t v = r.begin(); v != r.end(); ++v) {
+            if (!hasAllRays(v)) continue;
+            const GatherHit* rest = cached() ? &restHits_[size_t(restSlot_[v]) * (rays_ - probes_)] : nullptr;
+            out[v] = meanOverHits(scene, firstPass, &probeHits_[size_t(v) * probes_], rest);
+        }
     });
 }
 
 void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                                 const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out, WorkCounter* progress) {
-    hits_.clear();
-    hits_.shrink_to_fit();
+    clear();
     out.assign(scene.vertexCount(), Vec3f(0.0f));
     raysCast_ = 0;
     if (rays_ == 0) return;
@@ -210,8 +277,8 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
         std::vector<GatherHit> hits(rays_);
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             if (scene.vertexHidden[v]) continue;  // all misses: 0
-            castVertexInto(scene, bvh, starts, frontNormals, v, hits.data());
-            out[v] = meanOverHits(scene, firstPass, hits.data());
+            castVertexInto(scene, bvh, starts, frontNormals, v, 0, rays_, hits.data());
+            out[v] = meanOverHits(scene, firstPass, hits.data(), hits.data() + probes_);
         }
         if (progress) progress->add(r.size());
     });

@@ -15,6 +15,7 @@
 // summed per vertex in ray order, so updates and full recomputations agree to the bit.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -39,51 +40,80 @@ static_assert(sizeof(GatherHit) == 16, "the kept hit's size, as the docs state i
 
 class FinalGather {
 public:
-    FinalGather(uint32_t raysPerVertex, uint64_t seed) : rays_(raysPerVertex), seed_(seed) {}
+    // probeRays: with a gather cache (GatherCache), the rays every vertex casts (the first of its
+    // M): the records cast the rest. 0, or M or more: every vertex casts all M (no cache).
+    FinalGather(uint32_t raysPerVertex, uint64_t seed, uint32_t probeRays = 0)
+        : rays_(raysPerVertex), probes_(probeRays == 0 ? raysPerVertex : std::min(probeRays, raysPerVertex)), seed_(seed) {}
 
-    // Every vertex's rays, for the scene's current pose (bvh holds it).
+    // Every vertex's first probeRays() rays, for the scene's current pose (bvh holds it); no
+    // vertex is a record until setRecords (without a cache, every vertex has all its rays).
     void castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress = nullptr);
-    // Every ray of the given vertices (their start or normal changed).
+    // Every kept ray of the given vertices (their start or normal changed).
     void cast(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint32_t>& vertices);
-    // Re-casts the rays of the other vertices (skip[v] = 0) whose segment meets one of `boxes`;
-    // returns how many.
+    // Re-casts the kept rays of the other vertices (skip[v] = 0) whose segment meets one of
+    // `boxes`; returns how many.
     uint64_t recastMeeting(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                            const std::vector<Bounds3f>& boxes, const std::vector<uint8_t>& skip);
+    // With a cache: the vertices with record[v] set cast the rest of their M rays (those that
+    // already had them keep them), the others drop theirs.
+    void setRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint8_t>& record);
 
-    // Each vertex's gathered irradiance from the first pass F (per vertex, the current pose's).
+    // Each vertex's gathered irradiance from the first pass F (per vertex, the current pose's);
+    // 0 at a vertex that does not have all M rays (a cache interpolates those).
     void gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const;
     // castAll and gather at once, keeping no hit: each vertex's hits are cast into a buffer of M
     // and summed at once, in ray order — the same bits as castAll then gather — when no frame will
     // update from this one (the last frame, --full-recompute), so that a frame needs no M hits a
     // vertex of memory. Leaves nothing to update: hit() and the re-casts need a castAll first.
+    // Without a cache only.
     void castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                        const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out, WorkCounter* progress = nullptr);
+    // Drops every kept hit.
+    void clear();
 
     uint32_t raysPerVertex() const { return rays_; }
+    uint32_t probeRays() const { return probes_; }
+    bool cached() const { return probes_ < rays_; }
     // The direction a kept hit's ray was cast along (decoded from its 16-bit octahedral form).
     static Vec3f rayDirection(const GatherHit& hit);
-    const GatherHit& hit(uint32_t v, uint32_t ray) const { return hits_[size_t(v) * rays_ + ray]; }
-    // Rays cast by the last castAll(), or by cast() and recastMeeting() since the last castAll().
+    // Ray `ray` of v: one of its probes, or (a record's) one of the rest.
+    const GatherHit& hit(uint32_t v, uint32_t ray) const {
+        return ray < probes_ ? probeHits_[size_t(v) * probes_ + ray] : restHits_[size_t(restSlot_[v]) * (rays_ - probes_) + ray - probes_];
+    }
+    bool hasAllRays(uint32_t v) const { return !cached() || restSlot_[v] != kNoSlot; }
+    // Rays cast by the last castAll(), or by cast(), recastMeeting() and setRecords() since then.
     uint64_t raysCast() const { return raysCast_; }
     void resetRayCount() { raysCast_ = 0; }
-    size_t bytes() const { return hits_.capacity() * sizeof(GatherHit); }
+    size_t bytes() const {
+        return (probeHits_.capacity() + restHits_.capacity()) * sizeof(GatherHit) + restSlot_.capacity() * sizeof(uint32_t);
+    }
 
 private:
     class Directions;
-    // The mean over a vertex's M hits of F interpolated at each (gather's sum, castAndGather's).
-    Vec3f meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* hits) const;
+    static constexpr uint32_t kNoSlot = UINT32_MAX;
+    // The mean over a vertex's M hits (first its probes, then the rest, in ray order) of F
+    // interpolated at each (gather's sum, castAndGather's).
+    Vec3f meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* probes,
+                       const GatherHit* rest) const;
     GatherHit castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                       const Vec3f& direction) const;
+    // Rays [first, first + count) of v along its Sobol directions, into `hits`: each direction
+    // stored in 16-bit octahedral form and the ray cast along that decoded direction (a hidden
+    // vertex: misses).
+    void castVertexInto(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                        const std::vector<Vec3f>& frontNormals, uint32_t v, uint32_t first, uint32_t count,
+                        GatherHit* hits) const;
+    // Every kept ray of v.
     void castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                     const std::vector<Vec3f>& frontNormals, uint32_t v);
-    // A vertex's M rays along its Sobol directions, into `hits`: each direction stored in 16-bit
-    // octahedral form and the ray cast along that decoded direction (a hidden vertex: misses).
-    void castVertexInto(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
-                        const std::vector<Vec3f>& frontNormals, uint32_t v, GatherHit* hits) const;
+    GatherHit* restOf(uint32_t v) { return &restHits_[size_t(restSlot_[v]) * (rays_ - probes_)]; }
 
-    uint32_t rays_;
+    uint32_t rays_, probes_;
     uint64_t seed_;
-    std::vector<GatherHit> hits_;  // vertex-major
+    std::vector<GatherHit> probeHits_;  // vertex-major, probes_ a vertex
+    // The records' other rays_ - probes_ hits, in slots; restSlot_[v] is v's slot or kNoSlot.
+    std::vector<GatherHit> restHits_;
+    std::vector<uint32_t> restSlot_, freeSlots_;
     uint64_t raysCast_ = 0;
 };
 

@@ -24,9 +24,15 @@ struct LightingSettings {
     uint32_t directSamples = 16;
     // Final-gather rays per vertex (0: no gather).
     uint32_t gatherRays = 0;
+    // The gather cache's tolerance a (GatherCache: records spaced a times the distance to the
+    // geometry around them; 0: every vertex a record, the per-vertex gather's bits), or
+    // kGatherCacheOff: every vertex gathers, no probes, no records.
+    float gatherCache = kGatherCacheOff;
+    static constexpr float kGatherCacheOff = -1;
 
     bool exactDirect() const { return direct == DirectLighting::Exact; }
     bool gathers() const { return exactDirect() && gatherRays > 0; }
+    bool cachesGather() const { return gathers() && gatherCache >= 0; }
 };
 
 // Limits of the options: a vertex's samples are points of one Sobol sequence, indexed by 32 bits.

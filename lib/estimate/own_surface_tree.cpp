@@ -22,21 +22,7 @@ double boxMaxDot(const Bounds3f& box, const Vec3d& d) {
 }  // namespace
 
 OwnSurfaceTree::OwnSurfaceTree(const Scene& scene, const std::vector<Vec3f>& frontNormals, const MeshTopology& topology) {
-    // Pieces: union–find over welded vertices, each triangle joining its three corners; a piece
-    // is named by its smallest welded vertex id, so the numbering depends on the geometry alone.
-    std::vector<uint32_t> parent(scene.vertexCount());
-    for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = topology.weldedId(v);
-    auto root = [&](uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-    };
-    for (const Triangle& T : scene.triangles)
-        for (int k = 1; k < 3; ++k) {
-            const uint32_t a = root(T.v[0]), b = root(T.v[k]);
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
-        }
-    vertexPiece_.resize(scene.vertexCount());
-    for (uint32_t v = 0; v < vertexPiece_.size(); ++v) vertexPiece_[v] = root(v);
+    vertexPiece_ = topology.vertexPieces(scene.triangles);
     trianglePiece_.resize(scene.triangleCount());
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) trianglePiece_[t] = vertexPiece_[scene.triangles[t].v[0]];
     if (scene.triangleCount() == 0) return;

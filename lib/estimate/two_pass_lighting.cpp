@@ -7,10 +7,21 @@
 namespace qsgi {
 
 TwoPassLighting::TwoPassLighting(const LightingSettings& settings, uint64_t seed)
-    : settings_(settings), direct_(settings.directSamples, seed), gather_(settings.gathers() ? settings.gatherRays : 0, seed) {}
+    : settings_(settings),
+      direct_(settings.directSamples, seed),
+      gather_(settings.gathers() ? settings.gatherRays : 0, seed, settings.cachesGather() ? GatherCache::kProbeRays : 0) {
+    if (settings.cachesGather()) cache_.emplace(settings.gatherCache);
+}
 
 size_t TwoPassLighting::stateBytes() const {
-    return starts_.size() * 2 * sizeof(Vec3f) + direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes();
+    return starts_.size() * 2 * sizeof(Vec3f) + direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes() + (cache_ ? cache_->bytes() : 0);
+}
+
+void TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats) {
+    if (!cache_) return;
+    cache_->select(scene, starts_, gather_);
+    gather_.setRecords(scene, bvh, starts_, cache_->records());
+    stats.gatherRecords = cache_->recordCount();
 }
 
 void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const VertexRadiosity& photons,
@@ -22,7 +33,7 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     stats.directSeconds = clock.seconds();
     stats.shadowRays = direct_.raysCast();
     clock.restart();
-    if (settings_.gathers() && !keepForUpdates) {
+    if (settings_.gathers() && !keepForUpdates && !cache_) {
         if (progress) progress->start("gathering", scene.vertexCount());
         gather_.castAndGather(scene, bvh, starts_, firstPass(scene, photons), out.irradiance, progress);
         stats.gatherRays = gather_.raysCast();
@@ -34,11 +45,13 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     if (settings_.gathers()) {
         if (progress) progress->start("gathering", scene.vertexCount());
         gather_.castAll(scene, bvh, starts_, progress);
+        placeRecords(scene, bvh, stats);
         stats.gatherRays = gather_.raysCast();
     }
     combine(scene, photons, out);
     stats.gatherSeconds = clock.seconds();
-    solved_ = true;
+    solved_ = keepForUpdates;
+    if (!keepForUpdates) gather_.clear();
 }
 
 void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const MovedGeometry& moved,
@@ -67,6 +80,7 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Disc
         std::vector<uint8_t> skip(scene.vertexCount(), 0);
         for (uint32_t v : newStarts) skip[v] = 1;
         gather_.recastMeeting(scene, bvh, starts_, boxes, skip);
+        placeRecords(scene, bvh, stats);
         stats.gatherRays = gather_.raysCast();
     }
     combine(scene, photons, out);
@@ -95,6 +109,7 @@ void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons
     out.irradiance.resize(n);
     if (settings_.gathers()) {
         gather_.gather(scene, firstPass(scene, photons), out.irradiance);
+        if (cache_) cache_->interpolate(out.irradiance);
         addDirect(scene, out);
         return;
     }

@@ -14,6 +14,7 @@
 
 #include "estimate/direct_light.h"
 #include "estimate/final_gather.h"
+#include "estimate/gather_cache.h"
 #include "estimate/lighting_settings.h"
 #include "estimate/vertex_radiosity.h"
 #include "estimate/vertex_starts.h"
@@ -48,8 +49,10 @@ public:
     bool solved() const { return solved_; }
     void reset() { solved_ = false; }
 
-    // Bytes kept across frames (starts, direct light, gather hits).
+    // Bytes kept across frames (starts, direct light, gather hits, the cache's records and weights).
     size_t stateBytes() const;
+    // The gather cache of the last solve or update (nullptr without one).
+    const GatherCache* gatherCache() const { return cache_ ? &*cache_ : nullptr; }
 
 private:
     void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const;
@@ -57,11 +60,14 @@ private:
     std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons) const;
     // E = D + the gathered mean, and B.
     void addDirect(const Scene& scene, VertexRadiosity& out) const;
+    // With the cache: the records for the current pose, and the rest of their rays.
+    void placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats);
 
     LightingSettings settings_;
     VertexStarts starts_;
     DirectLight direct_;
     FinalGather gather_;
+    std::optional<GatherCache> cache_;  // with --gather-cache A
     bool solved_ = false;
 };
 

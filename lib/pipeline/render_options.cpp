@@ -209,7 +209,7 @@ static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was add
 static_assert(fieldCount<EstimatorSettings>() == 6, "an EstimatorSettings field was added or removed: give it an option");
 static_assert(fieldCount<PhotonMapSettings>() == 1, "a PhotonMapSettings field was added or removed: give it an option");
 static_assert(fieldCount<DetpSettings>() == 2, "a DetpSettings field was added or removed: give it an option");
-static_assert(fieldCount<LightingSettings>() == 3, "a LightingSettings field was added or removed: give it an option");
+static_assert(fieldCount<LightingSettings>() == 4, "a LightingSettings field was added or removed: give it an option");
 static_assert(fieldCount<EnvironmentSettings>() == 5, "an EnvironmentSettings field was added or removed: give it an option");
 static_assert(fieldCount<UpdateSettings>() == 5, "an UpdateSettings field was added or removed: give it an option");
 
@@ -314,6 +314,25 @@ std::vector<RenderOption> declareOptions() {
                      s.gatherGiven = true;
                  },
                  [](const RenderSettings& s) { return orNull(s.lighting.exactDirect(), json(s.lighting.gatherRays)); }});
+    o.push_back({"gather_cache", "--gather-cache", T::Object, 0, 0, "", {}, true, "off|A", "off",
+                 "with a gather: full gathers only at records spaced A times the distance to the geometry around "
+                 "them (crowding at contacts and edges), every other vertex interpolated from the records it "
+                 "reaches across its own surface (docs/method.md, the gather cache); A a number in [0, 1], 0 "
+                 "every vertex a record (the per-vertex gather's bytes); off: every vertex gathers",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     if (v.is_string() && v.get<std::string>() == "off") {
+                         s.lighting.gatherCache = LightingSettings::kGatherCacheOff;
+                         return;
+                     }
+                     if (!v.is_number() || !(v.get<double>() >= 0 && v.get<double>() <= 1))
+                         throw InputError(src.file, src.place, "must be off or a number in [0, 1] (the cache's tolerance)");
+                     s.lighting.gatherCache = v.get<float>();
+                 },
+                 [](const RenderSettings& s) {
+                     if (!s.lighting.gathers()) return json(nullptr);
+                     return s.lighting.cachesGather() ? json(s.lighting.gatherCache) : json("off");
+                 }});
     // Frames after the first
     o.push_back({"full_recompute", "--full-recompute", T::Boolean, 0, 0, "", {}, true, "", "false",
                  "compute every frame from scratch instead of updating the previous one (the same bytes; the "

@@ -54,4 +54,21 @@ MeshTopology::MeshTopology(const std::vector<Vec3f>& positions, const std::vecto
         forEachDistinctCorner(triangles[t], [&](uint32_t w) { incident_[fill[w]++] = t; });
 }
 
+std::vector<uint32_t> MeshTopology::vertexPieces(const std::vector<Triangle>& triangles) const {
+    // Union–find over welded ids, each triangle joining its three corners; the smaller root wins.
+    std::vector<uint32_t> parent(welded_);
+    auto root = [&](uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (const Triangle& T : triangles)
+        for (int k = 1; k < 3; ++k) {
+            const uint32_t a = root(T.v[0]), b = root(T.v[k]);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+    std::vector<uint32_t> pieces(parent.size());
+    for (uint32_t v = 0; v < pieces.size(); ++v) pieces[v] = root(v);
+    return pieces;
+}
+
 }  // namespace qsgi

@@ -21,6 +21,9 @@ public:
     // Triangles that have a vertex at v's position, in increasing order.
     const uint32_t* trianglesBegin(uint32_t v) const { return &incident_[first_[welded_[v]]]; }
     const uint32_t* trianglesEnd(uint32_t v) const { return &incident_[first_[welded_[v] + 1]]; }
+    // Each vertex's piece of surface: the vertices joined to it through triangles and welds, named
+    // by the piece's smallest vertex index, so the numbering depends on the geometry alone.
+    std::vector<uint32_t> vertexPieces(const std::vector<Triangle>& triangles) const;
 
 private:
     std::vector<uint32_t> welded_;

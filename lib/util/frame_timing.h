@@ -57,6 +57,9 @@ struct FrameTiming {
     // frame for exact direct light and for the final gather (which includes combining the passes).
     double directSeconds = 0, gatherSeconds = 0;
     uint64_t shadowRays = 0, gatherRays = 0;
+    // With the gather cache (--gather-cache A): the vertices that gathered all M rays (the rest
+    // are interpolated; 0 without the cache).
+    uint64_t gatherRecords = 0;
     // The frame's files as written, which --resume verifies before it trusts them ("files" in
     // timing.json; not a timing, so not in forEachTimingField's list).
     std::vector<FileRecord> files;
@@ -105,6 +108,7 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("shadow_rays", f.shadowRays);
     visit("gather_s", f.gatherSeconds);
     visit("gather_rays", f.gatherRays);
+    visit("gather_records", f.gatherRecords);
 }
 
 }  // namespace qsgi
