@@ -31,11 +31,21 @@ int majorAxis(const Vec3f& n) {
 // The vertices sharing a triangle with each vertex's (welded) position, its welded twins included
 // (at distance 0), each once, with the edge's length: the graph the records' light spreads over.
 struct GatherCache::Adjacency {
+    // Each edge is tested from both ends, in the same direction (from the smaller index), so
+    // the graph stays symmetric.
+    static bool seeEachOther(const SceneBvh& bvh, const VertexStarts& starts, uint32_t a, uint32_t b) {
+        if (a > b) std::swap(a, b);
+        const Vec3f d = starts.point(b) - starts.point(a);
+        const float distance = length(d);
+        if (!(distance > 0)) return true;
+        return !bvh.occluded(starts.point(a), d / distance, 0.0f, distance);
+    }
+
     std::vector<uint32_t> first;  // CSR offsets by vertex
     std::vector<uint32_t> vertex;
     std::vector<float> edge;  // its length
 
-    Adjacency(const Scene& scene, const MeshTopology& topology) {
+    Adjacency(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const MeshTopology& topology) {
         const uint32_t n = uint32_t(scene.vertexCount());
         std::vector<std::vector<uint32_t>> lists(n);
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 256), [&](const tbb::blocked_range<uint32_t>& r) {
@@ -47,6 +57,10 @@ struct GatherCache::Adjacency {
                         if (u != v && !scene.vertexHidden[u]) list.push_back(u);
                 std::sort(list.begin(), list.end());
                 list.erase(std::unique(list.begin(), list.end()), list.end());
+                // An edge whose start points do not see each other passes under something — a
+                // partition standing across the triangle, a block's foot — and carries no light.
+                list.erase(std::remove_if(list.begin(), list.end(), [&](uint32_t u) { return !seeEachOther(bvh, starts, v, u); }),
+                           list.end());
             }
         });
         first.assign(n + 1, 0);
@@ -66,8 +80,8 @@ struct GatherCache::Adjacency {
 namespace {
 }  // namespace
 
-float GatherCache::weight(const Label& label, const Vec3f& normal) const {
-    const float reach = reach_[label.record];
+float GatherCache::weight(const Label& label, const Vec3f& normal, float spacing) const {
+    const float reach = std::min(reach_[label.record], spacing);
     const float closeness = (dot(normal, normal_[label.record]) - kMinNormalDot) / (1 - kMinNormalDot);
     if (!(closeness > 0)) return 0;
     if (label.distance <= 1e-6f * reach) return 1e12f * closeness;  // at the record itself
@@ -109,13 +123,17 @@ void GatherCache::flood(const Scene& scene, const VertexStarts& starts, const Ad
             const Event e = queue.top();
             queue.pop();
             if (settled[e.vertex] == kRecordsPerVertex || has(e.vertex, e.record)) continue;
+            // A vertex reads records no farther than its own spacing (it is that far from what
+            // shapes its light): the split sphere both ways. None passes through a vertex
+            // crowded by geometry — the foot of a wall or a block.
+            if (e.record != e.vertex && !(e.distance < spacing_[e.vertex])) continue;
             labels_[size_t(e.vertex) * kRecordsPerVertex + settled[e.vertex]++] = Label{e.record, e.distance};
             const float reach = reach_[e.record];
             const Vec3f& normal = normal_[e.record];
             for (uint32_t i = adjacency.first[e.vertex]; i < adjacency.first[e.vertex + 1]; ++i) {
                 const uint32_t u = adjacency.vertex[i];
                 const float d = e.distance + adjacency.edge[i];
-                if (!(d < reach) || settled[u] == kRecordsPerVertex) continue;
+                if (!(d < reach) || !(d < spacing_[u]) || settled[u] == kRecordsPerVertex) continue;
                 if (!(dot(starts.normal(u), normal) > kMinNormalDot) || has(u, e.record)) continue;
                 queue.push({d, e.record, u});
             }
@@ -123,7 +141,7 @@ void GatherCache::flood(const Scene& scene, const VertexStarts& starts, const Ad
     });
 }
 
-void GatherCache::select(const Scene& scene, const VertexStarts& starts, const FinalGather& rays) {
+void GatherCache::select(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const FinalGather& rays) {
     const uint32_t n = uint32_t(scene.vertexCount());
     const uint32_t probes = rays.probeRays();
     const double diagonal = std::max(double(scene.animationBounds.extent()), 1e-30);
@@ -149,7 +167,7 @@ void GatherCache::select(const Scene& scene, const VertexStarts& starts, const F
     // the asking vertex nearest the cell's centre.
     const MeshTopology topology(scene.positions, scene.triangles);
     const std::vector<uint32_t> pieces = topology.vertexPieces(scene.triangles);
-    const Adjacency adjacency(scene, topology);
+    const Adjacency adjacency(scene, bvh, starts, topology);
     record_.assign(n, 0);
     reach_.assign(n, 0.0f);
     struct Ask {
@@ -182,26 +200,28 @@ void GatherCache::select(const Scene& scene, const VertexStarts& starts, const F
         return std::tie(a.cell, a.offCentre, a.vertex) < std::tie(b.cell, b.offCentre, b.vertex);
     });
     std::vector<uint32_t> sources;
+    // Every asker of a cell asks at the cell's level, so the one chosen reaches (its own R, as
+    // Ward's records) at least the cell's diagonal: every other asker, as the crow flies.
     for (size_t i = 0; i < asks.size();) {
-        const uint32_t rep = asks[i].vertex;
+        record_[asks[i].vertex] = 1;
         size_t j = i;
-        for (; j < asks.size() && asks[j].cell == asks[i].cell; ++j)
-            reach_[rep] = std::max(reach_[rep], spacing_[asks[j].vertex]);
-        record_[rep] = 1;
+        while (j < asks.size() && asks[j].cell == asks[i].cell) ++j;
         i = j;
     }
+    for (uint32_t v = 0; v < n; ++v)
+        if (record_[v]) reach_[v] = spacing_[v];
     for (uint32_t v = 0; v < n; ++v)
         if (record_[v]) sources.push_back(v);
     flood(scene, starts, adjacency, pieces, sources);
 
-    // A vertex no record reaches with any weight becomes one, reaching as far as it asked.
+    // A vertex no record reaches with any weight (across a fold, a crease, a gap) becomes one.
     bool added = false;
     for (uint32_t v = 0; v < n; ++v) {
         if (scene.vertexHidden[v] || record_[v]) continue;
         float total = 0;
         for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
             const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
-            if (label.record != UINT32_MAX) total += weight(label, starts.normal(v));
+            if (label.record != UINT32_MAX) total += weight(label, starts.normal(v), spacing_[v]);
         }
         if (total > 0) continue;
         record_[v] = 1;
@@ -227,7 +247,7 @@ void GatherCache::interpolate(std::vector<Vec3f>& irradiance) const {
             for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
                 const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
                 if (label.record == UINT32_MAX) break;
-                const double w = weight(label, normal_[v]);
+                const double w = weight(label, normal_[v], spacing_[v]);
                 if (w <= 0) continue;
                 sum += Vec3d(irradiance[label.record]) * w;
                 total += w;
@@ -244,37 +264,42 @@ Vec3f GatherCache::irradianceAt(const Scene& scene, uint32_t triangle, float b1,
     const float b[3] = {std::max(0.0f, 1 - b1 - b2), b1, b2};
     const Vec3f p = scene.positions[tri.v[0]] * b[0] + scene.positions[tri.v[1]] * b[1] + scene.positions[tri.v[2]] * b[2];
     const Vec3f normal = normalize(normal_[tri.v[0]] * b[0] + normal_[tri.v[1]] * b[1] + normal_[tri.v[2]] * b[2]);
-    // The records the corners read, each at its distance through the nearest corner.
-    std::vector<Label> candidates;
-    for (int c = 0; c < 3; ++c) {
-        const uint32_t corner = tri.v[c];
-        const float toCorner = length(p - scene.positions[corner]);
-        for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
-            const Label& label = labels_[size_t(corner) * kRecordsPerVertex + i];
-            if (label.record == UINT32_MAX) break;
-            const float g = toCorner + label.distance;
-            auto same = std::find_if(candidates.begin(), candidates.end(), [&](const Label& l) { return l.record == label.record; });
-            if (same == candidates.end())
-                candidates.push_back({label.record, g});
-            else
-                same->distance = std::min(same->distance, g);
-        }
-    }
-    std::sort(candidates.begin(), candidates.end(),
-              [](const Label& a, const Label& b) { return std::tie(a.distance, a.record) < std::tie(b.distance, b.record); });
-    if (candidates.size() > kRecordsPerVertex) candidates.resize(kRecordsPerVertex);
+    const float spacing = spacing_[tri.v[0]] * b[0] + spacing_[tri.v[1]] * b[1] + spacing_[tri.v[2]] * b[2];
+    // Each corner's records, weighted as at the corner but for the distance through it to p, and
+    // by the corner's barycentric: at a corner exactly its own weights, and continuous across
+    // edges (a corner's share fades with its barycentric).
     Vec3d sum(0.0);
     double total = 0;
-    for (const Label& label : candidates) {
-        const double w = weight(label, normal);
-        if (w <= 0) continue;
-        sum += Vec3d(irradiance[label.record]) * w;
-        total += w;
+    for (int c = 0; c < 3; ++c) {
+        if (!(b[c] > 0)) continue;
+        const uint32_t corner = tri.v[c];
+        const float toCorner = length(p - scene.positions[corner]);
+        // A record corner offers only itself (its value is its own gather), others what they read.
+        const uint32_t offered = record_[corner] ? 1 : kRecordsPerVertex;
+        for (uint32_t i = 0; i < offered; ++i) {
+            const Label& label = record_[corner] ? Label{corner, 0.0f} : labels_[size_t(corner) * kRecordsPerVertex + i];
+            if (label.record == UINT32_MAX) break;
+            const double w = double(b[c]) * weight(Label{label.record, toCorner + label.distance}, normal, spacing);
+            if (w <= 0) continue;
+            sum += Vec3d(irradiance[label.record]) * w;
+            total += w;
+        }
     }
     if (total > 0) return Vec3f(sum / total);
     // No record reaches the point (a hidden corner, or a crease between its corners): the
     // corners' values, as a viewer would interpolate them.
     return irradiance[tri.v[0]] * b[0] + irradiance[tri.v[1]] * b[1] + irradiance[tri.v[2]] * b[2];
+}
+
+std::vector<uint32_t> GatherCache::recordsRead(uint32_t v) const {
+    if (record_[v]) return {v};
+    std::vector<uint32_t> read;
+    for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
+        const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
+        if (label.record == UINT32_MAX) break;
+        if (weight(label, normal_[v], spacing_[v]) > 0) read.push_back(label.record);
+    }
+    return read;
 }
 
 size_t GatherCache::bytes() const {

@@ -13,12 +13,15 @@
 // at contacts, in corners and on concave surfaces, and thin out on open ones.
 //
 // Who reads which record: each record's light spreads along its mesh's edges (a geodesic flood,
-// Dijkstra's order) up to its reach — the largest R of the vertices that asked for it — and only
-// into vertices whose normal is within 30° of its own; each vertex keeps the K nearest that reach
-// it. A vertex no record reaches (across a crease, a fold, a gap in its mesh) becomes a record
+// Dijkstra's order) up to its own R (the chosen asker of a cell asked at the cell's level, so it
+// reaches the cell's diagonal), only into vertices whose own R is farther than the record, whose
+// normal is within 30° of its own, and over edges whose ends see each other; each vertex keeps
+// the K nearest that reach it. A vertex no record reaches (across a crease, a fold, a gap in its
+// mesh) becomes a record
 // itself, and the flood is run again. Light never crosses from one mesh to another, from one side
-// of a wall or thin partition to the other, or round a sharp edge. The weights, ((reach − g)/g)²
-// times how close the normals are, are infinite at a record: a record's value is its own gather.
+// of a wall or thin partition to the other, or round a sharp edge. The weights, ((R − g)/g)² (R
+// the smaller of the record's and the vertex's) times how close the normals are, are all but
+// infinite at a record: a record's value is its own gather.
 //
 // Everything is a pure function of the pose and the probes, computed from scratch every frame in a
 // fixed order — no hysteresis — so an update reaches exactly the records and weights a full
@@ -48,18 +51,21 @@ public:
 
     // Chooses the records and each vertex's weights for the current pose, from the probes `rays`
     // holds (castAll and its updates).
-    void select(const Scene& scene, const VertexStarts& starts, const FinalGather& rays);
+    // bvh: the current pose's, for the edges' visibility.
+    void select(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const FinalGather& rays);
     const std::vector<uint8_t>& records() const { return record_; }
     size_t recordCount() const { return recordCount_; }
 
     // Fills every vertex that is not a record from the records' values in `irradiance`.
     void interpolate(std::vector<Vec3f>& irradiance) const;
     // The cache's answer at a point of a triangle (barycentrics b1, b2 of its corners 1 and 2): the
-    // records its corners read, at the distance through the nearest corner, the K nearest of them,
-    // weighted as at a vertex (at a vertex, its own value). `irradiance`: every vertex's, as
+    // records each corner reads, weighted as at that corner for the distance through it to the
+    // point, times the corner's barycentric (at a vertex, its own value; continuous across edges). `irradiance`: every vertex's, as
     // interpolate leaves it. Needs select() for the current pose.
     Vec3f irradianceAt(const Scene& scene, uint32_t triangle, float b1, float b2, const std::vector<Vec3f>& irradiance) const;
 
+    // The records whose values make v's (with a weight above 0; v itself if it is one).
+    std::vector<uint32_t> recordsRead(uint32_t v) const;
     // The spacing R_v each vertex asked for (scene units; 0: a record of its own).
     const std::vector<float>& spacing() const { return spacing_; }
     size_t bytes() const;
@@ -73,7 +79,8 @@ private:
     // Every vertex's labels: the first kRecordsPerVertex of `sources` whose light reaches it.
     void flood(const Scene& scene, const VertexStarts& starts, const Adjacency& adjacency,
                const std::vector<uint32_t>& pieces, const std::vector<uint32_t>& sources);
-    float weight(const Label& label, const Vec3f& normal) const;
+    // A record's weight at a vertex (or point) with this normal and spacing R.
+    float weight(const Label& label, const Vec3f& normal, float spacing) const;
 
     float tolerance_;
     std::vector<float> spacing_;      // R_v

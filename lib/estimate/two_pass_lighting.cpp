@@ -19,7 +19,7 @@ size_t TwoPassLighting::stateBytes() const {
 
 void TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats) {
     if (!cache_) return;
-    cache_->select(scene, starts_, gather_);
+    cache_->select(scene, bvh, starts_, gather_);
     gather_.setRecords(scene, bvh, starts_, cache_->records());
     stats.gatherRecords = cache_->recordCount();
 }
