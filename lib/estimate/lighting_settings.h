@@ -3,6 +3,7 @@
 // shadow rays plus — with a final gather — one bounce gathered over the photon solution.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "util/enum_names.h"
@@ -24,15 +25,30 @@ struct LightingSettings {
     uint32_t directSamples = 16;
     // Final-gather rays per vertex (0: no gather).
     uint32_t gatherRays = 0;
-    // The gather cache's tolerance a (GatherCache: records spaced a times the distance to the
-    // geometry around them; 0: every vertex a record, the per-vertex gather's bits), or
-    // kGatherCacheOff: every vertex gathers, no probes, no records.
+    // The gather cache's tolerance A (GatherCache: records spaced A times the distance to the
+    // geometry around them; 0: every vertex a record, the per-vertex gather's bits),
+    // kGatherCacheOff (every vertex gathers: no probes, no records) or kGatherCacheAuto (resolved
+    // for the scene by resolvedFor).
     float gatherCache = kGatherCacheOff;
-    static constexpr float kGatherCacheOff = -1;
+    static constexpr float kGatherCacheOff = -1, kGatherCacheAuto = -2;
+    // What auto resolves to: the cache at this tolerance on scenes of at least this many vertices,
+    // where it was measured to win per second (docs/method.md, the gather cache: data/cornell's
+    // 21,636 vertices reach the per-vertex gather's error in 0.73x its time, a 5.3·10⁵-vertex
+    // floor's frame takes half the time; on scenes of 2–6·10³ vertices the gather is a small part
+    // of a frame and the cache at best ties), otherwise off.
+    static constexpr float kAutoTolerance = 0.2f;
+    static constexpr size_t kAutoMinVertices = 10000;
 
     bool exactDirect() const { return direct == DirectLighting::Exact; }
     bool gathers() const { return exactDirect() && gatherRays > 0; }
+    // Needs gatherCache resolved (not auto).
     bool cachesGather() const { return gathers() && gatherCache >= 0; }
+    // These settings with an auto cache resolved for a scene of `vertices` vertices.
+    LightingSettings resolvedFor(size_t vertices) const {
+        LightingSettings r = *this;
+        if (r.gatherCache == kGatherCacheAuto) r.gatherCache = vertices >= kAutoMinVertices ? kAutoTolerance : kGatherCacheOff;
+        return r;
+    }
 };
 
 // Limits of the options: a vertex's samples are points of one Sobol sequence, indexed by 32 bits.

@@ -68,7 +68,9 @@ FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSo
                                    EstimatorContext{scene_, bvh_, device, geometry_.estimatorRegions(), !settings.update.fullRecompute,
                                                     &work_, settings.lighting.exactDirect()})),
       tracer_(scene, bvh_, aimedAt(settings.trace, estimator_->reach())) {
-    if (settings_.lighting.exactDirect()) lighting_.emplace(settings_.lighting, settings_.trace.seed);
+    // An auto gather cache is settled once, for the scene the run renders (its vertices do not
+    // change from frame to frame), so every frame of a run, and a resumed one, uses the same.
+    if (settings_.lighting.exactDirect()) lighting_.emplace(settings_.lighting.resolvedFor(scene.vertexCount()), settings_.trace.seed);
 }
 
 FrameSolver::~FrameSolver() = default;

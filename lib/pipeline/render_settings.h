@@ -34,9 +34,10 @@ struct RenderSettings {
     std::string outDir = "out";
     EstimatorSettings estimator;     // radius 0 here: chosen from the scene (defaultRadius)
     bool radiusGiven = false;
-    // Exact direct light, 64 samples, 256 gather rays: the lowest error per second measured
-    // (docs/photons-and-radius.md). LightingSettings' own defaults are the paper's method.
-    LightingSettings lighting{DirectLighting::Exact, 64, 256};
+    // Exact direct light, 64 samples, 256 gather rays, the gather cache where it pays: the lowest
+    // error per second measured (docs/photons-and-radius.md, docs/method.md). LightingSettings'
+    // own defaults are the paper's method.
+    LightingSettings lighting{DirectLighting::Exact, 64, 256, LightingSettings::kGatherCacheAuto};
     bool gatherGiven = false;   // gather from the config or the command line
     // 10^6 photons (TraceSettings' own 10^5 is for the library's callers). K as given: a run
     // traces with effectiveTrace's, capped at max_bounces.
