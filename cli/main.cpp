@@ -168,8 +168,12 @@ int runCompare(const std::string& a, const std::string& b, std::optional<double>
     qsgi::Bounds3f bounds;
     for (const qsgi::Vec3f& p : reference.positions) bounds.extend(p);
     const float radius = radiusOption ? float(*radiusOption) : qsgi::defaultRadius(bounds);
+    // A reference of a vertex subset (scripts/reference.py --vertices N) is judged on its subset.
+    const std::vector<bool> only(reference.referenced.begin(), reference.referenced.end());
+    if (!reference.referenced.empty() && std::count(only.begin(), only.end(), true) == 0)
+        throw qsgi::InputError(b, "vertex property 'referenced'", "flags no vertex: nothing to compare");
     const qsgi::AccuracyReport r = qsgi::compareSolutions(reference.positions, reference.normals, reference.triangles,
-                                                          solution.radiosity, reference.radiosity, radius);
+                                                          solution.radiosity, reference.radiosity, radius, only);
     const std::pair<const char*, const qsgi::ErrorStats*> rows[] = {
         {"all", &r.all}, {"edge", &r.edge}, {"near_edge", &r.nearEdge}, {"interior", &r.interior}, {"contact", &r.contact}};
     if (json) {

@@ -20,6 +20,11 @@ make Dr.Jit's JIT fail ("Cannot select fminimum"), so this script points DRJIT_L
 LLVM 19 when it is not set.
 
   scripts/reference.py SCENE.gltf QSGI_FRAME.ply OUT.ply [--spp N] [--seed S] [--config CONFIG] [--sky R,G,B]
+                       [--vertices N]
+
+--vertices N: a dense mesh's reference at N vertices only, drawn uniformly (seeded by --seed);
+OUT.ply flags them in a `referenced` vertex property
+(the others hold 0) and `qsgi compare` judges a solution on them alone, region by region.
 
 CONFIG: a qsgi config whose "lights" are added (point lights and a uniform sky only here); --sky R,G,B
 adds a uniform sky as qsgi's --sky does (Mitsuba's `constant` emitter). Light that escapes to the sky
@@ -84,8 +89,9 @@ def read_ply(path):
     return positions, normals, fa["v"].astype(np.int64)
 
 
-def write_ply(path, positions, normals, faces, radiosity, comment):
-    v = np.zeros(len(positions), VERTEX_DTYPE)
+def write_ply(path, positions, normals, faces, radiosity, comment, referenced=None):
+    dtype = VERTEX_DTYPE if referenced is None else np.dtype(VERTEX_DTYPE.descr + [("referenced", "u1")])
+    v = np.zeros(len(positions), dtype)
     for i, k in enumerate("xyz"):
         v[k] = positions[:, i]
         v["n" + k] = normals[:, i]
@@ -95,7 +101,9 @@ def write_ply(path, positions, normals, faces, radiosity, comment):
     fa["n"] = 3
     fa["v"] = faces
     properties = "".join(f"property float {n}\n" for n in VERTEX_DTYPE.names[:9])
-    properties += "".join(f"property uchar {n}\n" for n in VERTEX_DTYPE.names[9:])
+    properties += "".join(f"property uchar {n}\n" for n in dtype.names[9:])
+    if referenced is not None:
+        v["referenced"] = referenced
     header = (f"ply\nformat binary_little_endian 1.0\ncomment {comment}\nelement vertex {len(v)}\n{properties}"
               f"element face {len(fa)}\nproperty list uchar int vertex_indices\nend_header\n")
     tmp = path + ".tmp"
@@ -121,8 +129,21 @@ def mean_texture_colour(gltf_path, doc, texture):
     return linear.reshape(-1, 3).mean(0)
 
 
+def gltf_document(path):
+    """The JSON of a .gltf, or of a .glb's first chunk (qsgi's asset.glb: a refined mesh's
+    materials per vertex, in the same flattening order as its frame PLYs)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] == b"glTF":
+        length, kind = struct.unpack_from("<II", data, 12)
+        if kind != 0x4E4F534A:
+            sys.exit(f"{path}: a GLB whose first chunk is not JSON")
+        return json.loads(data[20:20 + length])
+    return json.loads(data)
+
+
 def gltf_vertex_materials(path):
-    doc = json.load(open(path))
+    doc = gltf_document(path)
     scene = doc["scenes"][doc.get("scene", 0)]
     materials = doc.get("materials", [])
     albedo, emission = [], []
@@ -158,7 +179,7 @@ def gltf_vertex_materials(path):
 
 def gltf_point_lights(path, config):
     """KHR_lights_punctual point lights on root-level nodes with a translation, plus config lights."""
-    doc = json.load(open(path))
+    doc = gltf_document(path)
     lights = []
     defs = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     for node in doc.get("nodes", []):
@@ -289,7 +310,10 @@ def main():
     ap.add_argument("--config", help="qsgi config whose point lights and sky are added")
     ap.add_argument("--sky", help="R,G,B: a uniform sky of this radiance, as qsgi's --sky")
     ap.add_argument("--chunk", type=int, default=2048, help="vertices per wavefront")
+    ap.add_argument("--vertices", type=int, help="only this many vertices, drawn uniformly (dense meshes)")
     args = ap.parse_args()
+    if args.vertices is not None and args.vertices < 1:
+        ap.error("--vertices must be at least 1")
 
     mi.set_variant("llvm_ad_rgb")
     positions, normals, faces = read_ply(args.frame_ply)
@@ -303,11 +327,21 @@ def main():
             sky = sky * 3
         scene = build_scene(positions, faces, albedo, emission, gltf_point_lights(args.scene, args.config), sky, workdir)
     started = time.time()
-    E = irradiance(scene, query_points(positions, normals, faces, diagonal), normals, args.spp, args.seed, args.chunk)
+    origins = query_points(positions, normals, faces, diagonal)
+    chosen = np.arange(len(positions))
+    referenced = None
+    if args.vertices is not None and args.vertices < len(positions):
+        chosen = np.sort(np.random.default_rng(args.seed).choice(len(positions), args.vertices, replace=False))
+        referenced = np.zeros(len(positions), np.uint8)
+        referenced[chosen] = 1
+    E = np.zeros((len(positions), 3))
+    E[chosen] = irradiance(scene, origins[chosen], normals[chosen], args.spp, args.seed, args.chunk)
     B = albedo * E + np.pi * emission
+    if referenced is not None:
+        B[referenced == 0] = 0
     comment = (f"qsgi reference: Mitsuba {mi.__version__} path tracer, {args.spp} paths + emitter samples per vertex, "
-               f"seed {args.seed}, {time.time() - started:.0f} s")
-    write_ply(args.out, positions, normals, faces, B, comment)
+               f"seed {args.seed}, {len(chosen)} of {len(positions)} vertices, {time.time() - started:.0f} s")
+    write_ply(args.out, positions, normals, faces, B, comment, referenced)
     print(comment)
 
 

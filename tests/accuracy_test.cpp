@@ -93,3 +93,61 @@ TEST(Accuracy, CompareCommandReadsPlysAndRejectsMismatches) {
     EXPECT_EQ(notPly.exitCode, 2);
     EXPECT_NE(notPly.output.find("not a PLY"), std::string::npos) << notPly.output;
 }
+
+// A reference of a vertex subset (scripts/reference.py --vertices N) flags the vertices it holds
+// in a `referenced` property; `qsgi compare` judges the solution on those alone, by the same
+// regions (decided on the whole mesh). The unflagged vertices hold garbage that would show.
+TEST(Accuracy, CompareJudgesASubsetReferenceOnItsSubsetAlone) {
+    const fs::path dir = testScratchDir("compare-subset");
+    const Scene scene = testscenes::corner(8, Vec3f(0.5f));
+    const size_t n = scene.vertexCount();
+    VertexRadiosity solution;
+    solution.radiosity.assign(n, Vec3f(1.0f));
+    solution.irradiance.assign(n, Vec3f(2.0f));
+    writeFileAtomically(dir / "solution.ply", encodeVertexRadiosityPly(scene, solution, PreviewTonemap{}));
+    // The reference: 1.25 at every third vertex (flagged), 100 elsewhere (not).
+    std::vector<bool> flagged(n);
+    std::vector<Vec3f> reference(n);
+    for (size_t v = 0; v < n; ++v) {
+        flagged[v] = v % 3 == 0;
+        reference[v] = Vec3f(flagged[v] ? 1.25f : 100.0f);
+    }
+    std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(n) +
+                      "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+                      "property float nz\nproperty float radiosity_r\nproperty float radiosity_g\nproperty float radiosity_b\n"
+                      "property uchar referenced\nelement face " + std::to_string(scene.triangleCount()) +
+                      "\nproperty list uchar int vertex_indices\nend_header\n";
+    auto put = [&](const void* bytes, size_t size) { ply.append(static_cast<const char*>(bytes), size); };
+    for (size_t v = 0; v < n; ++v) {
+        put(&scene.positions[v], sizeof(Vec3f));
+        put(&scene.normals[v], sizeof(Vec3f));
+        put(&reference[v], sizeof(Vec3f));
+        const uint8_t flag = flagged[v];
+        put(&flag, 1);
+    }
+    for (const Triangle& t : scene.triangles) {
+        const uint8_t three = 3;
+        put(&three, 1);
+        for (uint32_t i : t.v) {
+            const int32_t index = int32_t(i);
+            put(&index, 4);
+        }
+    }
+    writeFileAtomically(dir / "subset.ply", ply);
+    const VertexRadiosityPly back = readVertexRadiosityPly((dir / "subset.ply").string());
+    ASSERT_EQ(back.referenced.size(), n);
+    EXPECT_EQ(back.referenced[3], 1);
+    EXPECT_EQ(back.referenced[4], 0);
+
+    const CommandResult r = runQsgi("compare " + (dir / "solution.ply").string() + " " + (dir / "subset.ply").string() + " --json");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const nlohmann::json j = nlohmann::json::parse(r.output);
+    // 1 against 1.25 at every flagged vertex: bias and RMS −0.2 and 0.2 in every region it has.
+    EXPECT_EQ(j["all"]["vertices"].get<size_t>(), (n + 2) / 3);
+    for (const char* region : {"all", "edge", "near_edge", "interior"}) {
+        if (j[region]["vertices"].get<size_t>() == 0) continue;
+        EXPECT_NEAR(j[region]["relative_bias"].get<double>(), -0.2, 1e-6) << region;
+        EXPECT_NEAR(j[region]["relative_rms"].get<double>(), 0.2, 1e-6) << region;
+    }
+    EXPECT_GT(j["edge"]["vertices"].get<size_t>() + j["near_edge"]["vertices"].get<size_t>(), 0u);
+}

@@ -200,14 +200,19 @@ std::vector<bool> touchingOtherSurfaces(const std::vector<Vec3f>& positions, con
 
 AccuracyReport compareSolutions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
                                 const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values,
-                                const std::vector<Vec3f>& reference, float radius) {
+                                const std::vector<Vec3f>& reference, float radius, const std::vector<bool>& only) {
     AccuracyReport r;
-    r.all = errorStats(values, reference);
+    auto within = [&](std::vector<bool> in) {
+        if (only.empty()) return in;
+        for (size_t v = 0; v < in.size(); ++v) in[v] = in[v] && v < only.size() && only[v];
+        return in;
+    };
+    r.all = errorStats(values, reference, only);
     const std::vector<EdgeRegion> region = edgeRegions(positions, normals, triangles, radius);
     auto subset = [&](EdgeRegion which) {
         std::vector<bool> in(region.size());
         for (size_t v = 0; v < region.size(); ++v) in[v] = region[v] == which;
-        return in;
+        return within(std::move(in));
     };
     r.edge = errorStats(values, reference, subset(EdgeRegion::OnEdge));
     r.nearEdge = errorStats(values, reference, subset(EdgeRegion::NearEdge));
@@ -216,7 +221,7 @@ AccuracyReport compareSolutions(const std::vector<Vec3f>& positions, const std::
     // exact; a tolerance keeps float rounding of placed meshes from hiding them).
     Bounds3f bounds;
     for (const Vec3f& p : positions) bounds.extend(p);
-    r.contact = errorStats(values, reference, touchingOtherSurfaces(positions, triangles, 1e-5f * bounds.extent()));
+    r.contact = errorStats(values, reference, within(touchingOtherSurfaces(positions, triangles, 1e-5f * bounds.extent())));
     return r;
 }
 

@@ -49,8 +49,10 @@ std::vector<bool> verticesNearCreases(const std::vector<Vec3f>& positions, const
 ErrorStats errorStats(const std::vector<Vec3f>& values, const std::vector<Vec3f>& reference,
                       const std::vector<bool>& subset = {});
 
+// `only`, if not empty: the vertices the reference holds (a vertex subset's reference); the
+// regions are decided on the whole mesh and each counts only these.
 AccuracyReport compareSolutions(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
                                 const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values,
-                                const std::vector<Vec3f>& reference, float radius);
+                                const std::vector<Vec3f>& reference, float radius, const std::vector<bool>& only = {});
 
 }  // namespace qsgi

@@ -180,6 +180,9 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
         for (int c = 0; c < 3; ++c)
             if (p.name == std::string("irradiance_") + "rgb"[c]) irradiance[c] = &p;
     const bool hasIrradiance = irradiance[0] && irradiance[1] && irradiance[2];
+    const PlyProperty* referenced = nullptr;
+    for (const auto& p : properties)
+        if (p.name == "referenced") referenced = &p;
     const size_t vertexCount = size_t(vertex.count);
     if (vertexCount > (size_t(1) << 31)) throw InputError(path, "header", "implausible vertex count");
     std::vector<char> data(vertexCount * stride);
@@ -190,6 +193,7 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     out.normals.resize(vertexCount);
     out.radiosity.resize(vertexCount);
     if (hasIrradiance) out.irradiance.resize(vertexCount);
+    if (referenced) out.referenced.resize(vertexCount);
     for (size_t v = 0; v < vertexCount; ++v) {
         const char* row = data.data() + v * stride;
         for (const PlyProperty& p : properties) {
@@ -209,6 +213,7 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
         out.positions[v] = {f[0], f[1], f[2]};
         out.normals[v] = {f[3], f[4], f[5]};
         out.radiosity[v] = {f[6], f[7], f[8]};
+        if (referenced) out.referenced[v] = readScalar(row + referenced->offset, referenced->type) != 0;
         if (hasIrradiance) {
             for (int c = 0; c < 3; ++c) {
                 const double value = readScalar(row + irradiance[c]->offset, irradiance[c]->type);

@@ -14,6 +14,9 @@ struct VertexRadiosityPly {
     std::vector<Vec3f> positions, normals, radiosity;
     std::vector<Vec3f> irradiance;    // empty when the file has none (written before issue 35)
     std::vector<Triangle> triangles;  // from `element face` (polygons fanned), if present
+    // A reference of a vertex subset (scripts/reference.py --vertices N) flags the vertices it
+    // computed in a `referenced` property; empty when the file has none (every vertex counts).
+    std::vector<uint8_t> referenced;
 };
 
 // Throws InputError naming the file for anything it cannot read.
