@@ -143,6 +143,11 @@ def dense_floor(folder, tiles=22, stem="dense-floor"):
 
 def main():
     args = sys.argv[1:]
+    if any(a in ("-h", "--help") for a in args):
+        print(__doc__)
+        return
+    if any(a.startswith("-") and a != "--tiles" for a in args):
+        sys.exit("make_bench_scenes.py: unknown option; usage: make_bench_scenes.py [FOLDER] [--tiles N]")
     tiles = None
     if "--tiles" in args:
         k = args.index("--tiles")

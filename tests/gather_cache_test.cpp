@@ -101,6 +101,11 @@ TEST(GatherCache, ToleranceZeroGivesThePerVertexGathersBits) {
     EXPECT_EQ(zero.stats.gatherRecords, scene.vertexCount());
     EXPECT_EQ(zero.stats.gatherRays, off.stats.gatherRays);
     EXPECT_EQ(off.stats.gatherRecords, 0u);
+    // With no more rays than the probes every vertex gathers in full: no cache, whatever A.
+    const Frame fewOff = solveFrame(scene, gatherWith(GatherCache::kProbeRays, LightingSettings::kGatherCacheOff));
+    const Frame fewCached = solveFrame(scene, gatherWith(GatherCache::kProbeRays, 0.5f));
+    EXPECT_TRUE(sameBits(fewOff.out.irradiance, fewCached.out.irradiance));
+    EXPECT_EQ(fewCached.stats.gatherRecords, 0u);
 }
 
 // Against the per-vertex gather of the same rays (records cast exactly the rays the per-vertex

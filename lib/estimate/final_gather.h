@@ -16,6 +16,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cassert>
 #include <cstdint>
 #include <vector>
 
@@ -78,6 +79,7 @@ public:
     static Vec3f rayDirection(const GatherHit& hit);
     // Ray `ray` of v: one of its probes, or (a record's) one of the rest.
     const GatherHit& hit(uint32_t v, uint32_t ray) const {
+        assert(size_t(v) * probes_ < probeHits_.size() && (ray < probes_ || restSlot_[v] != kNoSlot));
         return ray < probes_ ? probeHits_[size_t(v) * probes_ + ray] : restHits_[size_t(restSlot_[v]) * (rays_ - probes_) + ray - probes_];
     }
     bool hasAllRays(uint32_t v) const { return !cached() || restSlot_[v] != kNoSlot; }

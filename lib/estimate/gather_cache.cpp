@@ -47,10 +47,15 @@ struct GatherCache::Adjacency {
 
     Adjacency(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const MeshTopology& topology) {
         const uint32_t n = uint32_t(scene.vertexCount());
+        // Only vertices of some triangle of their own take part: one welded to a mesh but used by
+        // no triangle would get neighbours no list names back (it becomes a record of its own).
+        std::vector<uint8_t> used(n, 0);
+        for (const Triangle& t : scene.triangles)
+            for (uint32_t u : t.v) used[u] = 1;
         std::vector<std::vector<uint32_t>> lists(n);
         tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 256), [&](const tbb::blocked_range<uint32_t>& r) {
             for (uint32_t v = r.begin(); v != r.end(); ++v) {
-                if (scene.vertexHidden[v]) continue;
+                if (scene.vertexHidden[v] || !used[v]) continue;
                 std::vector<uint32_t>& list = lists[v];
                 for (const uint32_t* t = topology.trianglesBegin(v); t != topology.trianglesEnd(v); ++t)
                     for (uint32_t u : scene.triangles[*t].v)
@@ -214,21 +219,25 @@ void GatherCache::select(const Scene& scene, const SceneBvh& bvh, const VertexSt
         if (record_[v]) sources.push_back(v);
     flood(scene, starts, adjacency, pieces, sources);
 
-    // A vertex no record reaches with any weight (across a fold, a crease, a gap) becomes one.
-    bool added = false;
-    for (uint32_t v = 0; v < n; ++v) {
-        if (scene.vertexHidden[v] || record_[v]) continue;
-        float total = 0;
-        for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
-            const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
-            if (label.record != UINT32_MAX) total += weight(label, starts.normal(v), spacing_[v]);
+    // A vertex no record reaches with any weight (across a fold, a crease, a gap) becomes one,
+    // and the records flood again. A new record can fill a vertex's labels before an older one's
+    // light passes through it, so the next flood can leave other vertices unreached: repeat until
+    // none is (the records only grow, so this ends; two rounds almost always).
+    for (;;) {
+        bool added = false;
+        for (uint32_t v = 0; v < n; ++v) {
+            if (scene.vertexHidden[v] || record_[v]) continue;
+            float total = 0;
+            for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
+                const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
+                if (label.record != UINT32_MAX) total += weight(label, starts.normal(v), spacing_[v]);
+            }
+            if (total > 0) continue;
+            record_[v] = 1;
+            reach_[v] = spacing_[v];
+            added = true;
         }
-        if (total > 0) continue;
-        record_[v] = 1;
-        reach_[v] = spacing_[v];
-        added = true;
-    }
-    if (added) {
+        if (!added) break;
         sources.clear();
         for (uint32_t v = 0; v < n; ++v)
             if (record_[v]) sources.push_back(v);
@@ -261,7 +270,10 @@ void GatherCache::interpolate(std::vector<Vec3f>& irradiance) const {
 Vec3f GatherCache::irradianceAt(const Scene& scene, uint32_t triangle, float b1, float b2,
                                 const std::vector<Vec3f>& irradiance) const {
     const Triangle& tri = scene.triangles[triangle];
-    const float b[3] = {std::max(0.0f, 1 - b1 - b2), b1, b2};
+    // Barycentrics clamped to the triangle and made to sum to 1.
+    float b[3] = {std::clamp(1 - b1 - b2, 0.0f, 1.0f), std::clamp(b1, 0.0f, 1.0f), std::clamp(b2, 0.0f, 1.0f)};
+    const float sumB = b[0] + b[1] + b[2];
+    for (float& w : b) w = sumB > 0 ? w / sumB : 1.0f / 3;
     const Vec3f p = scene.positions[tri.v[0]] * b[0] + scene.positions[tri.v[1]] * b[1] + scene.positions[tri.v[2]] * b[2];
     const Vec3f normal = normalize(normal_[tri.v[0]] * b[0] + normal_[tri.v[1]] * b[1] + normal_[tri.v[2]] * b[2]);
     const float spacing = spacing_[tri.v[0]] * b[0] + spacing_[tri.v[1]] * b[1] + spacing_[tri.v[2]] * b[2];

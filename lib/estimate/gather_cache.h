@@ -16,10 +16,11 @@
 // Dijkstra's order) up to its own R (the chosen asker of a cell asked at the cell's level, so it
 // reaches the cell's diagonal), only into vertices whose own R is farther than the record, whose
 // normal is within 30° of its own, and over edges whose ends see each other; each vertex keeps
-// the K nearest that reach it. A vertex no record reaches (across a crease, a fold, a gap in its
-// mesh) becomes a record
-// itself, and the flood is run again. Light never crosses from one mesh to another, from one side
-// of a wall or thin partition to the other, or round a sharp edge. The weights, ((R − g)/g)² (R
+// the first K to reach it (Dijkstra's order: nearest first). A vertex no record reaches (across a
+// crease, a fold, a gap in its mesh) becomes a record itself, and the flood runs again until every
+// vertex is reached. Light never crosses from one welded surface to another (meshes sharing vertex
+// positions are one), from one side of a wall or thin partition to the other, or round a sharp
+// edge. The weights, ((R − g)/g)² (R
 // the smaller of the record's and the vertex's) times how close the normals are, are all but
 // infinite at a record: a record's value is its own gather.
 //
@@ -33,6 +34,7 @@
 #include <vector>
 
 #include "estimate/final_gather.h"
+#include "estimate/lighting_settings.h"
 #include "estimate/vertex_starts.h"
 #include "scene/mesh_topology.h"
 #include "scene/scene.h"
@@ -41,9 +43,8 @@ namespace qsgi {
 
 class GatherCache {
 public:
-    // The probes every vertex casts (of its M gather rays): 16 Sobol points spread well over the
-    // hemisphere, and cost a sixteenth of a full gather at 256 rays.
-    static constexpr uint32_t kProbeRays = 16;
+    // The probes every vertex casts (of its M gather rays).
+    static constexpr uint32_t kProbeRays = LightingSettings::kGatherProbeRays;
     // Records each vertex reads, at most.
     static constexpr uint32_t kRecordsPerVertex = 4;
 

@@ -37,12 +37,16 @@ struct LightingSettings {
     // floor's frame takes half the time; on scenes of 2–6·10³ vertices the gather is a small part
     // of a frame and the cache at best ties), otherwise off.
     static constexpr float kAutoTolerance = 0.2f;
+    // The rays every vertex casts under the cache (the first of its M; GatherCache): 16 Sobol
+    // points spread well over the hemisphere, a sixteenth of a full gather at 256 rays.
+    static constexpr uint32_t kGatherProbeRays = 16;
     static constexpr size_t kAutoMinVertices = 10000;
 
     bool exactDirect() const { return direct == DirectLighting::Exact; }
     bool gathers() const { return exactDirect() && gatherRays > 0; }
-    // Needs gatherCache resolved (not auto).
-    bool cachesGather() const { return gathers() && gatherCache >= 0; }
+    // Needs gatherCache resolved (not auto). With no more rays than the probes every vertex
+    // gathers in full anyway: no cache.
+    bool cachesGather() const { return gathers() && gatherCache >= 0 && gatherRays > kGatherProbeRays; }
     // These settings with an auto cache resolved for a scene of `vertices` vertices.
     LightingSettings resolvedFor(size_t vertices) const {
         LightingSettings r = *this;

@@ -50,8 +50,9 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     }
     combine(scene, photons, out);
     stats.gatherSeconds = clock.seconds();
-    solved_ = keepForUpdates;
-    if (!keepForUpdates) gather_.clear();
+    // Without a gather nothing grows with M: the state stays for updates either way.
+    solved_ = keepForUpdates || !settings_.gathers();
+    if (!solved_) gather_.clear();
 }
 
 void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const MovedGeometry& moved,
