@@ -59,6 +59,7 @@ json otherValue(const RenderOption& o, const RenderSettings& s) {
             if (std::string(o.key) == "camera") return 3;
             if (std::string(o.key) == "sky") return json::array({0.5, 0.25, 1});
             if (std::string(o.key) == "environment") return "sky.exr";
+            if (std::string(o.key) == "gather_cache") return now == json(0.5) ? json(0.25) : json(0.5);
             return json::parse(R"([{"type": "point", "position": [0, 1, 0], "intensity": [1, 1, 1]}])");
     }
     return nullptr;
@@ -214,6 +215,7 @@ TEST(RenderOptions, ConfigAndCommandLineApplyTheSameRules) {
         if (o.type == OptionType::Integer) bad = {o.min - 1, 1e20, 2.5, "many"};
         if (o.type == OptionType::Number) bad = {0, -1, 1e300, "fast"};
         if (o.type == OptionType::Text || o.type == OptionType::Object) bad = {};
+        if (std::string(o.key) == "gather_cache") bad = {"nonsense", -0.5, 2, 1e300};
         for (const json& value : bad) {
             SCOPED_TRACE(value.dump());
             RenderSettings a = base, b = base;
