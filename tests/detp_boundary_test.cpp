@@ -258,12 +258,18 @@ TEST(DetpBoundary, OpenEdgeOfAFloorIsUnbiased) {
 // the independent discs along the box's sides).
 TEST(DetpBoundary, FloorBesideABoxNeitherLosesNorGainsLightFromUnderIt) {
     const float r = 0.1f;
-    const uint64_t photons = 2000000;
-    Scene scene = testscenes::boxOnFloor(96, 12, Vec3f(0.0f));
+    // The floor is 1.5 m a side, not 4 m (36 cells, the 4 m floor's 96-cell spacing): the
+    // measured vertices lie within h + r = 0.4 of the centre, and nothing beyond 2r of them
+    // reaches their discs (black surfaces, a point light), so the rest only cost vertices and
+    // photons. The photons are the 4 m floor's (2·10⁶) times the share of its aimed solid angle the
+    // 1.5 m floor keeps (0.288), rounded up: φ0, hence σ, is the 4 m floor's or smaller.
+    const uint64_t photons = 580000;
+    Scene scene = testscenes::boxOnFloor(36, 12, Vec3f(0.0f), 0.75f);
     const Vec3d light(0.8, 1.5, 0.6);
     testscenes::addPointLight(scene, Vec3f(light), Vec3f(1.0f));
     const RayCache cache = trace(scene, photons);
     const double phi0 = cache.maxPhotonPower, h = 0.3;  // I Ω/N: the solid angle aimed at the scene
+    std::printf("floor beside a box: %llu photons, φ0 %.4g\n", static_cast<unsigned long long>(photons), phi0);
     const auto clip = estimate(scene, cache, EstimatorKind::Detp, DetpBoundary::Clip, r);
     const auto paper = estimate(scene, cache, EstimatorKind::Detp, DetpBoundary::Paper, r);
     auto insideFootprint = [&](double x, double z) { return std::fabs(x) < h && std::fabs(z) < h; };

@@ -264,11 +264,11 @@ Scene closedBox(int cells) {
     return s;
 }
 
-Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo) {
+Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo, float floorHalf) {
     Scene s;
     const uint32_t m = addMaterial(s, albedo);
     const int floor = s.addNode("Floor", Transform());
-    addGrid(s, floor, {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, floorCells, m);
+    addGrid(s, floor, {-floorHalf, 0, floorHalf}, {2 * floorHalf, 0, 0}, {0, 0, -2 * floorHalf}, floorCells, m);
     const float h = 0.3f;
     addBoxOnFloor(s, s.addNode("Cube", Transform()), h, 2 * h, cubeCells, m);
     s.finalize();

@@ -84,8 +84,9 @@ qsgi::Scene closedSphere(float radius, int subdivisions, qsgi::Vec3f albedo, boo
 qsgi::Scene plane(float halfSize, int cells, qsgi::Vec3f albedo);
 // A closed box [-1,1]^3 with coloured walls facing inward.
 qsgi::Scene closedBox(int cells);
-// A 4x4 m floor (y = 0) with a 0.6 m cube on it: the cube's convex edges make silhouettes.
-qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo);
+// A 4x4 m floor (y = 0; 2·floorHalf a side when given) with a 0.6 m cube on it: the cube's
+// convex edges make silhouettes.
+qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo, float floorHalf = 2.0f);
 // A floor y = 0 (x, z in [-1, 1], `floorCells` per side, its vertices first) with a closed slab
 // standing on it: [−half, half]² and `height` high (a rug, when low).
 qsgi::Scene slabOnFloor(int floorCells, float half, float height, qsgi::Vec3f albedo);
