@@ -147,14 +147,23 @@ TEST(DetpBoundary, CeilingAboveALightPanelSeesOnlyTheGap) {
 // over the number of independent discs along the edge (its length / 2r, on each surface).
 TEST(DetpBoundary, InsideCornerEdgesAreUnbiasedWithLinearAndFirstOrderWithClip) {
     const float r = 0.1f;
-    const uint64_t photons = 2000000;  // aimed: about half of them land, as many as 4·10⁶ unaimed
     const double halfLength = 0.8;
-    for (const Vec3d light : {Vec3d(0.0, 1.5, 0.5), Vec3d(0.0, 1.0, 1.0), Vec3d(0.0, 0.5, 1.5)}) {
-        // 64 cells: the noise of an edge mean is set by the independent discs along the edge,
-        // not by how many vertices sample them, and each estimate costs vertices × crossings.
-        Scene scene = testscenes::corner(64, Vec3f(0.0f));
+    // The corner is 0.5 m deep (floor and wall), not 2 m: every disc measured lies within r of
+    // the edge, and nothing beyond 2r of it reaches one (black surfaces, a point light), so the
+    // other 1.5 m only cost photons and vertices. The photons are those of the 2 m corner (2·10⁶,
+    // aimed: about half of them land, as many as 4·10⁶ unaimed) times the share of its aimed solid
+    // angle that the 0.5 m corner keeps (0.175, 0.301, 0.176 for the three lights), rounded up: as
+    // many photons per steradian, so φ0 and σ are those of the 2 m corner, or smaller.
+    for (const auto& [light, photons] : {std::pair{Vec3d(0.0, 1.5, 0.5), uint64_t(360000)},
+                                         std::pair{Vec3d(0.0, 1.0, 1.0), uint64_t(610000)},
+                                         std::pair{Vec3d(0.0, 0.5, 1.5), uint64_t(360000)}}) {
+        // 64 cells per 2 m: the noise of an edge mean is set by the independent discs along the
+        // edge, not by how many vertices sample them, and each estimate costs vertices × crossings.
+        Scene scene = testscenes::corner(64, Vec3f(0.0f), 0.5f);
         testscenes::addPointLight(scene, Vec3f(light), Vec3f(1.0f));
         const RayCache cache = trace(scene, photons);
+        std::printf("inside corner, light (%.1f, %.1f, %.1f): %llu photons, φ0 %.4g\n", light.x, light.y, light.z,
+                    static_cast<unsigned long long>(photons), double(cache.maxPhotonPower));
         const double phi0 = cache.maxPhotonPower;  // I Ω/N: the solid angle aimed at the corner
         const auto clip = estimate(scene, cache, EstimatorKind::Detp, DetpBoundary::Clip, r);
         const auto linear = estimate(scene, cache, EstimatorKind::Detp, DetpBoundary::Linear, r);
@@ -206,12 +215,18 @@ TEST(DetpBoundary, InsideCornerEdgesAreUnbiasedWithLinearAndFirstOrderWithClip) 
 // border's length / 2r discs; 4σ + 0.5 % allowed.
 TEST(DetpBoundary, OpenEdgeOfAFloorIsUnbiased) {
     const float r = 0.1f, half = 1.6f;
-    const uint64_t photons = 2000000;
-    Scene scene = testscenes::plane(half, 128, Vec3f(0.0f));
+    // Only the outer 0.4 m of the 3.2 m floor (16 of its 128 cells a side): the measured discs
+    // lie within r of the outer border, and nothing beyond 2r of it reaches one (a black floor, a
+    // point light), so the inside only cost vertices and the photons landing there. The photons
+    // are the whole floor's (2·10⁶, aimed) times the share of its aimed solid angle the frame
+    // keeps (0.757), rounded up: φ0, hence σ, is the whole floor's or smaller.
+    const uint64_t photons = 1520000;
+    Scene scene = testscenes::squareFrame(half, 128, 16, Vec3f(0.0f));
     const Vec3d light(0, 1, 0);
     testscenes::addPointLight(scene, Vec3f(light), Vec3f(1.0f));
     const RayCache cache = trace(scene, photons);
     const double phi0 = cache.maxPhotonPower;  // I Ω/N: the solid angle aimed at the floor
+    std::printf("open edge of a floor: %llu photons, φ0 %.4g\n", static_cast<unsigned long long>(photons), phi0);
     for (DetpBoundary rule : {DetpBoundary::Clip, DetpBoundary::Linear, DetpBoundary::Paper}) {
         const auto E = estimate(scene, cache, EstimatorKind::Detp, rule, r);
         double bias = 0, variance = 0;
@@ -243,12 +258,18 @@ TEST(DetpBoundary, OpenEdgeOfAFloorIsUnbiased) {
 // the independent discs along the box's sides).
 TEST(DetpBoundary, FloorBesideABoxNeitherLosesNorGainsLightFromUnderIt) {
     const float r = 0.1f;
-    const uint64_t photons = 2000000;
-    Scene scene = testscenes::boxOnFloor(96, 12, Vec3f(0.0f));
+    // The floor is 1.5 m a side, not 4 m (36 cells, the 4 m floor's 96-cell spacing): the
+    // measured vertices lie within h + r = 0.4 of the centre, and nothing beyond 2r of them
+    // reaches their discs (black surfaces, a point light), so the rest only cost vertices and
+    // photons. The photons are the 4 m floor's (2·10⁶) times the share of its aimed solid angle the
+    // 1.5 m floor keeps (0.288), rounded up: φ0, hence σ, is the 4 m floor's or smaller.
+    const uint64_t photons = 580000;
+    Scene scene = testscenes::boxOnFloor(36, 12, Vec3f(0.0f), 0.75f);
     const Vec3d light(0.8, 1.5, 0.6);
     testscenes::addPointLight(scene, Vec3f(light), Vec3f(1.0f));
     const RayCache cache = trace(scene, photons);
     const double phi0 = cache.maxPhotonPower, h = 0.3;  // I Ω/N: the solid angle aimed at the scene
+    std::printf("floor beside a box: %llu photons, φ0 %.4g\n", static_cast<unsigned long long>(photons), phi0);
     const auto clip = estimate(scene, cache, EstimatorKind::Detp, DetpBoundary::Clip, r);
     const auto paper = estimate(scene, cache, EstimatorKind::Detp, DetpBoundary::Paper, r);
     auto insideFootprint = [&](double x, double z) { return std::fabs(x) < h && std::fabs(z) < h; };

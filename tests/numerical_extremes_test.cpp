@@ -9,7 +9,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
+#include "estimate/disc_regions.h"
 #include "pipeline/render_settings.h"
 #include "scene/gltf_loader.h"
 #include "test_support.h"
@@ -73,11 +75,27 @@ TEST(NumericalExtremes, SceneScaledByAThousandthOrAThousandGivesTheSameIrradianc
     constexpr uint64_t kPhotons = 40000;
     std::vector<RayCache> caches;
     for (const Scene& s : scenes) caches.push_back(traceScene(s, kPhotons, 5));
+    // Each scale's BVH and disc regions (DETP's, and the photon map's with coverage) once, for
+    // every rule: what estimateWith would compute afresh for each.
+    struct Prepared {
+        Prepared(const Scene& scene, float radius) : bvh(device, scene), discs(radius, false), covered(radius, true) {
+            discs.computeAll(scene, bvh);
+            covered.computeAll(scene, bvh);
+        }
+        EmbreeDevice device;
+        SceneBvh bvh;
+        DiscRegions discs, covered;
+    };
+    std::vector<std::unique_ptr<Prepared>> prepared;
+    for (const Scene& s : scenes) prepared.push_back(std::make_unique<Prepared>(s, defaultRadius(s)));
     for (const NamedEstimator& rule : kRules) {
         SCOPED_TRACE(rule.name);
         std::vector<VertexRadiosity> results;
         for (size_t i = 0; i < scenes.size(); ++i) {
-            results.push_back(estimateWith(scenes[i], caches[i], rule.settings(defaultRadius(scenes[i]))));
+            const EstimatorSettings settings = rule.settings(defaultRadius(scenes[i]));
+            const Prepared& p = *prepared[i];
+            const DiscRegions& regions = settings.kind == EstimatorKind::PhotonMap ? p.covered : p.discs;
+            results.push_back(estimateVertexRadiosity(scenes[i], p.bvh, caches[i], settings, p.device, &regions));
             expectFiniteAndNonNegative(results.back(), rule.name);
         }
         const double reference = totalLuminance(results[0].irradiance);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -120,23 +121,38 @@ uint32_t addMaterial(Scene& s, Vec3f albedo, Vec3f emission = Vec3f(0.0f)) {
     return uint32_t(s.materials.size() - 1);
 }
 
-// Quad grid from corner spanning u, v; front (CCW) side faces cross(u, v).
-void addGrid(Scene& s, int node, Vec3f corner, Vec3f u, Vec3f v, int cells, uint32_t material) {
+// Quad grid from corner spanning u (cellsU cells) and v (cellsV cells); front (CCW) side faces
+// cross(u, v). With `keep`, only the cells (i, j) it accepts, and only their vertices.
+void addGrid(Scene& s, int node, Vec3f corner, Vec3f u, Vec3f v, int cellsU, int cellsV, uint32_t material,
+             const std::function<bool(int, int)>& keep = {}) {
     std::vector<Vec3f> p, n;
     std::vector<uint32_t> idx;
     const Vec3f normal = normalize(cross(u, v));
-    for (int j = 0; j <= cells; ++j)
-        for (int i = 0; i <= cells; ++i) {
-            p.push_back(corner + u * (float(i) / cells) + v * (float(j) / cells));
+    const int row = cellsU + 1;
+    std::vector<uint32_t> index(size_t(row) * size_t(cellsV + 1), UINT32_MAX);
+    auto vertex = [&](int i, int j) {
+        uint32_t& k = index[size_t(j) * size_t(row) + size_t(i)];
+        if (k == UINT32_MAX) {
+            k = uint32_t(p.size());
+            p.push_back(corner + u * (float(i) / cellsU) + v * (float(j) / cellsV));
             n.push_back(normal);
         }
-    const uint32_t row = uint32_t(cells + 1);
-    for (int j = 0; j < cells; ++j)
-        for (int i = 0; i < cells; ++i) {
-            const uint32_t a = uint32_t(j) * row + uint32_t(i);
-            idx.insert(idx.end(), {a, a + 1, a + row + 1, a, a + row + 1, a + row});
+        return k;
+    };
+    if (!keep)  // every vertex, in rows, as the grids always were numbered
+        for (int j = 0; j <= cellsV; ++j)
+            for (int i = 0; i <= cellsU; ++i) vertex(i, j);
+    for (int j = 0; j < cellsV; ++j)
+        for (int i = 0; i < cellsU; ++i) {
+            if (keep && !keep(i, j)) continue;
+            const uint32_t a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i + 1, j + 1), d = vertex(i, j + 1);
+            idx.insert(idx.end(), {a, b, c, a, c, d});
         }
     s.addInstance(node, std::move(p), std::move(n), idx, material);
+}
+
+void addGrid(Scene& s, int node, Vec3f corner, Vec3f u, Vec3f v, int cells, uint32_t material) {
+    addGrid(s, node, corner, u, v, cells, cells, material);
 }
 
 // A box standing on y = 0 over [−half, half]² and `height` high: its four sides and top, facing
@@ -248,11 +264,11 @@ Scene closedBox(int cells) {
     return s;
 }
 
-Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo) {
+Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo, float floorHalf) {
     Scene s;
     const uint32_t m = addMaterial(s, albedo);
     const int floor = s.addNode("Floor", Transform());
-    addGrid(s, floor, {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, floorCells, m);
+    addGrid(s, floor, {-floorHalf, 0, floorHalf}, {2 * floorHalf, 0, 0}, {0, 0, -2 * floorHalf}, floorCells, m);
     const float h = 0.3f;
     addBoxOnFloor(s, s.addNode("Cube", Transform()), h, 2 * h, cubeCells, m);
     s.finalize();
@@ -268,12 +284,25 @@ Scene slabOnFloor(int floorCells, float half, float height, Vec3f albedo) {
     return s;
 }
 
-Scene corner(int cells, Vec3f albedo) {
+Scene corner(int cells, Vec3f albedo, float depth) {
     Scene s;
     const uint32_t m = addMaterial(s, albedo);
     const int node = s.addNode("Corner", Transform());
-    addGrid(s, node, {-1, 0, 2}, {2, 0, 0}, {0, 0, -2}, cells, m);  // floor, +y
-    addGrid(s, node, {-1, 0, 0}, {2, 0, 0}, {0, 2, 0}, cells, m);   // wall, +z
+    const int deep = int(std::lround(float(cells) * depth / 2));  // the same spacing as along x
+    addGrid(s, node, {-1, 0, depth}, {2, 0, 0}, {0, 0, -depth}, cells, deep, m);  // floor, +y
+    addGrid(s, node, {-1, 0, 0}, {2, 0, 0}, {0, depth, 0}, cells, deep, m);       // wall, +z
+    s.finalize();
+    return s;
+}
+
+Scene squareFrame(float halfSize, int cells, int borderCells, Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    auto inBorder = [&](int i, int j) {
+        return i < borderCells || j < borderCells || i >= cells - borderCells || j >= cells - borderCells;
+    };
+    addGrid(s, s.addNode("Frame", Transform()), {-halfSize, 0, halfSize}, {2 * halfSize, 0, 0}, {0, 0, -2 * halfSize}, cells,
+            cells, m, inBorder);
     s.finalize();
     return s;
 }

@@ -84,13 +84,18 @@ qsgi::Scene closedSphere(float radius, int subdivisions, qsgi::Vec3f albedo, boo
 qsgi::Scene plane(float halfSize, int cells, qsgi::Vec3f albedo);
 // A closed box [-1,1]^3 with coloured walls facing inward.
 qsgi::Scene closedBox(int cells);
-// A 4x4 m floor (y = 0) with a 0.6 m cube on it: the cube's convex edges make silhouettes.
-qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo);
+// A 4x4 m floor (y = 0; 2·floorHalf a side when given) with a 0.6 m cube on it: the cube's
+// convex edges make silhouettes.
+qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo, float floorHalf = 2.0f);
 // A floor y = 0 (x, z in [-1, 1], `floorCells` per side, its vertices first) with a closed slab
 // standing on it: [−half, half]² and `height` high (a rug, when low).
 qsgi::Scene slabOnFloor(int floorCells, float half, float height, qsgi::Vec3f albedo);
-// An inside corner: floor y = 0 (x in [-1,1], z in [0,2]) and wall z = 0 (x in [-1,1], y in [0,2]).
-qsgi::Scene corner(int cells, qsgi::Vec3f albedo);
+// An inside corner: floor y = 0 (x in [-1,1], z in [0,depth]) and wall z = 0 (x in [-1,1], y in
+// [0,depth]), `cells` per 2 m in every direction (cells·depth/2 across the depth).
+qsgi::Scene corner(int cells, qsgi::Vec3f albedo, float depth = 2.0f);
+// plane(halfSize, cells, albedo) without its inside: only the cells within `borderCells` of its
+// edge (one welded mesh, y = 0, facing +y), its vertices numbered in the order the cells need them.
+qsgi::Scene squareFrame(float halfSize, int cells, int borderCells, qsgi::Vec3f albedo);
 // A floor y = 0 (x, z in [-1, 1]) with a square opaque plate (half size `half`, zero thickness,
 // facing up) `gap` above it.
 qsgi::Scene plateOverFloor(int floorCells, float half, float gap, qsgi::Vec3f albedo);
