@@ -18,10 +18,12 @@ if(QSGI_TESTS_SANITIZED)
     PhotonMapUpdate.UpdatedMapEqualsNewMapAndBruteForce 21
     Resume.SigintAndSigtermStopAfterTheCurrentFrameWithAConsistentFolder 20
     GltfOut.KhronosSamplesComeBackWholeWithTheBake 19
-    OwnSurface.TheTreeShortcutChangesNoStartPointOrDisc 18)
+    OwnSurface.TheTreeShortcutChangesNoStartPointOrDisc 18
+    GatherCache.IncrementalFramesEqualFullRecomputationOnTheDataScenes 70)
 else()
   set(costs
     HostileInput.EveryBadFileIsRefusedWithOneLineNamingItExitTwoAndNothingWritten 95
+    GatherCache.IncrementalFramesEqualFullRecomputationOnTheDataScenes 44
     Estimators.IndexedPhotonMapAndDetpEqualBruteForce 55
     DetpBoundary.OutsideOfASphereIsUnbiasedWithinOnePercent 46
     GatherAccuracy.ErrorFallsWithGatherRaysAndPhotonsInEveryRegion 37
