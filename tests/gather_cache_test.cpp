@@ -287,7 +287,7 @@ TEST(GatherCache, AnswersAtAnySurfacePointAgreeWithTheVertices) {
 // records' other M − 16 hits — bounded by the records, not by vertices × M. A cropped dense floor
 // (tiles of 32 × 32 cells with a block on them), M = 256.
 TEST(GatherCache, KeptStateIsBoundedByTheRecords) {
-    Scene scene = testscenes::tiledFloor(kSanitized ? 2 : 4, 32, Transform(), Vec3f(0.6f));
+    Scene scene = testscenes::tiledFloor(4, 32, Transform(), Vec3f(0.6f));
     testscenes::addPointLight(scene, Vec3f(0.3f, 1.0f, 0.2f), Vec3f(2.0f));
     const SecondPassRig rig(scene);
     const uint32_t m = 256;

@@ -119,10 +119,10 @@ void FinalGather::castAll(const Scene& scene, const SceneBvh& bvh, const VertexS
     probeHits_.assign(scene.vertexCount() * size_t(probes_), GatherHit{});
     if (cached()) restSlot_.assign(scene.vertexCount(), kNoSlot);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
-    if (progress) progress->setTotal(scene.vertexCount());
+    if (progress) progress->setTotal(scene.vertexCount() * uint64_t(rays_));
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), [&](const tbb::blocked_range<uint32_t>& r) {
         for (uint32_t v = r.begin(); v != r.end(); ++v) castVertex(scene, bvh, starts, frontNormals, v);
-        if (progress) progress->add(r.size());
+        if (progress) progress->add(r.size() * uint64_t(probes_));
     });
     raysCast_ = uint64_t(scene.vertexCount()) * probes_;
 }
@@ -143,7 +143,8 @@ void FinalGather::cast(const Scene& scene, const SceneBvh& bvh, const VertexStar
     raysCast_ += cast;
 }
 
-void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint8_t>& record) {
+void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint8_t>& record,
+                             WorkCounter* progress) {
     if (!cached()) return;
     // Slots first, in vertex order (which slot a record holds changes no bit: its sum is its own).
     std::vector<uint32_t> added;
@@ -166,9 +167,11 @@ void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const Vert
         added.push_back(v);
     }
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    if (progress) progress->resize(scene.vertexCount() * uint64_t(probes_) + added.size() * rest);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, added.size(), 4), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i)
             castVertexInto(scene, bvh, starts, frontNormals, added[i], probes_, uint32_t(rest), restOf(added[i]));
+        if (progress) progress->add(r.size() * rest);
     });
     raysCast_ += uint64_t(added.size()) * rest;
 }
@@ -269,7 +272,7 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
     raysCast_ = 0;
     if (rays_ == 0) return;
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
-    if (progress) progress->setTotal(scene.vertexCount());
+    if (progress) progress->setTotal(scene.vertexCount() * uint64_t(rays_));
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), [&](const tbb::blocked_range<uint32_t>& r) {
         // One vertex's hits at a time: cast them all, then sum them, as castAll and gather do
         // (summing as each ray returns interleaves the first pass's scattered reads with
@@ -280,7 +283,7 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
             castVertexInto(scene, bvh, starts, frontNormals, v, 0, rays_, hits.data());
             out[v] = meanOverHits(scene, firstPass, hits.data(), hits.data() + probes_);
         }
-        if (progress) progress->add(r.size());
+        if (progress) progress->add(r.size() * uint64_t(rays_));
     });
     raysCast_ = uint64_t(scene.vertexCount()) * rays_;
 }

@@ -48,6 +48,7 @@ public:
 
     // Every vertex's first probeRays() rays, for the scene's current pose (bvh holds it); no
     // vertex is a record until setRecords (without a cache, every vertex has all its rays).
+    // progress counts rays, of every vertex's M (with a cache, setRecords then says how many).
     void castAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress = nullptr);
     // Every kept ray of the given vertices (their start or normal changed).
     void cast(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint32_t>& vertices);
@@ -57,7 +58,9 @@ public:
                            const std::vector<Bounds3f>& boxes, const std::vector<uint8_t>& skip);
     // With a cache: the vertices with record[v] set cast the rest of their M rays (those that
     // already had them keep them), the others drop theirs.
-    void setRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint8_t>& record);
+    // progress: castAll's, in rays (its total, every vertex's M, is resized to what is cast).
+    void setRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint8_t>& record,
+                    WorkCounter* progress = nullptr);
 
     // Each vertex's gathered irradiance from the first pass F (per vertex, the current pose's);
     // 0 at a vertex that does not have all M rays (a cache interpolates those).

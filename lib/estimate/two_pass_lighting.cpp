@@ -17,10 +17,10 @@ size_t TwoPassLighting::stateBytes() const {
     return starts_.size() * 2 * sizeof(Vec3f) + direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes() + (cache_ ? cache_->bytes() : 0);
 }
 
-void TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats) {
+void TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats, WorkCounter* progress) {
     if (!cache_) return;
     cache_->select(scene, bvh, starts_, gather_);
-    gather_.setRecords(scene, bvh, starts_, cache_->records());
+    gather_.setRecords(scene, bvh, starts_, cache_->records(), progress);
     stats.gatherRecords = cache_->recordCount();
 }
 
@@ -45,7 +45,7 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     if (settings_.gathers()) {
         if (progress) progress->start("gathering", scene.vertexCount());
         gather_.castAll(scene, bvh, starts_, progress);
-        placeRecords(scene, bvh, stats);
+        placeRecords(scene, bvh, stats, progress);
         stats.gatherRays = gather_.raysCast();
     }
     combine(scene, photons, out);

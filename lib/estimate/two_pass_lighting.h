@@ -61,7 +61,7 @@ private:
     // E = D + the gathered mean, and B.
     void addDirect(const Scene& scene, VertexRadiosity& out) const;
     // With the cache: the records for the current pose, and the rest of their rays.
-    void placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats);
+    void placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats, WorkCounter* progress = nullptr);
 
     LightingSettings settings_;
     VertexStarts starts_;

@@ -36,6 +36,14 @@ public:
         if (report_) report_(stage_, 0, total_);
     }
 
+    // The stage's size, corrected once the work is better known (a first total was an upper
+    // bound): what is done stands.
+    void resize(uint64_t total) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        total_ = total;
+        if (report_) report_(stage_, done_, total_);
+    }
+
     // `n` more items done; reports at most every 100 ms. Thread-safe.
     void add(uint64_t n) {
         const uint64_t done = done_ += n;
