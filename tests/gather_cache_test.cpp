@@ -134,17 +134,6 @@ TEST(GatherCache, InterpolationErrorFallsWithTheToleranceTowardThePerVertexGathe
             const double e = cached.values[v].y / want - 1;
             sum2 += e * e;
             ++n;
-            if (std::getenv("QSGI_DEBUG_CACHE") && std::fabs(e) > 0.5) {
-                const Vec3d p = Vec3d(scene.positions[v]) + scene.worldOrigin;
-                std::printf("  v %zu (%.3f %.3f %.3f) n (%.2f %.2f %.2f) want %.4f got %.4f R %.4f record %d reads", v, p.x, p.y, p.z,
-                            rig.starts.normal(v).x, rig.starts.normal(v).y, rig.starts.normal(v).z, want, cached.values[v].y,
-                            cached.cache.spacing()[v], int(cached.cache.records()[v]));
-                for (uint32_t r : cached.cache.recordsRead(uint32_t(v))) {
-                    const Vec3d q = Vec3d(scene.positions[r]) + scene.worldOrigin;
-                    std::printf(" [%u (%.3f %.3f %.3f) %.4f]", r, q.x, q.y, q.z, exact.values[r].y);
-                }
-                std::printf("\n");
-            }
         }
         const double rms = std::sqrt(sum2 / double(n));
         std::printf("tolerance %.2f: %zu records of %zu vertices, interpolation error %.3f %%\n", tolerance,

@@ -259,7 +259,7 @@ void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             if (!hasAllRays(v)) continue;
-            const GatherHit* rest = cached() ? &restHits_[size_t(restSlot_[v]) * (rays_ - probes_)] : nullptr;
+            const GatherHit* rest = cached() ? restOf(v) : nullptr;
             out[v] = meanOverHits(scene, firstPass, &probeHits_[size_t(v) * probes_], rest);
         }
     });

@@ -83,7 +83,7 @@ public:
     // Ray `ray` of v: one of its probes, or (a record's) one of the rest.
     const GatherHit& hit(uint32_t v, uint32_t ray) const {
         assert(size_t(v) * probes_ < probeHits_.size() && (ray < probes_ || restSlot_[v] != kNoSlot));
-        return ray < probes_ ? probeHits_[size_t(v) * probes_ + ray] : restHits_[size_t(restSlot_[v]) * (rays_ - probes_) + ray - probes_];
+        return ray < probes_ ? probeHits_[size_t(v) * probes_ + ray] : restOf(v)[ray - probes_];
     }
     bool hasAllRays(uint32_t v) const { return !cached() || restSlot_[v] != kNoSlot; }
     // Rays cast by the last castAll(), or by cast(), recastMeeting() and setRecords() since then.
@@ -111,7 +111,9 @@ private:
     // Every kept ray of v.
     void castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                     const std::vector<Vec3f>& frontNormals, uint32_t v);
+    // A record's hits after its probes.
     GatherHit* restOf(uint32_t v) { return &restHits_[size_t(restSlot_[v]) * (rays_ - probes_)]; }
+    const GatherHit* restOf(uint32_t v) const { return &restHits_[size_t(restSlot_[v]) * (rays_ - probes_)]; }
 
     uint32_t rays_, probes_;
     uint64_t seed_;

@@ -82,9 +82,6 @@ struct GatherCache::Adjacency {
     }
 };
 
-namespace {
-}  // namespace
-
 float GatherCache::weight(const Label& label, const Vec3f& normal, float spacing) const {
     const float reach = std::min(reach_[label.record], spacing);
     const float closeness = (dot(normal, normal_[label.record]) - kMinNormalDot) / (1 - kMinNormalDot);
@@ -95,10 +92,12 @@ float GatherCache::weight(const Label& label, const Vec3f& normal, float spacing
     return falloff * falloff * closeness;
 }
 
-void GatherCache::flood(const Scene& scene, const VertexStarts& starts, const Adjacency& adjacency,
-                        const std::vector<uint32_t>& pieces, const std::vector<uint32_t>& sources) {
-    labels_.assign(scene.vertexCount() * size_t(kRecordsPerVertex), Label{});
-    std::vector<uint8_t> settled(scene.vertexCount(), 0);
+void GatherCache::flood(const Adjacency& adjacency, const std::vector<uint32_t>& pieces) {
+    std::vector<uint32_t> sources;
+    for (uint32_t v = 0; v < record_.size(); ++v)
+        if (record_[v]) sources.push_back(v);
+    labels_.assign(record_.size() * size_t(kRecordsPerVertex), Label{});
+    std::vector<uint8_t> settled(record_.size(), 0);
     // Light stays on its piece of surface, so each piece floods on its own, in parallel: the
     // sources grouped by piece (in vertex order within each).
     std::vector<uint32_t> bySource(sources);
@@ -139,7 +138,7 @@ void GatherCache::flood(const Scene& scene, const VertexStarts& starts, const Ad
                 const uint32_t u = adjacency.vertex[i];
                 const float d = e.distance + adjacency.edge[i];
                 if (!(d < reach) || !(d < spacing_[u]) || settled[u] == kRecordsPerVertex) continue;
-                if (!(dot(starts.normal(u), normal) > kMinNormalDot) || has(u, e.record)) continue;
+                if (!(dot(normal_[u], normal) > kMinNormalDot) || has(u, e.record)) continue;
                 queue.push({d, e.record, u});
             }
         }
@@ -204,7 +203,6 @@ void GatherCache::select(const Scene& scene, const SceneBvh& bvh, const VertexSt
     std::sort(asks.begin(), asks.end(), [](const Ask& a, const Ask& b) {
         return std::tie(a.cell, a.offCentre, a.vertex) < std::tie(b.cell, b.offCentre, b.vertex);
     });
-    std::vector<uint32_t> sources;
     // Every asker of a cell asks at the cell's level, so the one chosen reaches (its own R, as
     // Ward's records) at least the cell's diagonal: every other asker, as the crow flies.
     for (size_t i = 0; i < asks.size();) {
@@ -215,9 +213,7 @@ void GatherCache::select(const Scene& scene, const SceneBvh& bvh, const VertexSt
     }
     for (uint32_t v = 0; v < n; ++v)
         if (record_[v]) reach_[v] = spacing_[v];
-    for (uint32_t v = 0; v < n; ++v)
-        if (record_[v]) sources.push_back(v);
-    flood(scene, starts, adjacency, pieces, sources);
+    flood(adjacency, pieces);
 
     // A vertex no record reaches with any weight (across a fold, a crease, a gap) becomes one,
     // and the records flood again. A new record can fill a vertex's labels before an older one's
@@ -227,21 +223,15 @@ void GatherCache::select(const Scene& scene, const SceneBvh& bvh, const VertexSt
         bool added = false;
         for (uint32_t v = 0; v < n; ++v) {
             if (scene.vertexHidden[v] || record_[v]) continue;
-            float total = 0;
-            for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
-                const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
-                if (label.record != UINT32_MAX) total += weight(label, starts.normal(v), spacing_[v]);
-            }
-            if (total > 0) continue;
+            bool reached = false;
+            forEachRecordRead(v, [&](uint32_t, double) { reached = true; });
+            if (reached) continue;
             record_[v] = 1;
             reach_[v] = spacing_[v];
             added = true;
         }
         if (!added) break;
-        sources.clear();
-        for (uint32_t v = 0; v < n; ++v)
-            if (record_[v]) sources.push_back(v);
-        flood(scene, starts, adjacency, pieces, sources);
+        flood(adjacency, pieces);
     }
     recordCount_ = size_t(std::count(record_.begin(), record_.end(), uint8_t(1)));
 }
@@ -253,14 +243,10 @@ void GatherCache::interpolate(std::vector<Vec3f>& irradiance) const {
             if (record_[v]) continue;
             Vec3d sum(0.0);
             double total = 0;
-            for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
-                const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
-                if (label.record == UINT32_MAX) break;
-                const double w = weight(label, normal_[v], spacing_[v]);
-                if (w <= 0) continue;
-                sum += Vec3d(irradiance[label.record]) * w;
+            forEachRecordRead(v, [&](uint32_t record, double w) {
+                sum += Vec3d(irradiance[record]) * w;
                 total += w;
-            }
+            });
             // Hidden vertices have no labels: 0.
             irradiance[v] = total > 0 ? Vec3f(sum / total) : Vec3f(0.0f);
         }
@@ -306,11 +292,7 @@ Vec3f GatherCache::irradianceAt(const Scene& scene, uint32_t triangle, float b1,
 std::vector<uint32_t> GatherCache::recordsRead(uint32_t v) const {
     if (record_[v]) return {v};
     std::vector<uint32_t> read;
-    for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
-        const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
-        if (label.record == UINT32_MAX) break;
-        if (weight(label, normal_[v], spacing_[v]) > 0) read.push_back(label.record);
-    }
+    forEachRecordRead(v, [&](uint32_t record, double) { read.push_back(record); });
     return read;
 }
 

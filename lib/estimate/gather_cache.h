@@ -77,9 +77,19 @@ private:
         float distance = 0;  // geodesic, along the mesh's edges
     };
     struct Adjacency;
-    // Every vertex's labels: the first kRecordsPerVertex of `sources` whose light reaches it.
-    void flood(const Scene& scene, const VertexStarts& starts, const Adjacency& adjacency,
-               const std::vector<uint32_t>& pieces, const std::vector<uint32_t>& sources);
+    // Every vertex's labels: the first kRecordsPerVertex records (record_) whose light reaches it.
+    void flood(const Adjacency& adjacency, const std::vector<uint32_t>& pieces);
+    // Calls visit(record, weight) for each record v's labels name with a weight above 0, nearest
+    // first: what v's interpolated value is made of.
+    template <typename Visit>
+    void forEachRecordRead(uint32_t v, Visit&& visit) const {
+        for (uint32_t i = 0; i < kRecordsPerVertex; ++i) {
+            const Label& label = labels_[size_t(v) * kRecordsPerVertex + i];
+            if (label.record == UINT32_MAX) break;
+            const float w = weight(label, normal_[v], spacing_[v]);
+            if (w > 0) visit(label.record, double(w));
+        }
+    }
     // A record's weight at a vertex (or point) with this normal and spacing R.
     float weight(const Label& label, const Vec3f& normal, float spacing) const;
 
