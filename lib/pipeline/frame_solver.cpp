@@ -190,12 +190,19 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     if (firstFrame || why != FromScratchReason::None) {
         // A frame may update from this one only if one follows and could.
         const bool updatesMayFollow = updateFollows && !settings_.update.fullRecompute && estimator_->canUpdate();
-        solveFromScratch(updatesMayFollow, stats);
+        // After the first frame the tracking state is made at once, from the tails its trace
+        // kept (no second look at the cache, which is then not kept), so that the frames after
+        // it pay only their updates; after a fallback, only once a frame updates again, from
+        // the kept cache, and that frame's price includes it.
+        if (firstFrame && updatesMayFollow) {
+            const TrackingLayout layout = trackingLayout();
+            EnvelopeTails tails{layout.envelope, layout.extension, {}};
+            solveFromScratch(false, stats, &tails);
+            startTracking(stats, &tails);
+        } else {
+            solveFromScratch(updatesMayFollow, stats);
+        }
         stats.fromScratchReason = nameOf(kFromScratchReasonNames, why);
-        // After the first frame the tracking state is made at once, so that the frames after it
-        // pay only their updates; after a fallback, only once a frame updates again, and that
-        // frame's price includes it.
-        if (firstFrame && updatesMayFollow) startTracking(stats);
     } else {
         stats.fromScratch = false;
         if (change.any) {
@@ -222,14 +229,14 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
     return result_;
 }
 
-void FrameSolver::solveFromScratch(bool keepCache, FrameTiming& stats) {
+void FrameSolver::solveFromScratch(bool keepCache, FrameTiming& stats, EnvelopeTails* tails) {
     stats.fromScratch = true;
     mode_ = Mode::FromScratch;
     tracked_.reset();
     lastCache_.reset();
     Stopwatch clock;
     work_.start("tracing", settings_.trace.photons);
-    RayCache cache = tracer_.traceAll(&work_);
+    RayCache cache = tracer_.traceAll(&work_, tails);
     stats.photonSimulationSeconds = clock.seconds();
     stats.segments = cache.segmentCount();
     stats.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
@@ -243,25 +250,42 @@ void FrameSolver::solveFromScratch(bool keepCache, FrameTiming& stats) {
     if (keepCache) lastCache_ = std::move(cache);
 }
 
-void FrameSolver::startTracking(FrameTiming& stats) {
+FrameSolver::TrackingLayout FrameSolver::trackingLayout() const {
     // Paths that meet the envelope are tracked, the rest stay folded into the estimator's state.
-    stage("tracking");
-    Stopwatch clock;
-    const RayCache& cache = *lastCache_;
+    TrackingLayout layout;
     const float reach = estimator_->reach();
     const float margin = envelopeMargin(reach > 0, reach, scene_.sceneEpsilon());
-    const Envelope envelope = settings_.update.useEnvelope ? Envelope::ofAnimation(scene_, margin) : Envelope::everything();
-    const Bounds3f gridBounds = envelope.isEverything() ? scene_.animationBounds.expanded(margin) : envelope.bounds();
+    layout.envelope = settings_.update.useEnvelope ? Envelope::ofAnimation(scene_, margin) : Envelope::everything();
+    layout.extension = reach;
+    layout.gridBounds = layout.envelope.isEverything() ? scene_.animationBounds.expanded(margin) : layout.envelope.bounds();
     // The grid answers two kinds of query: the movers' new bounds (rule (b)) and, for DETP, the
     // discs a frame recomputes. For the first, cells an eighth of the envelope across are fine
     // and cheap to fill (measured on data/cornell: the impact-count update 2.0x -> 2.5x against
     // 32 divisions); discs want cells a few discs across, no more than 32 along an axis. The
     // whole scene (no envelope) gets half as many.
-    const float divisions = (reach > 0 ? 32.0f : 8.0f) / (envelope.isEverything() ? 2.0f : 1.0f);
-    const float cellSize = std::max(4 * reach, gridBounds.extent() / divisions);
-    tracked_ = std::make_unique<TrackedPaths>(cache, envelope, reach, gridBounds, cellSize, settings_.update.trackedGenerations);
-    foldedSegments_ = cache.segmentCount() - tracked_->trackedSegments();
-    trackedShare_ = double(tracked_->trackedSegments()) / double(std::max<uint64_t>(cache.segmentCount(), 1));
+    const float divisions = (reach > 0 ? 32.0f : 8.0f) / (layout.envelope.isEverything() ? 2.0f : 1.0f);
+    layout.cellSize = std::max(4 * reach, layout.gridBounds.extent() / divisions);
+    return layout;
+}
+
+void FrameSolver::startTracking(FrameTiming& stats, EnvelopeTails* tails) {
+    stage("tracking");
+    Stopwatch clock;
+    const uint32_t generations = settings_.update.trackedGenerations;
+    uint64_t segments = 0;
+    if (tails) {
+        segments = stats.segments;  // this frame's trace
+        const TrackingLayout layout = trackingLayout();
+        tracked_ = std::make_unique<TrackedPaths>(tracer_.source(), *tails, layout.gridBounds, layout.cellSize, generations);
+    } else {
+        const RayCache& cache = *lastCache_;
+        segments = cache.segmentCount();
+        const TrackingLayout layout = trackingLayout();
+        tracked_ = std::make_unique<TrackedPaths>(cache, layout.envelope, layout.extension, layout.gridBounds, layout.cellSize,
+                                                  generations);
+    }
+    foldedSegments_ = segments - tracked_->trackedSegments();
+    trackedShare_ = double(tracked_->trackedSegments()) / double(std::max<uint64_t>(segments, 1));
     stats.photonSimulationSeconds += clock.seconds();
     clock.restart();
     estimator_->prepareUpdates(*tracked_, stats);

@@ -113,9 +113,20 @@ private:
     // The share of a from-scratch frame that building the tracking state costs.
     double trackingBuildShare() const;
     // keepCache: a frame may update from this one (its cache is kept for the tracked paths).
-    void solveFromScratch(bool keepCache, FrameTiming& stats);
-    // The incremental state from the last frame's cache: tracked paths and the estimator's own.
-    void startTracking(FrameTiming& stats);
+    // tails, if given, receives what the tracked paths keep, found while tracing.
+    void solveFromScratch(bool keepCache, FrameTiming& stats, EnvelopeTails* tails = nullptr);
+    // What the tracked paths keep (the envelope of the moving geometry and how far past an impact
+    // a segment counts), and where the grid that finds them lies and how fine it is.
+    struct TrackingLayout {
+        Envelope envelope;
+        float extension = 0;
+        Bounds3f gridBounds;
+        float cellSize = 0;
+    };
+    TrackingLayout trackingLayout() const;
+    // The incremental state: tracked paths and the estimator's own, from the tails this frame's
+    // trace kept, or else from the last frame's cache. segments: how many the frame traced.
+    void startTracking(FrameTiming& stats, EnvelopeTails* tails = nullptr);
     void solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& stats);
     // Where the estimator's answer goes: result_ itself, or photons_ under a second pass.
     VertexRadiosity& estimate() { return lighting_ ? photons_ : result_; }

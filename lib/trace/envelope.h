@@ -24,6 +24,15 @@ public:
     // Whether the segment, continued `extension` past its impact (an escaping segment: without
     // end), meets the envelope.
     bool meets(const Segment& s, float extension) const;
+    // What is tracked of one path (its segments [begin, end), in bounce order): appends them from
+    // the first that meets the envelope on, or nothing if none does.
+    void appendTail(const Segment* begin, const Segment* end, float extension, std::vector<Segment>& out) const {
+        for (const Segment* s = begin; s != end; ++s)
+            if (meets(*s, extension)) {
+                out.insert(out.end(), s, end);
+                return;
+            }
+    }
     bool isEverything() const { return everything_; }
     const std::vector<Bounds3f>& boxes() const { return boxes_; }
     Bounds3f bounds() const;  // of all boxes

@@ -19,6 +19,15 @@ namespace {
 // Where the kernel puts a segment: a retrace's list, or the cache block a first trace writes.
 void append(std::vector<Segment>& out, const Segment& s) { out.push_back(s); }
 void append(RayCache::BlockWriter& out, const Segment& s) { out.add(s); }
+// A first trace that also keeps tails: the block, and the current path's segments as traced.
+struct BlockAndPath {
+    RayCache::BlockWriter& block;
+    std::vector<Segment>& path;
+};
+void append(BlockAndPath& out, const Segment& s) {
+    out.block.add(s);
+    out.path.push_back(s);
+}
 }  // namespace
 
 void PhotonTracer::tracePath(uint64_t path, std::vector<Segment>& out) const { tracePathInto(path, out); }
@@ -72,7 +81,7 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
     }
 }
 
-RayCache PhotonTracer::traceAll(WorkCounter* progress) const {
+RayCache PhotonTracer::traceAll(WorkCounter* progress, EnvelopeTails* tails) const {
     const LightSampler& lights = source_->lights();
     const uint64_t n = settings_.photons;
     if (progress) progress->setTotal(n);
@@ -81,16 +90,27 @@ RayCache PhotonTracer::traceAll(WorkCounter* progress) const {
     constexpr uint64_t kChunk = 4096;
     const uint64_t chunks = (n + kChunk - 1) / kChunk;
     std::vector<RayCache::BlockWriter> blocks(chunks);
+    if (tails) tails->blocks.assign(chunks, {});
     // Each thread writes its chunks into one writer and keeps an exact-size copy of each.
     tbb::enumerable_thread_specific<RayCache::BlockWriter> writers;
+    tbb::enumerable_thread_specific<std::vector<Segment>> paths;
     tbb::parallel_for(tbb::blocked_range<uint64_t>(0, chunks, 1), [&](const tbb::blocked_range<uint64_t>& r) {
         RayCache::BlockWriter& block = writers.local();
+        std::vector<Segment>& path = paths.local();
         for (uint64_t c = r.begin(); c != r.end(); ++c) {
             const uint64_t begin = c * kChunk, end = std::min(n, (c + 1) * kChunk);
             block.clear();
             for (uint64_t p = begin; p < end; ++p) {
                 block.beginPath();
-                if (!lights.empty()) tracePathInto(p, block);
+                if (lights.empty()) continue;
+                if (!tails) {
+                    tracePathInto(p, block);
+                    continue;
+                }
+                path.clear();
+                BlockAndPath out{block, path};
+                tracePathInto(p, out);
+                tails->envelope.appendTail(path.data(), path.data() + path.size(), tails->extension, tails->blocks[c]);
             }
             blocks[c] = block.exactCopy();
             if (progress) progress->add(end - begin);

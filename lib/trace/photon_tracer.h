@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "scene/scene.h"
+#include "trace/envelope.h"
 #include "trace/light_sampler.h"
 #include "trace/photon_source.h"
 #include "trace/ray_cache.h"
@@ -17,13 +18,24 @@ namespace qsgi {
 
 static_assert(RayCache::kBytesPerPath == kLeastBytesPerPhoton, "a photon's least cost (trace_settings.h) is the cache's");
 
+// What a first frame that later frames will update keeps beside its cache (TrackedPaths): per
+// block of the cache, each path's segments from its first that meets `envelope` (continued
+// `extension` past its impact) on, in path order. Found as the paths are traced, so that the
+// cache is not decoded again to find them.
+struct EnvelopeTails {
+    Envelope envelope;
+    float extension = 0;
+    std::vector<std::vector<Segment>> blocks;  // filled by traceAll
+};
+
 class PhotonTracer {
 public:
     PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings);
 
     // Traces every photon from scratch. progress, if given, counts the photons done (its total set
     // here), from the worker threads as every other stage's.
-    RayCache traceAll(WorkCounter* progress = nullptr) const;
+    // tails, if given, also receives the tails that meet its envelope.
+    RayCache traceAll(WorkCounter* progress = nullptr, EnvelopeTails* tails = nullptr) const;
 
     // Appends every segment of `path`.
     void tracePath(uint64_t path, std::vector<Segment>& out) const;
@@ -33,6 +45,8 @@ public:
                       std::vector<Segment>& out) const;
 
     const LightSampler& lights() const { return source_->lights(); }
+    // What decodes the caches it writes (and the tails it keeps).
+    const std::shared_ptr<const PhotonSource>& source() const { return source_; }
 
 private:
     // The one kernel of first traces and retraces, writing to a segment list or a cache block.

@@ -41,13 +41,20 @@ TrackedPaths::TrackedPaths(const RayCache& cache, const Envelope& envelope, floa
     std::vector<std::vector<Segment>> kept(cache.blockCount());
     cache.forEachBlock([&](size_t b, const std::vector<Segment>& block) {
         forEachPathGroup(block, [&](size_t begin, size_t end) {
-            for (size_t j = begin; j < end; ++j)
-                if (envelope.meets(block[j], extension_)) {
-                    kept[b].insert(kept[b].end(), block.begin() + int64_t(j), block.begin() + int64_t(end));
-                    break;
-                }
+            envelope.appendTail(block.data() + begin, block.data() + end, extension_, kept[b]);
         });
     });
+    keep(kept, gridBounds, cellSize);
+}
+
+TrackedPaths::TrackedPaths(std::shared_ptr<const PhotonSource> source, EnvelopeTails& tails, const Bounds3f& gridBounds,
+                           float cellSize, uint32_t generations)
+    : source_(std::move(source)), extension_(tails.extension), generations_(generations) {
+    if (!source_) throw std::logic_error("TrackedPaths: no photon source to decode with");
+    keep(tails.blocks, gridBounds, cellSize);
+}
+
+void TrackedPaths::keep(std::vector<std::vector<Segment>>& kept, const Bounds3f& gridBounds, float cellSize) {
     size_t slots = 0, segments = 0;
     uint32_t longest = 0;
     for (const std::vector<Segment>& tails : kept) {

@@ -48,6 +48,10 @@ public:
     // lower it).
     TrackedPaths(const RayCache& cache, const Envelope& envelope, float extension, const Bounds3f& gridBounds,
                  float cellSize, uint32_t generations = kGenerations);
+    // The same from the tails the tracer kept while tracing that cache (EnvelopeTails: the same
+    // segments, found without decoding the cache), which it empties.
+    TrackedPaths(std::shared_ptr<const PhotonSource> source, EnvelopeTails& tails, const Bounds3f& gridBounds, float cellSize,
+                 uint32_t generations = kGenerations);
     static constexpr uint32_t kGenerations = SlottedPathStore<>::kMaxGenerations;
 
     // The paths the move from the previous pose to the current one affects, in increasing path
@@ -98,6 +102,9 @@ private:
     // Slot s's segments at places [from, to), decoded into out[0, to − from).
     void decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) const;
     bool isLive(const SegmentRef& r) const { return store_.isLive(r.slot, r.place, r.generation); }
+    // Both constructors: the store and the index from the tails, per block of paths in path
+    // order (emptied).
+    void keep(std::vector<std::vector<Segment>>& kept, const Bounds3f& gridBounds, float cellSize);
     double reach(const Record& r) const;  // how far along the ray the grid lists it
     // The retrace's two stages: the new tails traced (in parallel; nothing changes), then
     // committed to the store and the index (the old tails decoded into changes.removed first).
