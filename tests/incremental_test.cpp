@@ -549,6 +549,51 @@ TEST(Incremental, AnEstimatorWithoutAnUpdateLogsItsFramesAsFromScratch) {
 
 // Equal distances are ordered by (path, bounce): the k nearest impacts are the same set whatever
 // order the cache holds them in (an incremental update reorders it).
+// A first frame keeps the tails it will track while it traces (EnvelopeTails) instead of decoding
+// its cache again: the tracked paths made from them are the ones made from the cache — the same
+// paths in the same slots, every segment to the bit — with and without a disc's extension past
+// the impact. Both kinds of path occur (tracked and folded), so a rule that kept all or none
+// would fail.
+TEST(TrackedPaths, TailsKeptWhileTracingAreTheCachesOwn) {
+    AnimatedScene a{"box", [] {
+                        Scene s = testscenes::boxOnFloor(16, 3, Vec3f(0.7f));
+                        testscenes::addPointLight(s, Vec3f(0.3f, 1.5f, 0.2f), Vec3f(10.0f));
+                        return s;
+                    },
+                    "Cube", [](int f) { return Vec3d(0.05 * f, 0.0, 0.0); }, 4};
+    int mover = -1;
+    const Scene scene = prepare(a, mover);
+    ASSERT_GE(mover, 0);
+    EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
+    const PhotonTracer tracer(scene, bvh, TraceSettings{20000, 7, 32, EmissionAim{}, PhotonSampling{}});
+    for (const float extension : {0.0f, 0.1f}) {
+        SCOPED_TRACE("extension " + std::to_string(extension));
+        const Envelope envelope = Envelope::ofAnimation(scene, envelopeMargin(extension > 0, extension, scene.sceneEpsilon()));
+        const Bounds3f grid = envelope.bounds();
+        const float cell = grid.extent() / 8;
+        EnvelopeTails tails{envelope, extension, {}};
+        const RayCache cache = tracer.traceAll(nullptr, &tails);
+        const TrackedPaths fromCache(cache, envelope, extension, grid, cell);
+        const TrackedPaths fromTails(tracer.source(), tails, grid, cell);
+        ASSERT_GT(fromCache.trackedPaths(), 0u);
+        ASSERT_LT(fromCache.trackedSegments(), cache.segmentCount());
+        ASSERT_EQ(fromTails.trackedPaths(), fromCache.trackedPaths());
+        ASSERT_EQ(fromTails.trackedSegments(), fromCache.trackedSegments());
+        EXPECT_EQ(fromTails.bytes(), fromCache.bytes());
+        std::vector<Segment> expected, got;
+        fromCache.allSegments(expected);
+        fromTails.allSegments(got);
+        ASSERT_EQ(got.size(), expected.size());
+        for (size_t i = 0; i < got.size(); ++i) {
+            const Segment &x = got[i], &y = expected[i];
+            ASSERT_TRUE(x.origin == y.origin && x.direction == y.direction && x.length == y.length && x.power == y.power &&
+                        x.triangle == y.triangle && x.path == y.path && x.bounce == y.bounce && x.impactDynamic == y.impactDynamic)
+                << "tracked segment " << i;
+        }
+    }
+}
+
 TEST(PhotonMapOrder, KNearestDoNotDependOnTheCacheOrder) {
     Scene s = testscenes::boxOnFloor(8, 2, Vec3f(0.6f));
     testscenes::addPointLight(s, Vec3f(0.2f, 1.5f, 0.1f), Vec3f(10.0f));
