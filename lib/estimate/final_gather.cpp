@@ -30,7 +30,8 @@ void encodeOctahedral(const Vec3f& d, uint16_t& u, uint16_t& v) {
     u = roundToUint16((std::clamp(px, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f);
     v = roundToUint16((std::clamp(py, -1.0f, 1.0f) * 0.5f + 0.5f) * 65535.0f);
 }
-Vec3f decodeOctahedral(uint16_t u, uint16_t v) {
+// The decoded direction before it is normalised: along the same line.
+Vec3f octahedralUnnormalised(uint16_t u, uint16_t v) {
     float px = float(u) / 65535.0f * 2 - 1, py = float(v) / 65535.0f * 2 - 1;
     const float z = 1 - std::fabs(px) - std::fabs(py);
     if (z < 0) {
@@ -38,8 +39,9 @@ Vec3f decodeOctahedral(uint16_t u, uint16_t v) {
         px = qx;
         py = qy;
     }
-    return normalize(Vec3f(px, py, z));
+    return Vec3f(px, py, z);
 }
+Vec3f decodeOctahedral(uint16_t u, uint16_t v) { return normalize(octahedralUnnormalised(u, v)); }
 }  // namespace
 
 // A vertex's gather directions: its frame and its numbers, made once for all its rays (the scan
@@ -203,18 +205,51 @@ void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const Vert
 }
 
 namespace {
+// A box ahead of a vertex, and the cone from the vertex's start point that holds it: a ray can
+// meet the box only if it points into the cone and reaches the box's bounding ball. The test
+// needs neither the ray's normalised direction nor a division, and rules out most kept rays
+// before the exact one (the scan of every kept ray was two thirds of a later frame's gather on
+// data/cornell). The ball is padded far beyond the decoded direction's rounding (a few ulps of
+// its length, here 10⁻⁵ of the distance), so no ray the exact test would take is ruled out.
+struct BoxAhead {
+    const Bounds3f* box;
+    Vec3d towards;      // from the start point to the ball's centre
+    double nearest;     // how far the ray must reach to enter the ball
+    double cosSquared;  // the cone's half-angle, as cos²; -1 with the start point in the ball
+    BoxAhead(const Bounds3f* b, const Vec3f& origin) : box(b) {
+        const Vec3d centre = (Vec3d(b->lower) + Vec3d(b->upper)) * 0.5;
+        towards = centre - Vec3d(origin);
+        const double distance = length(towards);
+        const double radius = 0.5 * length(Vec3d(b->upper) - Vec3d(b->lower)) + 1e-5 * (distance + 1e-30);
+        nearest = distance - radius;
+        cosSquared = distance > radius ? (distance * distance - radius * radius) / (distance * distance) : -1.0;
+    }
+    // Whether the ray along `along` (any length) reaching `t` may meet the box.
+    bool mayMeet(const Vec3f& along, float t) const {
+        if (cosSquared < 0) return true;
+        if (double(t) < nearest) return false;
+        const double d = dot(Vec3d(along), towards);
+        return d > 0 && d * d >= cosSquared * dot(Vec3d(along), Vec3d(along)) * dot(towards, towards);
+    }
+};
+
 // Re-casts the rays of `hits` (leaving `origin`, each along its kept direction) whose segment
 // meets one of `ahead`; returns how many.
 template <typename Cast>
-uint64_t recastSpanMeeting(const Vec3f& origin, const std::vector<const Bounds3f*>& ahead, GatherHit* hits, size_t count,
+uint64_t recastSpanMeeting(const Vec3f& origin, const std::vector<BoxAhead>& ahead, GatherHit* hits, size_t count,
                            Cast&& castRay) {
     uint64_t recast = 0;
     for (size_t j = 0; j < count; ++j) {
+        const Vec3f along = octahedralUnnormalised(hits[j].octU, hits[j].octV);
+        bool mayMeet = false;
+        for (const BoxAhead& box : ahead)
+            if ((mayMeet = box.mayMeet(along, hits[j].t))) break;
+        if (!mayMeet) continue;
         const Vec3f d = FinalGather::rayDirection(hits[j]);
         bool meets = false;
-        for (const Bounds3f* box : ahead) {
+        for (const BoxAhead& box : ahead) {
             double t0 = 0, t1 = double(hits[j].t);
-            if ((meets = box->clip(origin, d, t0, t1))) break;
+            if ((meets = box.box->clip(origin, d, t0, t1))) break;
         }
         if (!meets) continue;
         const uint16_t u = hits[j].octU, w = hits[j].octV;
@@ -234,7 +269,7 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
     const uint64_t recast = tbb::parallel_reduce(
         tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 16), uint64_t(0),
         [&](const tbb::blocked_range<uint32_t>& r, uint64_t count) {
-            std::vector<const Bounds3f*> ahead;
+            std::vector<BoxAhead> ahead;
             for (uint32_t v = r.begin(); v != r.end(); ++v) {
                 if (skip[v] || scene.vertexHidden[v]) continue;
                 const Vec3f origin = starts.point(v);
@@ -248,7 +283,7 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
                                            (c & 4) ? box.upper.z : box.lower.z);
                         reach = std::max(reach, dot(corner - origin, n));
                     }
-                    if (reach >= 0) ahead.push_back(&box);
+                    if (reach >= 0) ahead.emplace_back(&box, origin);
                 }
                 if (ahead.empty()) continue;
                 auto recastAlong = [&](const Vec3f& d) { return castRay(bvh, frontNormals, origin, d); };
