@@ -23,7 +23,10 @@ void DirectLight::readEmitters(const Scene& scene) {
         // Chosen by power, as photons are (LightSampler): luminance of π L_e A.
         const double power = double(luminance(m.emission)) * double(area);
         if (!(power > 0)) continue;
-        emitters_.push_back({t, m.emission, area, power});
+        const Triangle& tri = scene.triangles[t];
+        emitters_.push_back({t, m.emission, area, power,
+                             {Vec3d(scene.positions[tri.v[0]]), Vec3d(scene.positions[tri.v[1]]), Vec3d(scene.positions[tri.v[2]])},
+                             Vec3d(scene.geometricNormal(t))});
         total += power;
     }
     double running = 0;
@@ -81,17 +84,15 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
         const float u0 = numbers.uniform(i, 0);
         const size_t e = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), double(u0)) - cdf_.begin());
         const Emitter& emitter = emitters_[std::min(e, emitters_.size() - 1)];
-        const Triangle& tri = scene.triangles[emitter.triangle];
         float b1, b2;
         uniformTriangle(numbers.uniform(i, 1), numbers.uniform(i, 2), b1, b2);
-        const Vec3d x = Vec3d(scene.positions[tri.v[0]]) * double(1 - b1 - b2) + Vec3d(scene.positions[tri.v[1]]) * double(b1) +
-                        Vec3d(scene.positions[tri.v[2]]) * double(b2);
+        const Vec3d x = emitter.corner[0] * double(1 - b1 - b2) + emitter.corner[1] * double(b1) + emitter.corner[2] * double(b2);
         const Vec3d d = x - p;
         const double d2 = dot(d, d);
         if (!(d2 > 0)) continue;
         const Vec3d w = d / std::sqrt(d2);
         const double cosV = dot(n, w);
-        const double cosE = -dot(Vec3d(scene.geometricNormal(emitter.triangle)), w);
+        const double cosE = -dot(emitter.normal, w);
         if (!(cosV > 0) || !(cosE > 0)) continue;
         // L_e cosθ_v cosθ_e / (d² p), p = P(emitter) / area.
         const double weight = cosV * cosE / d2 * double(emitter.area) / emitter.probability * perSample;

@@ -23,6 +23,7 @@
 // computeAll() read them.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -54,6 +55,11 @@ private:
         Vec3f radiance;  // L_e
         float area;
         double probability;  // of being chosen
+        // Its corners and unit normal (Scene::geometricNormal), read once: emitters never move,
+        // and a sample then touches no scene array (a refined light panel's thousands of
+        // triangles made these reads a fifth of the direct light's time).
+        std::array<Vec3d, 3> corner;
+        Vec3d normal;
     };
     void readEmitters(const Scene& scene);
     // Calls visit(direction, tfar, irradianceIfClear) for each shadow ray of vertex v: the segment
