@@ -60,6 +60,62 @@ TEST(SceneBvh, EqualDistancesGoToTheLowestTriangleId) {
     }
 }
 
+// intersect() asks the dynamic BVH only when the ray meets the dynamic triangles' padded bounds
+// before the static hit. Checked against occluded(), which asks both BVHs along its own path: for
+// every ray the closest hit leaves nothing nearer and something at it, and a miss nothing at all.
+// Rays aimed at the moved cube (and dealt at random around it) make sure both the dynamic hits and
+// the skipped rays occur, with the cube moved from where its BVH was built.
+TEST(SceneBvh, ClosestHitsAgreeWithOcclusionAroundAMover) {
+    Scene scene = testscenes::boxOnFloor(16, 3, Vec3f(0.7f));
+    int cube = -1;
+    for (size_t i = 0; i < scene.nodes.size(); ++i)
+        if (scene.nodes[i].name == "Cube") cube = int(i);
+    ASSERT_GE(cube, 0);
+    scene.markDynamic({cube});
+    EmbreeDevice device;
+    SceneBvh bvh(device, scene);
+    std::vector<Transform> locals = scene.restLocals();
+    locals[size_t(cube)] = Transform::fromTRS(Vec3d(0.4, 0.05, -0.3), {0, 0, 0, 1}, Vec3d(1.0)) * locals[size_t(cube)];
+    scene.applyPose(Pose(locals));
+    bvh.updateDynamic(scene);
+    std::vector<uint32_t> cubeTriangles;
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t)
+        if (scene.triangleDynamic[t]) cubeTriangles.push_back(t);
+    ASSERT_FALSE(cubeTriangles.empty());
+    const Bounds3f b = scene.animationBounds.expanded(0.5f);
+    uint64_t state = 12345;
+    auto uniform = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return float(state >> 40) / float(1 << 24);
+    };
+    int dynamicHits = 0, staticHits = 0, misses = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3f origin(b.lower.x + uniform() * (b.upper.x - b.lower.x), b.lower.y + uniform() * (b.upper.y - b.lower.y),
+                           b.lower.z + uniform() * (b.upper.z - b.lower.z));
+        Vec3f direction;
+        if (i % 2 == 0) {  // at a point inside one of the cube's triangles
+            const Triangle& t = scene.triangles[cubeTriangles[size_t(uniform() * float(cubeTriangles.size())) % cubeTriangles.size()]];
+            const float u = 0.05f + 0.45f * uniform(), v = 0.05f + 0.45f * uniform();
+            direction = normalize(scene.positions[t.v[0]] * (1 - u - v) + scene.positions[t.v[1]] * u + scene.positions[t.v[2]] * v - origin);
+        } else {
+            direction = normalize(Vec3f(2 * uniform() - 1, 2 * uniform() - 1, 2 * uniform() - 1));
+        }
+        if (!(length(direction) > 0)) continue;
+        const auto hit = bvh.intersect(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
+        if (!hit) {
+            ++misses;
+            EXPECT_FALSE(bvh.occluded(origin, direction, 0.0f, std::numeric_limits<float>::infinity())) << "ray " << i;
+            continue;
+        }
+        (scene.triangleDynamic[hit->triangle] ? dynamicHits : staticHits)++;
+        EXPECT_FALSE(bvh.occluded(origin, direction, 0.0f, hit->t * (1 - 1e-4f))) << "ray " << i << ": something nearer";
+        EXPECT_TRUE(bvh.occluded(origin, direction, 0.0f, hit->t * (1 + 1e-4f))) << "ray " << i << ": nothing at the hit";
+    }
+    EXPECT_GT(dynamicHits, 1000);
+    EXPECT_GT(staticHits, 1000);
+    EXPECT_GT(misses, 100);
+}
+
 // The disc regions' shortcut (docs/design.md §5): a static triangle near the ball counts only if
 // a corner rises to the asked height above the plane; coplanar and lower triangles never do.
 TEST(SceneBvh, StaticGeometryRisesOnlyWhereACornerReachesTheHeight) {
