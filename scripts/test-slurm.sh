@@ -3,7 +3,8 @@
 # (scripts/slurm/local-cluster.sh; needs root or sudo):
 #   1. a render split into 4 frame chunks writes every PLY, EXR and PNG byte for byte as one
 #      sequential run, and the merged timing.json lists every frame once, in order; --gltf-out's
-#      asset.glb, made after the merge from all the frames, is the sequential run's too;
+#      asset.glb, made after the merge from all the frames, is the sequential run's too, and no
+#      chunk (run with --frames-only) writes one of its own;
 #   2. an array task killed mid-chunk (scancel) leaves the merge undone; submitting the same
 #      command again runs only that chunk (resumed from its last complete frame) and the merge,
 #      and the result is again byte-identical;
@@ -58,6 +59,11 @@ same_frames "$work/sequential" "$work/chunked"
 # The one-file animation (--gltf-out) is made after the merge from all the frames: the sequential run's bytes.
 cmp -s "$work/sequential/asset.glb" "$work/chunked/asset.glb" || fail "the merged folder's asset.glb differs from the sequential run's"
 echo "test-slurm: the merged folder's asset.glb equals the sequential run's"
+# Chunks run --frames-only: none writes an asset of its part of the animation.
+chunk_assets=$(find "$work/chunked" -mindepth 2 -name asset.glb)
+[ -z "$chunk_assets" ] || fail "a chunk wrote an asset of its own: $chunk_assets"
+[ -d "$work/chunked/chunks" ] || fail "no chunks folder in $work/chunked: the check above looked at nothing"
+echo "test-slurm: no chunk wrote an asset.glb"
 
 echo "== 2. a killed array task, resubmitted"
 "$qsgi" render "${scene[@]}" --photons 400000 --frames 0:17 --out "$work/sequential-big"

@@ -371,6 +371,30 @@ TEST(GltfOut, ATransformFilesMotionBecomesTheAssetsNodeAnimation) {
     }
 }
 
+// The asset is made from the frames on disk, whichever run wrote them: frames 0–1 written by a run
+// of --frames-only (a Slurm chunk's way: no asset of its own, whatever --gltf-out says), then the
+// range finished with --resume, gives the bytes of one straight run — every frame file and the
+// asset alike.
+TEST(GltfOut, AnAssetOfFramesEarlierRunsWroteIsTheStraightRunsOwn) {
+    const fs::path out = testScratchDir("gltf-out-resumed");
+    const std::string render = "render " + (sourceDir() / "data/cornell/cornell.gltf").string() + " --animation " +
+                               (sourceDir() / "data/cornell/animation.json").string() + " --photons 5000 --gltf-out --gltf-colour 0 --no-exr --quiet" +
+                               std::string(kCheapSecondPass);
+    const CommandResult straight = runQsgi(render + " --frames 0:2 --out " + (out / "straight").string());
+    ASSERT_EQ(straight.exitCode, 0) << straight.output;
+    const CommandResult chunk = runQsgi(render + " --frames 0:1 --frames-only --out " + (out / "parts").string());
+    ASSERT_EQ(chunk.exitCode, 0) << chunk.output;
+    EXPECT_TRUE(fs::exists(out / "parts" / frameName(1, "ply")));
+    EXPECT_FALSE(fs::exists(out / "parts" / "asset.glb")) << "--frames-only wrote an asset";
+    const CommandResult finish = runQsgi(render + " --frames 0:2 --resume --out " + (out / "parts").string());
+    ASSERT_EQ(finish.exitCode, 0) << finish.output;
+    for (int frame = 0; frame <= 2; ++frame)
+        EXPECT_EQ(readFileBytes(out / "parts" / frameName(frame, "ply")), readFileBytes(out / "straight" / frameName(frame, "ply")))
+            << "frame " << frame;
+    ASSERT_TRUE(fs::exists(out / "straight" / "asset.glb"));
+    EXPECT_EQ(readFileBytes(out / "parts" / "asset.glb"), readFileBytes(out / "straight" / "asset.glb"));
+}
+
 // One mesh shown by four nodes: two lit differently, two under the floor in the dark (equal bakes,
 // all zero). The mesh is copied only where bakes differ: the first node keeps it, the second gets a
 // copy, the two dark ones share another.

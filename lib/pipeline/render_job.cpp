@@ -299,8 +299,10 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         if (failed.frame < start || failed.frame > last_) ++outcome.framesRemoved;
     // An asset of earlier frames would no longer be the folder's: gone before any frame changes.
     if (start <= last_) out.remove(kBakedAssetName);
+    // A run of --frames-only (a Slurm chunk) leaves the whole-run files to the run that has every frame.
+    const bool writeAsset = settings_.writeGltf && !settings_.framesOnly;
     if (start > last_) {  // resumed with nothing left to do
-        if (settings_.writeGltf) writeBakedAsset(out, outcome, warn);
+        if (writeAsset) writeBakedAsset(out, outcome, warn);
         return outcome;
     }
 
@@ -427,7 +429,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
             return outcome;
         }
     }
-    if (settings_.writeGltf) writeBakedAsset(out, outcome, warn);
+    if (writeAsset) writeBakedAsset(out, outcome, warn);
     return outcome;
 }
 

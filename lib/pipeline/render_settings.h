@@ -59,6 +59,9 @@ struct RenderSettings {
     bool writeExr = true, exrHalf = false, writePng = false;
     bool writeGltf = false;  // asset.glb: the scene file with the bake in it (lib/output/baked_asset.h)
     int gltfColourSet = -1;  // with writeGltf, the COLOR_n set to add, or -1
+    // Each frame's files and the log only, never asset.glb (whatever writeGltf says): what a Slurm
+    // array's chunk runs, its frames merged and the asset made once, from all of them.
+    bool framesOnly = false;
     std::optional<float> exposure;        // PNG preview; unset: automatic from frame 0
     std::optional<int> cameraIndex;       // a glTF camera by index
     struct LookAt { Vec3f position, target, up{0, 1, 0}; float yfov = 0.8f; };

@@ -101,12 +101,13 @@ def save_plan(out: str, wanted: dict) -> None:
 
 def task_command(out: str, index: int, threads: int) -> list:
     """Array task `index`'s qsgi command; its folder made a real one first, so qsgi never renders
-    through a link planted at OUT/chunks or OUT/chunks/NNN."""
+    through a link planted at OUT/chunks or OUT/chunks/NNN. --frames-only: a chunk writes its
+    frames, never an asset of its part of the animation (finish_command makes the one asset)."""
     p = load_plan(out)
     first, last = p["chunks"][index]
     chunk = make_subfolder(out, os.path.relpath(folder(out, index), out))
     return [p["qsgi"], "render"] + p["arguments"] + [
-        "--frames", f"{first}:{last}", "--out", chunk, "--resume", "--threads", str(threads)]
+        "--frames", f"{first}:{last}", "--out", chunk, "--resume", "--threads", str(threads), "--frames-only"]
 
 
 def finish_command(out: str) -> list:
