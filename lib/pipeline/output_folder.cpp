@@ -10,6 +10,7 @@
 #include <cstring>
 #include <set>
 
+#include "output/asset_sink.h"
 #include "output/file_checksum.h"
 #include "output/timing_log.h"
 

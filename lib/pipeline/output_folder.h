@@ -49,8 +49,6 @@ struct OutputFolderSurvey {
 
 // "frame_0012.ply" and the like.
 std::string frameFileName(int frame, const char* extension);
-// --gltf-out's file: the scene's glTF with the run's frames baked in (lib/output/baked_asset.h).
-inline constexpr const char* kBakedAssetName = "asset.glb";
 // "frame_0012.ply", "frame_12345.exr": a frame file's name as frameFileName writes it, with one
 // of the extensions qsgi writes (ply, exr, png, glb); not a temporary, not "frame_0003.png.bak".
 bool isFrameFileName(const std::string& name);

@@ -14,12 +14,10 @@
 
 #include "estimate/estimator.h"
 #include "estimate/impact_count.h"
-#include "output/baked_asset.h"
-#include "output/ply_reader.h"
+#include "output/asset_sink.h"
+#include "output/image_sink.h"
+#include "output/ply_sink.h"
 #include "scene/gltf_document.h"
-#include "output/image_files.h"
-#include "output/ply_writer.h"
-#include "output/radiosity_image.h"
 #include "output/timing_log.h"
 #include "output/folder_lock.h"
 #include "output/output_directory.h"
@@ -299,46 +297,42 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         if (failed.frame < start || failed.frame > last_) ++outcome.framesRemoved;
     // An asset of earlier frames would no longer be the folder's: gone before any frame changes.
     if (start <= last_) out.remove(kBakedAssetName);
-    // A run of --frames-only (a Slurm chunk) leaves the whole-run files to the run that has every frame.
-    const bool writeAsset = settings_.writeGltf && !settings_.framesOnly;
+    const std::vector<std::unique_ptr<FrameSink>> sinks = makeSinks();
+    auto finish = [&] {
+        for (const std::unique_ptr<FrameSink>& sink : sinks) {
+            WholeRunReport report;
+            sink->finish(out, report);
+            if (report.bytes == 0) continue;
+            outcome.assetBytes = report.bytes;
+            outcome.assetBakeBytes = report.bakeBytes;
+            outcome.assetSeconds = report.seconds;
+            for (const std::string& w : report.warnings) warn(w);
+        }
+    };
     if (start > last_) {  // resumed with nothing left to do
-        if (writeAsset) writeBakedAsset(out, outcome, warn);
+        finish();
         return outcome;
     }
 
     EmbreeDevice device;
-    auto imageMetadata = [&](int frame) {
-        ImageMetadata m;
-        m.strings = {{"qsgi:estimator", estimatorName(settings_.estimator.kind)}, {"qsgi:version", QSGI_VERSION},
-                     {"qsgi:scene", settings_.scenePath},
-                     {"qsgi:seed", std::to_string(settings_.trace.seed)}, {"Software", std::string("qsgi ") + QSGI_VERSION}};
-        m.ints = {{"qsgi:frame", frame}, {"qsgi:photons", int(std::min<uint64_t>(settings_.trace.photons, INT32_MAX))},
-                  {"qsgi:spp", settings_.samplesPerPixel}};
-        // 0: the estimator has no radius (impact count)
-        m.floats = {{"qsgi:radius", settings_.estimator.kind == EstimatorKind::ImpactCount ? 0.0f : settings_.estimator.radius}};
-        m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.photonMap.k : 0);
-        return m;
-    };
     const FrameSolverSettings solverSettings{settings_.estimator, effectiveTrace(settings_.trace), settings_.lighting,
                                              settings_.update};
     // Built in the rest pose, before any frame: every run refits the same BVHs (docs/design.md §6.0).
     scene_.applyPose(scene_.restPose());
     FrameSolver solver(scene_, device, solverSettings);
-    const ImageSettings imageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.trace.seed};
 
     // Previews are tonemapped as frame 0 of the animation is (docs/design.md §6.0), so that any frame
     // range writes the bytes one sequential run would. A run that starts later computes frame 0
     // once for it, then the state at its first frame from scratch.
-    std::optional<PreviewTonemap> tonemap;
-    std::optional<float> exposure = settings_.exposure;
-    auto fixPreviews = [&](const VertexRadiosity& result, const SceneBvh& bvh) {
-        tonemap = PreviewTonemap::fromPercentile(result.radiosity);
-        if (settings_.writePng && !exposure)
-            exposure = automaticExposure(renderRadiosityImage(scene_, bvh, result, cameraAt(0), imageSettings));
+    bool calibrated = false;
+    auto calibrate = [&](const VertexRadiosity& result, const SceneBvh& bvh) {
+        const SolvedFrame frame0{0, scene_, bvh, result};
+        for (const std::unique_ptr<FrameSink>& sink : sinks) sink->calibrate(frame0);
+        calibrated = true;
     };
     if (start > 0) {
         FrameTiming ignored;
-        fixPreviews(solver.solve(animation_.poseAt(0), ignored, false), solver.bvh());
+        calibrate(solver.solve(animation_.poseAt(0), ignored, false), solver.bvh());
         solver.reset();
     }
 
@@ -354,32 +348,30 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         FrameTiming timing;
         const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), timing, frame < last_);
         timing.frame = frame;
-        if (!tonemap) fixPreviews(result, solver.bvh());
+        if (!calibrated) calibrate(result, solver.bvh());
         if (frame == start) {
             log.photonsMissingScene = timing.photonsMissingScene;
             log.emittedFraction = solver.emittedFraction();
             log.emissionMeasured = true;
         }
+        const SolvedFrame solved{frame, scene_, solver.bvh(), result};
+        for (const std::unique_ptr<FrameSink>& sink : sinks)
+            if (const char* preparing = sink->preparingStage()) {
+                stage(preparing, 0, 0);
+                sink->prepare(solved, timing);
+            }
 
-        std::optional<RgbImage> image;
         Stopwatch clock;
-        if (settings_.writeExr || settings_.writePng) {
-            stage("image", 0, 0);
-            image = renderRadiosityImage(scene_, solver.bvh(), result, cameraAt(frame), imageSettings);
-            timing.renderSeconds = clock.seconds();
-        }
-
-        clock.restart();
         stage("writing", 0, 0);
         // A frame is on disk whole or not at all: every file, then timing.json listing them. A
         // failure (a full disk) removes the files already placed, so the folder holds exactly
         // the frames the log lists, and --resume continues from this one.
         // Every file encoded before any is written: an encoder that fails leaves nothing behind.
         const std::vector<std::string> names = frameFileNames(frame);
+        std::vector<EncodedFile> encoded;
+        for (const std::unique_ptr<FrameSink>& sink : sinks) sink->encode(solved, encoded);
         std::vector<std::pair<std::string, std::string>> files;
-        files.emplace_back(names[0], encodeVertexRadiosityPly(scene_, result, *tonemap));
-        if (settings_.writeExr) files.emplace_back(names[1], encodeExr(*image, imageMetadata(frame), settings_.exrHalf));
-        if (settings_.writePng) files.emplace_back(names[2], encodePngPreview(*image, *exposure));
+        for (EncodedFile& file : encoded) files.emplace_back(frameFileName(frame, file.extension.c_str()), std::move(file.bytes));
         const auto listed = std::find_if(log.frames.begin(), log.frames.end(), [&](const FrameTiming& f) { return f.frame == frame; });
         const bool listedBefore = listed != log.frames.end();
         const std::vector<FrameTiming> logBefore = listedBefore ? std::vector<FrameTiming>{} : log.frames;
@@ -429,60 +421,62 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
             return outcome;
         }
     }
-    if (writeAsset) writeBakedAsset(out, outcome, warn);
+    finish();
     return outcome;
 }
 
-void RenderJob::writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const std::function<void(const std::string&)>& warn) const {
-    Warnings warnings;
-    const GltfDocument& document = *assetDocument_;
-    const double fps = animation_.fps();
-    std::optional<BakedFrame> firstFrame;  // read once: for the exposure here and by the encoder
-    auto frameAt = [&](size_t k) {
-        if (k == 0 && firstFrame) return *firstFrame;
-        const int frame = first_ + int(k);
-        const std::string name = frameFileName(frame, "ply");
-        const VertexRadiosityPly ply = readVertexRadiosityPly((out.path() / name).string());
-        if (ply.radiosity.size() != scene_.vertexCount() || ply.irradiance.size() != scene_.vertexCount())
-            throw InputError((out.path() / name).string(), "",
-                             ply.irradiance.empty() ? "has no irradiance (an older qsgi wrote it): render it again without --resume"
-                                                    : "does not hold this scene's vertices");
-        BakedFrame baked;
-        baked.seconds = fps > 0 ? frame / fps : 0;
-        baked.radiance.resize(ply.radiosity.size());
-        for (size_t v = 0; v < ply.radiosity.size(); ++v) baked.radiance[v] = ply.radiosity[v] * float(1 / M_PI);
-        baked.irradiance = ply.irradiance;
-        return baked;
-    };
-    BakedAssetSettings asset;
-    asset.colourSet = settings_.gltfColourSet;
-    asset.playedAnimation = playedGltfAnimation_;
-    asset.assetFolder = settings_.outDir;
-    // COLOR_n's exposure puts the first frame's 99th percentile of B/π at 1, as the PLY previews
-    // do with frame 0's.
-    firstFrame = frameAt(0);
-    asset.exposure = double(PreviewTonemap::fromPercentile(firstFrame->radiance).scale);
-    // A transform file's motion becomes the asset's node animation; a glTF animation is the file's already.
-    std::vector<NodeMotion> motion;
-    const std::optional<int> gltfAnimation = gltfAnimationSelector(settings_.animationPath, "");
-    const bool transformFile = !settings_.animationPath.empty() && !gltfAnimation.has_value();
-    asset.playedAll = gltfAnimation.has_value() && *gltfAnimation < 0 && playedGltfAnimation_ < 0;
-    if (transformFile) asset.firstPose = animation_.localsAt(first_);
-    if (transformFile && last_ > first_) {
-        for (const int node : animation_.movedNodes()) motion.push_back(NodeMotion{node, {}});
-        for (int frame = first_; frame <= last_; ++frame) {
-            const std::vector<Transform> locals = animation_.localsAt(frame);
-            for (NodeMotion& m : motion) m.frames.push_back(decomposeTrs(locals[size_t(m.node)]));
-        }
+std::vector<std::unique_ptr<FrameSink>> RenderJob::makeSinks() const {
+    std::vector<std::unique_ptr<FrameSink>> sinks;
+    // In the order the log lists a frame's files: PLY, EXR, PNG.
+    sinks.push_back(std::make_unique<PlySink>());
+    if (settings_.writeExr || settings_.writePng) {
+        ImageSinkSettings image;
+        image.exr = settings_.writeExr;
+        image.exrHalf = settings_.exrHalf;
+        image.png = settings_.writePng;
+        image.exposure = settings_.exposure;
+        image.image = ImageSettings{settings_.width, settings_.height, settings_.samplesPerPixel, settings_.trace.seed};
+        image.cameraAt = [this](int frame) { return cameraAt(frame); };
+        image.metadataAt = [this](int frame) {
+            ImageMetadata m;
+            m.strings = {{"qsgi:estimator", estimatorName(settings_.estimator.kind)}, {"qsgi:version", QSGI_VERSION},
+                         {"qsgi:scene", settings_.scenePath},
+                         {"qsgi:seed", std::to_string(settings_.trace.seed)}, {"Software", std::string("qsgi ") + QSGI_VERSION}};
+            m.ints = {{"qsgi:frame", frame}, {"qsgi:photons", int(std::min<uint64_t>(settings_.trace.photons, INT32_MAX))},
+                      {"qsgi:spp", settings_.samplesPerPixel}};
+            // 0: the estimator has no radius (impact count)
+            m.floats = {{"qsgi:radius", settings_.estimator.kind == EstimatorKind::ImpactCount ? 0.0f : settings_.estimator.radius}};
+            m.ints.emplace_back("qsgi:k", settings_.estimator.kind == EstimatorKind::PhotonMap ? settings_.estimator.photonMap.k : 0);
+            return m;
+        };
+        sinks.push_back(std::make_unique<ImageSink>(std::move(image)));
     }
-    Stopwatch clock;
-    BakedAssetSummary summary;
-    const std::string bytes = encodeBakedAsset(document, scene_, size_t(last_ - first_ + 1), frameAt, motion, asset, warnings, &summary);
-    out.write(kBakedAssetName, bytes);
-    outcome.assetBytes = summary.bytes;
-    outcome.assetBakeBytes = summary.bakeBytes;
-    outcome.assetSeconds = clock.seconds();
-    for (const std::string& w : warnings.messages) warn(w);
+    // A run of --frames-only (a Slurm chunk) leaves the whole-run files to the run that has every frame.
+    if (settings_.writeGltf && !settings_.framesOnly) {
+        AssetSinkSettings asset;
+        asset.document = assetDocument_;
+        asset.first = first_;
+        asset.last = last_;
+        asset.fps = animation_.fps();
+        asset.plyName = [](int frame) { return frameFileName(frame, "ply"); };
+        asset.asset.colourSet = settings_.gltfColourSet;
+        asset.asset.playedAnimation = playedGltfAnimation_;
+        asset.asset.assetFolder = settings_.outDir;
+        // A transform file's motion becomes the asset's node animation; a glTF animation is the file's already.
+        const std::optional<int> gltfAnimation = gltfAnimationSelector(settings_.animationPath, "");
+        const bool transformFile = !settings_.animationPath.empty() && !gltfAnimation.has_value();
+        asset.asset.playedAll = gltfAnimation.has_value() && *gltfAnimation < 0 && playedGltfAnimation_ < 0;
+        if (transformFile) asset.asset.firstPose = animation_.localsAt(first_);
+        if (transformFile && last_ > first_) {
+            for (const int node : animation_.movedNodes()) asset.motion.push_back(NodeMotion{node, {}});
+            for (int frame = first_; frame <= last_; ++frame) {
+                const std::vector<Transform> locals = animation_.localsAt(frame);
+                for (NodeMotion& m : asset.motion) m.frames.push_back(decomposeTrs(locals[size_t(m.node)]));
+            }
+        }
+        sinks.push_back(std::make_unique<AssetSink>(scene_, std::move(asset)));
+    }
+    return sinks;
 }
 
 }  // namespace qsgi

@@ -5,6 +5,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pipeline/run_fingerprint.h"
 #include "pipeline/render_settings.h"
@@ -16,6 +17,7 @@
 namespace qsgi {
 
 class OutputDirectory;
+class FrameSink;
 
 struct FrameReport {
     int frame;
@@ -95,9 +97,9 @@ public:
     std::string unplayedAnimationsNote() const;
 
 private:
-    // asset.glb (--gltf-out): the scene file with this run's frames first_..last_ baked in,
-    // assembled from their PLYs in the folder (so a resumed run writes it whole).
-    void writeBakedAsset(OutputDirectory& out, RunOutcome& outcome, const std::function<void(const std::string&)>& warn) const;
+    // The run's outputs, each a sink of the frame loop (lib/output/frame_sink.h): the PLY, the
+    // images, and with --gltf-out (not --frames-only) asset.glb, made from the folder's PLYs.
+    std::vector<std::unique_ptr<FrameSink>> makeSinks() const;
 
     RenderSettings settings_;
     Scene scene_;

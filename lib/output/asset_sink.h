@@ -1,0 +1,39 @@
+// asset.glb (--gltf-out; lib/output/baked_asset.h): the scene's own glTF with the run's frames
+// first..last baked in. Made once, after the last frame, from the frames' PLYs in the folder, so
+// a resumed run (or the Slurm merge's finishing run) writes it whole, with the bytes of one
+// straight run.
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include "output/baked_asset.h"
+#include "output/frame_sink.h"
+
+namespace qsgi {
+
+// --gltf-out's file: the scene's glTF with the run's frames baked in.
+inline constexpr const char* kBakedAssetName = "asset.glb";
+
+struct AssetSinkSettings {
+    std::shared_ptr<const GltfDocument> document;  // the scene file as read
+    int first = 0, last = 0;                       // the frames baked
+    double fps = 0;                                // the animation's: a frame's time
+    std::function<std::string(int)> plyName;       // frame_NNNN.ply
+    BakedAssetSettings asset;                      // all but the exposure, which the first frame sets
+    std::vector<NodeMotion> motion;                // a transform file's, at every frame baked
+};
+
+class AssetSink : public FrameSink {
+public:
+    // scene: the render's (its vertices are the PLYs').
+    AssetSink(const Scene& scene, AssetSinkSettings settings) : scene_(scene), settings_(std::move(settings)) {}
+    void encode(const SolvedFrame&, std::vector<EncodedFile>&) override {}
+    void finish(OutputDirectory& out, WholeRunReport& report) override;
+
+private:
+    const Scene& scene_;
+    AssetSinkSettings settings_;
+};
+
+}  // namespace qsgi
