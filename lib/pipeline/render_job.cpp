@@ -67,7 +67,12 @@ Camera resolveCamera(const RenderSettings& s, const Scene& scene, Warnings& warn
 RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     : settings_(std::move(settings)), scene_(), animation_() {
     validateSettings(settings_);
-    scene_ = loadGltfScene(settings_.scenePath, warnings, GltfReadOptions{settings_.strict});
+    // One read of the file: the scene is built from it, and with --gltf-out the asset is made from
+    // it too, so that the asset is the file the render read even if it changes on disk meanwhile.
+    auto document = std::make_shared<const GltfDocument>(readGltfDocument(settings_.scenePath, warnings));
+    scene_ = loadGltfScene(*document, settings_.scenePath, warnings, GltfReadOptions{settings_.strict});
+    if (settings_.writeGltf) assetDocument_ = std::move(document);
+    else document.reset();  // the scene holds what it needs: the file's buffers go
     for (PunctualLight light : settings_.extraLights) {
         light.position = Vec3f(Vec3d(light.position) - scene_.worldOrigin);
         scene_.lights.push_back(light);
@@ -112,10 +117,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         refineMesh(scene_, settings_.subdivide);
     }
     if (settings_.writeGltf) {
-        // Refused now, not after the render, if the asset cannot take the bake; kept, so that the
-        // asset is the file the render read even if it changes on disk meanwhile.
-        Warnings ignored;  // the loader has said what the file's oddities are
-        assetDocument_ = std::make_shared<const GltfDocument>(readGltfDocument(settings_.scenePath, ignored));
+        // Refused now, not after the render, if the asset cannot take the bake.
         BakedAssetSettings asset;
         asset.colourSet = settings_.gltfColourSet;
         checkAssetTakesBake(*assetDocument_, scene_, asset, settings_.scenePath);

@@ -107,8 +107,8 @@ private:
     Camera cameraAt(int frame) const;
     Animation animation_;
     int first_ = 0, last_ = 0;
-    int playedGltfAnimation_ = -1;
-    std::shared_ptr<const struct GltfDocument> assetDocument_;  // --gltf-out: the scene file as read  // the glTF animation the frames show (-1: none, all, a transform file)
+    int playedGltfAnimation_ = -1;  // the glTF animation the frames show (-1: none, all, a transform file)
+    std::shared_ptr<const struct GltfDocument> assetDocument_;  // --gltf-out: the scene file as the render read it
     RunFingerprint fingerprint_;
     bool lit_ = false;
     MeshResolution resolution_;

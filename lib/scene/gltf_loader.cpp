@@ -1104,6 +1104,10 @@ Scene loadGltfScene(const std::string& path, Warnings& warnings, const GltfReadO
     return buildScene(readGltfDocument(path, warnings), path, warnings, options);
 }
 
+Scene loadGltfScene(const GltfDocument& document, const std::string& path, Warnings& warnings, const GltfReadOptions& options) {
+    return buildScene(document, path, warnings, options);
+}
+
 Scene loadGltfSceneFromMemory(const std::string& path, std::string bytes, const std::string& baseDir,
                               Warnings& warnings, const GltfReadOptions& options) {
     return buildScene(parseGltfDocument(path, std::move(bytes), baseDir, warnings), path, warnings, options);

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "scene/gltf_document.h"
 #include "scene/scene.h"
 #include "util/error.h"
 
@@ -22,6 +23,9 @@ struct GltfReadOptions {
 // (refusals under options.strict). Recoverable oddities (ignored extensions, missing images, …)
 // go to warnings.
 Scene loadGltfScene(const std::string& path, Warnings& warnings, const GltfReadOptions& options = {});
+// The same for a file already read (readGltfDocument): what a caller that keeps the document
+// (the asset, --gltf-out) builds the scene from, so that both come from one read of the file.
+Scene loadGltfScene(const GltfDocument& document, const std::string& path, Warnings& warnings, const GltfReadOptions& options = {});
 // The same for a file in memory (see parseGltfDocument).
 Scene loadGltfSceneFromMemory(const std::string& path, std::string bytes, const std::string& baseDir,
                               Warnings& warnings, const GltfReadOptions& options = {});
