@@ -547,8 +547,6 @@ TEST(Incremental, AnEstimatorWithoutAnUpdateLogsItsFramesAsFromScratch) {
     }
 }
 
-// Equal distances are ordered by (path, bounce): the k nearest impacts are the same set whatever
-// order the cache holds them in (an incremental update reorders it).
 // A first frame keeps the tails it will track while it traces (EnvelopeTails) instead of decoding
 // its cache again: the tracked paths made from them are the ones made from the cache — the same
 // paths in the same slots, every segment to the bit — with and without a disc's extension past
@@ -594,6 +592,8 @@ TEST(TrackedPaths, TailsKeptWhileTracingAreTheCachesOwn) {
     }
 }
 
+// Equal distances are ordered by (path, bounce): the k nearest impacts are the same set whatever
+// order the cache holds them in (an incremental update reorders it).
 TEST(PhotonMapOrder, KNearestDoNotDependOnTheCacheOrder) {
     Scene s = testscenes::boxOnFloor(8, 2, Vec3f(0.6f));
     testscenes::addPointLight(s, Vec3f(0.2f, 1.5f, 0.1f), Vec3f(10.0f));

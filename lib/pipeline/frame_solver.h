@@ -125,7 +125,8 @@ private:
     };
     TrackingLayout trackingLayout() const;
     // The incremental state: tracked paths and the estimator's own, from the tails this frame's
-    // trace kept, or else from the last frame's cache. segments: how many the frame traced.
+    // trace kept (the frame's segment count then read from stats.segments), or else from the last
+    // frame's cache.
     void startTracking(FrameTiming& stats, EnvelopeTails* tails = nullptr);
     void solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& stats);
     // Where the estimator's answer goes: result_ itself, or photons_ under a second pass.

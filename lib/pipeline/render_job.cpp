@@ -304,11 +304,11 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         for (const std::unique_ptr<FrameSink>& sink : sinks) {
             WholeRunReport report;
             sink->finish(out, report);
-            if (report.bytes == 0) continue;
+            for (const std::string& w : report.warnings) warn(w);
+            if (report.bytes == 0) continue;  // a sink of frames only
             outcome.assetBytes = report.bytes;
             outcome.assetBakeBytes = report.bakeBytes;
             outcome.assetSeconds = report.seconds;
-            for (const std::string& w : report.warnings) warn(w);
         }
     };
     if (start > last_) {  // resumed with nothing left to do

@@ -85,6 +85,7 @@ SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     const Bounds3f b = scene.animationBounds;
     rayEpsilon_ = std::max(1e-5f * b.extent(), 64 * std::numeric_limits<float>::epsilon() * b.maxAbsCoordinate());
     if (!(rayEpsilon_ > 0)) rayEpsilon_ = 1e-5f;
+    nearScene_ = b.expanded(b.extent());
     boundDynamic(scene);
 }
 
@@ -162,7 +163,7 @@ std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& 
     // saved).
     if (dynamic_.empty()) return still;
     double t0 = tnear, t1 = still ? still->t : tfar;
-    if (!dynamicBounds_.clip(origin, direction, t0, t1)) return still;
+    if (nearScene_.contains(origin) && !dynamicBounds_.clip(origin, direction, t0, t1)) return still;
     const std::optional<SurfaceHit> moving =
         intersectPart(dynamicScene_, dynamic_, origin, direction, tnear, still ? still->t : tfar);
     if (!moving) return still;

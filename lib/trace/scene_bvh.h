@@ -110,6 +110,10 @@ private:
     // The dynamic triangles' bounds in the current pose, padded: a ray that misses them cannot
     // meet a dynamic triangle, and skips Embree (most occlusion rays pass far from the movers).
     Bounds3f dynamicBounds_;
+    // The animation's bounds grown by their extent: from an origin inside, a hit's rounding is far
+    // below the padding of dynamicBounds_, so intersect() may skip the dynamic part by them. A
+    // camera farther out asks Embree whatever the bounds say.
+    Bounds3f nearScene_;
 };
 
 }  // namespace qsgi

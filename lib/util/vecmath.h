@@ -94,6 +94,9 @@ struct Bounds3f {
         b.upper = upper + Vec3f(margin);
         return b;
     }
+    bool contains(const Vec3f& p) const {
+        return lower.x <= p.x && p.x <= upper.x && lower.y <= p.y && p.y <= upper.y && lower.z <= p.z && p.z <= upper.z;
+    }
     bool overlaps(const Bounds3f& b) const {
         return !empty() && !b.empty() && lower.x <= b.upper.x && b.lower.x <= upper.x && lower.y <= b.upper.y &&
                b.lower.y <= upper.y && lower.z <= b.upper.z && b.lower.z <= upper.z;

@@ -22,7 +22,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from qsgibatch import chunks, output_folder, slurm  # noqa: E402
 
 REPOSITORY = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-SET_HERE = ("--out", "--frames", "--resume", "--threads")
+SET_HERE = ("--out", "--frames", "--resume", "--threads", "--frames-only")
 
 
 def parse_arguments(argv):
