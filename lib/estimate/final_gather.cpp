@@ -53,24 +53,12 @@ public:
     Directions(const VertexSamples& numbers, const Vec3f& n) : radius_(numbers.dimension(0)), angle_(numbers.dimension(1)), n_(n) {
         orthonormalBasis(n_, t_, b_);
     }
-    // Rays [first, first + count), count ≤ kBatch, cosine-weighted about n_v (pdf cosθ/π, as
-    // cosineHemisphere), encoded (u, w) and decoded (the direction cast). Made a batch at a time,
-    // in stages over arrays, before any of the batch is cast (measured: about as fast as one ray
-    // at a time; the arithmetic and its order are what give the bits).
-    static constexpr uint32_t kBatch = 32;
-    void encodedBatch(uint32_t first, uint32_t count, uint16_t* u, uint16_t* w, Vec3f* cast) const {
-        float radial[kBatch], cosine[kBatch], sine[kBatch], height[kBatch];
-        for (uint32_t k = 0; k < count; ++k) {
-            const float u0 = radius_.uniform(first + k), u1 = angle_.uniform(first + k);
-            const float phi = 2 * kPi * u1;
-            radial[k] = std::sqrt(u0);
-            height[k] = std::sqrt(std::max(0.0f, 1 - u0));
-            cosine[k] = std::cos(phi);
-            sine[k] = std::sin(phi);
-        }
-        for (uint32_t k = 0; k < count; ++k)
-            encodeOctahedral(normalize(t_ * (radial[k] * cosine[k]) + b_ * (radial[k] * sine[k]) + n_ * height[k]), u[k], w[k]);
-        for (uint32_t k = 0; k < count; ++k) cast[k] = decodeOctahedral(u[k], w[k]);
+    // Cosine-weighted about n_v (pdf cosθ/π), as cosineHemisphere.
+    Vec3f operator()(uint32_t ray) const {
+        const float u0 = radius_.uniform(ray), u1 = angle_.uniform(ray);
+        const float r = std::sqrt(u0), phi = 2 * kPi * u1;
+        const float z = std::sqrt(std::max(0.0f, 1 - u0));
+        return normalize(t_ * (r * std::cos(phi)) + b_ * (r * std::sin(phi)) + n_ * z);
     }
 
 private:
@@ -104,19 +92,14 @@ void FinalGather::castVertexInto(const Scene& scene, const SceneBvh& bvh, const 
         for (uint32_t j = 0; j < count; ++j) hits[j] = GatherHit{};
         return;
     }
-    const Directions directions(starts, v, seed_);
+    const Directions direction(starts, v, seed_);
     const Vec3f origin = starts.point(v);
-    uint16_t u[Directions::kBatch], w[Directions::kBatch];
-    Vec3f cast[Directions::kBatch];
-    for (uint32_t batch = 0; batch < count; batch += Directions::kBatch) {
-        const uint32_t n = std::min(Directions::kBatch, count - batch);
-        directions.encodedBatch(first + batch, n, u, w, cast);
-        for (uint32_t k = 0; k < n; ++k) {
-            GatherHit& hit = hits[batch + k];
-            hit = castRay(bvh, frontNormals, origin, cast[k]);
-            hit.octU = u[k];
-            hit.octV = w[k];
-        }
+    for (uint32_t j = 0; j < count; ++j) {
+        uint16_t u, w;
+        encodeOctahedral(direction(first + j), u, w);
+        hits[j] = castRay(bvh, frontNormals, origin, decodeOctahedral(u, w));
+        hits[j].octU = u;
+        hits[j].octV = w;
     }
 }
 

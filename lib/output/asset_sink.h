@@ -28,7 +28,6 @@ class AssetSink : public FrameSink {
 public:
     // scene: the render's (its vertices are the PLYs').
     AssetSink(const Scene& scene, AssetSinkSettings settings) : scene_(scene), settings_(std::move(settings)) {}
-    void encode(const SolvedFrame&, std::vector<EncodedFile>&) override {}
     void finish(OutputDirectory& out, WholeRunReport& report) override;
 
 private:

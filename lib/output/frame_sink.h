@@ -50,7 +50,7 @@ public:
     // The frame's heavy work before any file is encoded (an image), timed into `timing`.
     virtual void prepare(const SolvedFrame& /*frame*/, FrameTiming& /*timing*/) {}
     // Appends the frame's files, in the order the log lists them. Nothing is written.
-    virtual void encode(const SolvedFrame& frame, std::vector<EncodedFile>& files) = 0;
+    virtual void encode(const SolvedFrame& /*frame*/, std::vector<EncodedFile>& /*files*/) {}
     // After the last frame (or a resumed run with none left to compute): the sink's whole-run
     // file, written through `out`. Sinks of frames only have none.
     virtual void finish(OutputDirectory& /*out*/, WholeRunReport& /*report*/) {}

@@ -272,15 +272,14 @@ void FrameSolver::startTracking(FrameTiming& stats, EnvelopeTails* tails) {
     stage("tracking");
     Stopwatch clock;
     const uint32_t generations = settings_.update.trackedGenerations;
+    const TrackingLayout layout = trackingLayout();
     uint64_t segments = 0;
     if (tails) {
         segments = stats.segments;  // this frame's trace
-        const TrackingLayout layout = trackingLayout();
         tracked_ = std::make_unique<TrackedPaths>(tracer_.source(), *tails, layout.gridBounds, layout.cellSize, generations);
     } else {
         const RayCache& cache = *lastCache_;
         segments = cache.segmentCount();
-        const TrackingLayout layout = trackingLayout();
         tracked_ = std::make_unique<TrackedPaths>(cache, layout.envelope, layout.extension, layout.gridBounds, layout.cellSize,
                                                   generations);
     }
