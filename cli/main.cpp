@@ -305,9 +305,10 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "qsgi: every frame is already complete in %s\n", out.c_str());
         else if (!o.quiet)
             std::fprintf(stderr, "qsgi: %s\n", display.summary(out, outcome).c_str());
-        if (!o.quiet && outcome.assetBytes > 0)
-            std::fprintf(stderr, "qsgi: wrote %s/asset.glb: %.1f MB, of which the bake %.1f MB (%.2f s to assemble and write)\n",
-                         out.c_str(), double(outcome.assetBytes) * 1e-6, double(outcome.assetBakeBytes) * 1e-6, outcome.assetSeconds);
+        for (const qsgi::WholeRunReport& file : outcome.wholeRunFiles)
+            if (!o.quiet)
+                std::fprintf(stderr, "qsgi: wrote %s/%s: %s (%.2f s to assemble and write)\n", out.c_str(), file.name.c_str(),
+                             file.sizes.c_str(), file.seconds);
         if (!o.quiet && outcome.filesReplaced > 0)
             std::fprintf(stderr, "qsgi: --overwrite: unlinked %d files of another run from %s before rendering\n",
                          outcome.filesReplaced, out.c_str());

@@ -1,10 +1,10 @@
 #include "output/asset_sink.h"
 
-#include <cmath>
+#include <cstdio>
 #include <optional>
 
 #include "output/output_directory.h"
-#include "output/ply_reader.h"
+#include "output/frame_readback.h"
 #include "output/ply_writer.h"
 #include "util/stopwatch.h"
 
@@ -17,17 +17,12 @@ void AssetSink::finish(OutputDirectory& out, WholeRunReport& report) {
     auto frameAt = [&](size_t k) {
         if (k == 0 && firstFrame) return *firstFrame;
         const int frame = settings_.first + int(k);
-        const std::string path = (out.path() / settings_.plyName(frame)).string();
-        const VertexRadiosityPly ply = readVertexRadiosityPly(path);
-        if (ply.radiosity.size() != scene_.vertexCount() || ply.irradiance.size() != scene_.vertexCount())
-            throw InputError(path, "",
-                             ply.irradiance.empty() ? "has no irradiance (an older qsgi wrote it): render it again without --resume"
-                                                    : "does not hold this scene's vertices");
+        VertexRadiosityPly ply = readFramePly((out.path() / settings_.plyName(frame)).string(), scene_.vertexCount());
         BakedFrame baked;
         baked.seconds = fps > 0 ? frame / fps : 0;
         baked.radiance.resize(ply.radiosity.size());
-        for (size_t v = 0; v < ply.radiosity.size(); ++v) baked.radiance[v] = ply.radiosity[v] * float(1 / M_PI);
-        baked.irradiance = ply.irradiance;
+        for (size_t v = 0; v < ply.radiosity.size(); ++v) baked.radiance[v] = bakedRadiance(ply.radiosity[v]);
+        baked.irradiance = std::move(ply.irradiance);
         return baked;
     };
     BakedAssetSettings asset = settings_.asset;
@@ -40,8 +35,11 @@ void AssetSink::finish(OutputDirectory& out, WholeRunReport& report) {
     const std::string bytes = encodeBakedAsset(*settings_.document, scene_, size_t(settings_.last - settings_.first + 1), frameAt,
                                                settings_.motion, asset, warnings, &summary);
     out.write(kBakedAssetName, bytes);
+    report.name = kBakedAssetName;
     report.bytes = summary.bytes;
-    report.bakeBytes = summary.bakeBytes;
+    char sizes[96];
+    std::snprintf(sizes, sizeof sizes, "%.1f MB, of which the bake %.1f MB", double(summary.bytes) * 1e-6, double(summary.bakeBytes) * 1e-6);
+    report.sizes = sizes;
     report.seconds = clock.seconds();
     report.warnings = warnings.messages;
 }

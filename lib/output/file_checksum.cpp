@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include "util/error.h"
@@ -29,6 +30,20 @@ struct StateFree {
 
 std::string xxh3Hex(std::string_view bytes) { return hex(XXH3_64bits(bytes.data(), bytes.size())); }
 
+struct Xxh3Stream::State {
+    std::unique_ptr<XXH3_state_t, StateFree> xxh{XXH3_createState()};
+};
+
+Xxh3Stream::Xxh3Stream() : state_(std::make_unique<State>()) {
+    if (!state_->xxh) throw std::bad_alloc();
+    XXH3_64bits_reset(state_->xxh.get());
+}
+Xxh3Stream::~Xxh3Stream() = default;
+
+void Xxh3Stream::update(std::string_view bytes) { XXH3_64bits_update(state_->xxh.get(), bytes.data(), bytes.size()); }
+
+std::string Xxh3Stream::hex() const { return qsgi::hex(XXH3_64bits_digest(state_->xxh.get())); }
+
 std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record, const std::string& folderName) {
     auto unreadable = [&](int error) {
         return EnvironmentError(folderName, "cannot read " + record.name + " to verify it: " + std::strerror(error));
@@ -44,8 +59,7 @@ std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record, 
         return "has " + std::to_string(link.st_size) + " bytes, timing.json says " + std::to_string(record.bytes);
     const int fd = ::openat(folderFd, record.name.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) throw unreadable(errno);
-    std::unique_ptr<XXH3_state_t, StateFree> state(XXH3_createState());
-    XXH3_64bits_reset(state.get());
+    Xxh3Stream checksum;
     std::vector<char> buffer(1 << 20);
     uint64_t total = 0;
     for (;;) {
@@ -57,12 +71,12 @@ std::optional<std::string> fileMismatch(int folderFd, const FileRecord& record, 
             throw unreadable(error);
         }
         if (n == 0) break;
-        XXH3_64bits_update(state.get(), buffer.data(), size_t(n));
+        checksum.update(std::string_view(buffer.data(), size_t(n)));
         total += uint64_t(n);
     }
     ::close(fd);
     if (total != record.bytes) return "changed while being checked";
-    if (hex(XXH3_64bits_digest(state.get())) != record.xxh3) return "has other bytes than qsgi wrote (checksum differs)";
+    if (checksum.hex() != record.xxh3) return "has other bytes than qsgi wrote (checksum differs)";
     return std::nullopt;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -15,6 +16,21 @@ namespace qsgi {
 
 // XXH3 64-bit of `bytes` as 16 lowercase hex digits.
 std::string xxh3Hex(std::string_view bytes);
+
+// The same checksum of bytes that arrive in pieces (a file written as it is made).
+class Xxh3Stream {
+public:
+    Xxh3Stream();
+    ~Xxh3Stream();
+    Xxh3Stream(const Xxh3Stream&) = delete;
+    Xxh3Stream& operator=(const Xxh3Stream&) = delete;
+    void update(std::string_view bytes);
+    std::string hex() const;  // of everything so far: xxh3Hex of the pieces joined
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
 
 // Why the file `record.name` in the folder open as `folderFd` is not the one recorded: missing, a
 // symbolic link, not a regular file, another size, another checksum. nullopt when it matches.

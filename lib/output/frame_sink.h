@@ -34,7 +34,9 @@ struct EncodedFile {
 
 // What a sink's whole-run file came to, for the run's report.
 struct WholeRunReport {
-    size_t bytes = 0, bakeBytes = 0;
+    std::string name;  // asset.glb, asset.usda; empty: the sink has no whole-run file
+    size_t bytes = 0;
+    std::string sizes;  // for the user: "12.3 MB, of which the bake 4.5 MB"
     double seconds = 0;
     std::vector<std::string> warnings;
 };

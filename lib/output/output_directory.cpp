@@ -90,10 +90,28 @@ int OutputDirectory::createTemporary(const std::string& name, std::string& tempo
 }
 
 FileRecord OutputDirectory::write(const std::string& name, std::string_view bytes) {
+    return writeStreamed(name, [&](const PieceWriter& put) { put(bytes); });
+}
+
+FileRecord OutputDirectory::writeStreamed(const std::string& name, const std::function<void(const PieceWriter&)>& produce) {
     std::string temporary;
     const int fd = createTemporary(name, temporary);
     if (fd < 0) fail(path_, "cannot create a file to write " + name, errno);
-    int error = writeAll(fd, bytes);
+    int error = 0;
+    uint64_t size = 0;
+    Xxh3Stream checksum;
+    try {
+        produce([&](std::string_view piece) {
+            if (error) return;  // reported once produce is done
+            error = writeAll(fd, piece);
+            size += piece.size();
+            checksum.update(piece);
+        });
+    } catch (...) {
+        ::close(fd);
+        ::unlinkat(fd_, temporary.c_str(), 0);
+        throw;
+    }
     if (!error && ::fsync(fd) != 0) error = errno;
     if (::close(fd) != 0 && !error) error = errno;
     if (!error && ::renameat(fd_, temporary.c_str(), fd_, name.c_str()) != 0) error = errno;
@@ -105,7 +123,7 @@ FileRecord OutputDirectory::write(const std::string& name, std::string_view byte
     // the caller must know (NotDurableError), since undoing the write is no longer possible.
     if (::fsync(fd_) != 0 && errno != EINVAL)
         throw NotDurableError(path_.string(), "cannot sync the folder after writing " + name + ": " + std::strerror(errno));
-    return FileRecord{name, bytes.size(), xxh3Hex(bytes)};
+    return FileRecord{name, size, checksum.hex()};
 }
 
 void OutputDirectory::probeWritable() {

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,6 +43,11 @@ public:
     // before — except for NotDurableError: the file is in place, but the folder could not be
     // synced after the rename.
     FileRecord write(const std::string& name, std::string_view bytes);
+
+    // The same, for a file made in pieces too large to hold at once (asset.usda): `produce` hands
+    // each piece to its argument in order. If it throws, nothing is left and `name` keeps what it held.
+    using PieceWriter = std::function<void(std::string_view)>;
+    FileRecord writeStreamed(const std::string& name, const std::function<void(const PieceWriter&)>& produce);
 
     // Throws InputError (permissions, read-only) or EnvironmentError unless a file can be
     // created here: found out before the first frame's work, not after it.

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "output/asset_sink.h"
+#include "output/usd_sink.h"
 #include "output/file_checksum.h"
 #include "output/timing_log.h"
 
@@ -25,7 +26,7 @@ std::string frameFileName(int frame, const char* extension) {
 }
 
 bool isFrameFileName(const std::string& name) {
-    if (name == kBakedAssetName) return true;  // made from the frames: goes with them
+    if (name == kBakedAssetName || name == kUsdAssetName) return true;  // made from the frames: go with them
     constexpr size_t kPrefix = 6;  // "frame_"
     if (name.rfind("frame_", 0) != 0) return false;
     size_t digits = 0;

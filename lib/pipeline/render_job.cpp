@@ -17,6 +17,7 @@
 #include "output/asset_sink.h"
 #include "output/image_sink.h"
 #include "output/ply_sink.h"
+#include "output/usd_sink.h"
 #include "scene/gltf_document.h"
 #include "output/timing_log.h"
 #include "output/folder_lock.h"
@@ -28,6 +29,7 @@
 #include "scene/gltf_loader.h"
 #include "scene/mesh_refinement.h"
 #include "trace/photon_tracer.h"
+#include "util/memory.h"
 #include "util/stopwatch.h"
 
 namespace qsgi {
@@ -71,6 +73,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     // it too, so that the asset is the file the render read even if it changes on disk meanwhile.
     auto document = std::make_shared<const GltfDocument>(readGltfDocument(settings_.scenePath, warnings));
     scene_ = loadGltfScene(*document, settings_.scenePath, warnings, GltfReadOptions{settings_.strict});
+    for (const tinygltf::Mesh& mesh : document->model.meshes) meshNames_.push_back(mesh.name);  // asset.usda's names
     if (settings_.writeGltf) assetDocument_ = std::move(document);
     else document.reset();  // the scene holds what it needs: the file's buffers go
     for (PunctualLight light : settings_.extraLights) {
@@ -298,17 +301,15 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames)
         if (failed.frame < start || failed.frame > last_) ++outcome.framesRemoved;
     // An asset of earlier frames would no longer be the folder's: gone before any frame changes.
-    if (start <= last_) out.remove(kBakedAssetName);
+    if (start <= last_)
+        for (const char* name : {kBakedAssetName, kUsdAssetName}) out.remove(name);
     const std::vector<std::unique_ptr<FrameSink>> sinks = makeSinks();
     auto finish = [&] {
         for (const std::unique_ptr<FrameSink>& sink : sinks) {
             WholeRunReport report;
             sink->finish(out, report);
             for (const std::string& w : report.warnings) warn(w);
-            if (report.bytes == 0) continue;  // a sink of frames only
-            outcome.assetBytes = report.bytes;
-            outcome.assetBakeBytes = report.bakeBytes;
-            outcome.assetSeconds = report.seconds;
+            if (!report.name.empty()) outcome.wholeRunFiles.push_back(std::move(report));
         }
     };
     if (start > last_) {  // resumed with nothing left to do
@@ -477,6 +478,19 @@ std::vector<std::unique_ptr<FrameSink>> RenderJob::makeSinks() const {
             }
         }
         sinks.push_back(std::make_unique<AssetSink>(scene_, std::move(asset)));
+    }
+    if (settings_.writeUsd && !settings_.framesOnly) {
+        UsdSinkSettings usd;
+        usd.plyName = [](int frame) { return frameFileName(frame, "ply"); };
+        usd.asset.first = first_;
+        usd.asset.last = last_;
+        usd.asset.fps = animation_.fps();
+        usd.asset.source = settings_.scenePath;
+        usd.asset.meshNames = meshNames_;
+        usd.asset.nodeWorldAt = [this](int frame) { return scene_.worldTransforms(animation_.localsAt(frame)); };
+        // Frames held while writing: a group of meshes at a time, each group reading every PLY once.
+        usd.asset.memoryBudget = std::min<uint64_t>(uint64_t(1) << 30, usableMemory().bytes / 8);
+        sinks.push_back(std::make_unique<UsdSink>(scene_, std::move(usd)));
     }
     return sinks;
 }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "output/frame_sink.h"
 #include "pipeline/run_fingerprint.h"
 #include "pipeline/render_settings.h"
 #include "scene/animation.h"
@@ -45,9 +46,8 @@ struct RunOutcome {
     int framesRemoved = 0;  // frames outside the range whose files failed verification: unlinked
     int filesReplaced = 0;  // of another run, unlinked by --overwrite (frame files and timing.json)
     int framesWritten = 0;  // by this run
-    // asset.glb (--gltf-out): its bytes, those of the bake in it, and the seconds to assemble and write it
-    size_t assetBytes = 0, assetBakeBytes = 0;
-    double assetSeconds = 0;
+    // asset.glb (--gltf-out), asset.usda (--usd-out): what each came to and the seconds to make it
+    std::vector<WholeRunReport> wholeRunFiles;
 };
 
 // What a run tells its host, all optional: onFrame after each frame; stopRequested, asked after
@@ -98,7 +98,8 @@ public:
 
 private:
     // The run's outputs, each a sink of the frame loop (lib/output/frame_sink.h): the PLY, the
-    // images, and with --gltf-out (not --frames-only) asset.glb, made from the folder's PLYs.
+    // images, and (not with --frames-only) asset.glb with --gltf-out and asset.usda with --usd-out,
+    // made from the folder's PLYs.
     std::vector<std::unique_ptr<FrameSink>> makeSinks() const;
 
     RenderSettings settings_;
@@ -109,6 +110,7 @@ private:
     int first_ = 0, last_ = 0;
     int playedGltfAnimation_ = -1;  // the glTF animation the frames show (-1: none, all, a transform file)
     std::shared_ptr<const struct GltfDocument> assetDocument_;  // --gltf-out: the scene file as the render read it
+    std::vector<std::string> meshNames_;                         // the file's, by mesh index
     RunFingerprint fingerprint_;
     bool lit_ = false;
     MeshResolution resolution_;

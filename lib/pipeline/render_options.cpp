@@ -202,7 +202,7 @@ json getCamera(const RenderSettings& s) {
 // radiusGiven, qmcBouncesGiven, gatherGiven, framesSource, EnvironmentSettings' source), EmissionAim's margin (FrameSolver
 // sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
 // added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 35, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 36, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
 static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
@@ -538,8 +538,16 @@ std::vector<RenderOption> declareOptions() {
                  false, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.gltfColourSet = v.get<int>(); },
                  [](const RenderSettings& s) { return s.gltfColourSet >= 0 ? json(s.gltfColourSet) : json(nullptr); }});
+    o.push_back({"usd_out", "--usd-out", T::Boolean, 0, 0, "", {}, true, "", "false",
+                 "also write asset.usda: the scene's meshes with the bake as colours sampled at every frame "
+                 "(primvars radiance = B/pi and irradiance = E) and materials that show it by emission; Blender plays "
+                 "it on import (docs/outputs.md)",
+                 false, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.writeUsd = v; },
+                 [](const RenderSettings& s) { return json(s.writeUsd); }});
     o.push_back({nullptr, "--frames-only", T::Boolean, 0, 0, "", {}, true, "", "false",
-                 "write each frame's files and timing.json only, never asset.glb whatever --gltf-out says: what each "
+                 "write each frame's files and timing.json only, never asset.glb or asset.usda whatever --gltf-out and "
+                 "--usd-out say: what each "
                  "chunk of a Slurm array runs (the finishing run makes the asset once, from every frame)",
                  false, false, [](RenderSettings& s, const json& v, const OptionSource&) { s.framesOnly = v; },
                  [](const RenderSettings& s) { return json(s.framesOnly); }});

@@ -59,7 +59,8 @@ struct RenderSettings {
     bool writeExr = true, exrHalf = false, writePng = false;
     bool writeGltf = false;  // asset.glb: the scene file with the bake in it (lib/output/baked_asset.h)
     int gltfColourSet = -1;  // with writeGltf, the COLOR_n set to add, or -1
-    // Each frame's files and the log only, never asset.glb (whatever writeGltf says): what a Slurm
+    bool writeUsd = false;   // asset.usda: the meshes with the bake as time-sampled colours (lib/output/usd_asset.h)
+    // Each frame's files and the log only, never asset.glb or asset.usda (whatever writeGltf and writeUsd say): what a Slurm
     // array's chunk runs, its frames merged and the asset made once, from all of them.
     bool framesOnly = false;
     std::optional<float> exposure;        // PNG preview; unset: automatic from frame 0

@@ -1,0 +1,22 @@
+// A frame's PLY read back for a whole-run file (asset.glb, asset.usda), which a resumed run or the
+// Slurm merge's finishing run makes from frames other runs wrote: one check that the file holds
+// this scene's frame, and one rule for the radiance a bake shows.
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include "output/ply_reader.h"
+#include "util/vecmath.h"
+
+namespace qsgi {
+
+// B/π (W m⁻² sr⁻¹), the radiance of a Lambertian surface of radiosity B: what a bake shows
+// (asset.glb's _RADIANCE, asset.usda's radiance).
+inline Vec3f bakedRadiance(const Vec3f& radiosity) { return radiosity * float(1 / M_PI); }
+
+// The PLY at `path`. Throws InputError naming it unless it holds `vertexCount` vertices with
+// irradiance (an older qsgi wrote none).
+VertexRadiosityPly readFramePly(const std::string& path, size_t vertexCount);
+
+}  // namespace qsgi

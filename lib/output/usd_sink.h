@@ -1,0 +1,33 @@
+// asset.usda (--usd-out; lib/output/usd_asset.h): the scene's meshes with the run's frames
+// first..last as time-sampled colours. Made once, after the last frame, from the frames' PLYs in the
+// folder, so a resumed run (or the Slurm merge's finishing run) writes it whole, with the bytes of
+// one straight run; written as it is made, so a long animation's text is never held whole.
+#pragma once
+
+#include <functional>
+
+#include "output/frame_sink.h"
+#include "output/usd_asset.h"
+
+namespace qsgi {
+
+// --usd-out's file.
+inline constexpr const char* kUsdAssetName = "asset.usda";
+
+struct UsdSinkSettings {
+    std::function<std::string(int)> plyName;  // frame_NNNN.ply
+    UsdAssetSettings asset;
+};
+
+class UsdSink : public FrameSink {
+public:
+    // scene: the render's (its vertices are the PLYs').
+    UsdSink(const Scene& scene, UsdSinkSettings settings) : scene_(scene), settings_(std::move(settings)) {}
+    void finish(OutputDirectory& out, WholeRunReport& report) override;
+
+private:
+    const Scene& scene_;
+    UsdSinkSettings settings_;
+};
+
+}  // namespace qsgi
