@@ -3,7 +3,8 @@
 # (scripts/slurm/local-cluster.sh; needs root or sudo):
 #   1. a render split into 4 frame chunks writes every PLY, EXR and PNG byte for byte as one
 #      sequential run, and the merged timing.json lists every frame once, in order; --gltf-out's
-#      asset.glb, made after the merge from all the frames, is the sequential run's too, and no
+#      asset.glb and --usd-out's asset.usda, made after the merge from all the frames, are the
+#      sequential run's too, and no
 #      chunk (run with --frames-only) writes one of its own;
 #   2. an array task killed mid-chunk (scancel) leaves the merge undone; submitting the same
 #      command again runs only that chunk (resumed from its last complete frame) and the merge,
@@ -51,19 +52,21 @@ logged_frames() { /usr/bin/python3 -c "import json,sys; print(' '.join(str(f['fr
 scene=("$root/data/cornell/cornell.gltf" --animation "$root/data/cornell/animation.json" --width 64 --height 48 --png --quiet)
 
 echo "== 1. chunked render == sequential render"
-"$qsgi" render "${scene[@]}" --photons 100000 --frames 0:11 --gltf-out --out "$work/sequential"
-scripts/slurm/render.py --out "$work/chunked" --frames 0:11 --chunks 4 --qsgi "$qsgi" -- "${scene[@]}" --photons 100000 --gltf-out
+"$qsgi" render "${scene[@]}" --photons 100000 --frames 0:11 --gltf-out --usd-out --out "$work/sequential"
+scripts/slurm/render.py --out "$work/chunked" --frames 0:11 --chunks 4 --qsgi "$qsgi" -- "${scene[@]}" --photons 100000 --gltf-out --usd-out
 wait_for_queue
 [ "$(logged_frames "$work/chunked/timing.json")" = "$(seq -s ' ' 0 11)" ] || fail "merged timing.json lists other frames"
 same_frames "$work/sequential" "$work/chunked"
 # The one-file animation (--gltf-out) is made after the merge from all the frames: the sequential run's bytes.
-cmp -s "$work/sequential/asset.glb" "$work/chunked/asset.glb" || fail "the merged folder's asset.glb differs from the sequential run's"
-echo "test-slurm: the merged folder's asset.glb equals the sequential run's"
+for asset in asset.glb asset.usda; do
+  cmp -s "$work/sequential/$asset" "$work/chunked/$asset" || fail "the merged folder's $asset differs from the sequential run's"
+  echo "test-slurm: the merged folder's $asset equals the sequential run's"
+done
 # Chunks run --frames-only: none writes an asset of its part of the animation.
-chunk_assets=$(find "$work/chunked" -mindepth 2 -name asset.glb)
+chunk_assets=$(find "$work/chunked" -mindepth 2 -name 'asset.*')
 [ -z "$chunk_assets" ] || fail "a chunk wrote an asset of its own: $chunk_assets"
 [ -d "$work/chunked/chunks" ] || fail "no chunks folder in $work/chunked: the check above looked at nothing"
-echo "test-slurm: no chunk wrote an asset.glb"
+echo "test-slurm: no chunk wrote an asset.glb or asset.usda"
 
 echo "== 2. a killed array task, resubmitted"
 "$qsgi" render "${scene[@]}" --photons 400000 --frames 0:17 --out "$work/sequential-big"

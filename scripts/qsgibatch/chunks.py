@@ -113,8 +113,8 @@ def task_command(out: str, index: int, threads: int) -> list:
 def finish_command(out: str) -> list:
     """After the merge: the render again over the plan's whole range with --resume. It finds every
     frame complete (verifying each against the merged timing.json) and computes nothing, but writes
-    what qsgi makes from all the frames at once: with --gltf-out, OUT/asset.glb, the one file of the
-    whole animation."""
+    what qsgi makes from all the frames at once: with --gltf-out, OUT/asset.glb, and with --usd-out,
+    OUT/asset.usda, each one file of the whole animation."""
     p = load_plan(out)
     first, last = p["chunks"][0][0], p["chunks"][-1][1]
     return [p["qsgi"], "render"] + p["arguments"] + [

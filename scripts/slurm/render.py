@@ -98,7 +98,7 @@ def main(argv):
             os.execv(command[0], command)
         if args.merge:
             print(f"render: merged {chunks.merge(out)} frames into {out}")
-            # What is made from all the frames (--gltf-out's asset.glb), by qsgi itself.
+            # What is made from all the frames (--gltf-out's asset.glb, --usd-out's asset.usda), by qsgi itself.
             return subprocess.run(chunks.finish_command(out)).returncode
         return submit(args)
     except output_folder.FolderError as e:  # 2 a refusal, 75 another run holds the folder, 74 the machine failed
