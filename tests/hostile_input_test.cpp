@@ -15,7 +15,7 @@
 #include <sys/stat.h>
 
 #include "output/ply_reader.h"
-#include "pipeline/output_folder.h"
+#include "output/folder_survey.h"
 #include "pipeline/render_job.h"
 #include "scene/animation.h"
 #include "scene/gltf_loader.h"

@@ -11,7 +11,7 @@
 #include <map>
 #include <set>
 
-#include "pipeline/output_folder.h"
+#include "output/folder_survey.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;

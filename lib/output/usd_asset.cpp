@@ -269,7 +269,8 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
     }
 
     UsdText text(put);
-    text << "#usda 1.0\n(\n    defaultPrim = \"Scene\"\n    doc = "
+    text << "#usda 1.0\n(\n    customLayerData = {\n        string \"qsgi:version\" = " << quoted(QSGI_VERSION)
+         << "\n    }\n    defaultPrim = \"Scene\"\n    doc = "
          << quoted(std::string("qsgi ") + QSGI_VERSION + ": the vertex bake of " + settings.source +
                    ", frames " + std::to_string(settings.first) + " to " + std::to_string(settings.last) +
                    ". primvars:radiance is B/pi (W m^-2 sr^-1, what a Lambertian surface shows), primvars:irradiance "
@@ -279,7 +280,7 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
     if (settings.fps > 0) text << "    framesPerSecond = " << settings.fps << "\n";
     text << "    metersPerUnit = 1\n    startTimeCode = " << (long long)settings.first << "\n";
     if (settings.fps > 0) text << "    timeCodesPerSecond = " << settings.fps << "\n";
-    text << "    upAxis = \"Y\"\n)\n\ndef Xform \"Scene\"\n{\n    def Scope \"Materials\"\n    {\n";
+    text << "    upAxis = \"Y\"\n)\n\ndef Xform \"Scene\" (\n    kind = \"assembly\"\n)\n{\n    def Scope \"Materials\"\n    {\n";
     for (const std::string& name : materialOrder) writeMaterial(text, name);
     text << "    }\n";
 

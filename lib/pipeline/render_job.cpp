@@ -20,11 +20,10 @@
 #include "output/usd_sink.h"
 #include "scene/gltf_document.h"
 #include "output/timing_log.h"
-#include "output/folder_lock.h"
 #include "output/output_directory.h"
+#include "output/run_folder.h"
 #include "pipeline/render_options.h"
 #include "pipeline/frame_solver.h"
-#include "pipeline/output_folder.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
 #include "scene/mesh_refinement.h"
@@ -226,6 +225,19 @@ Camera RenderJob::cameraAt(int frame) const {
                        scene_.worldOrigin);
 }
 
+FolderExpectations folderExpectations(const RenderSettings& settings, const RunFingerprint& fingerprint) {
+    FolderExpectations expected;
+    expected.digest = fingerprint.digest;
+    expected.parts = fingerprint.parts;
+    expected.differences = fingerprintDifferences;
+    expected.frameExtensions = {"ply"};
+    if (settings.writeExr) expected.frameExtensions.push_back("exr");
+    if (settings.writePng) expected.frameExtensions.push_back("png");
+    expected.resume = settings.resume;
+    expected.overwrite = settings.overwrite;
+    return expected;
+}
+
 RunOutcome RenderJob::run(const RunObserver& observer) {
     refuseIfUnlit();
     std::optional<tbb::global_control> threadLimit;
@@ -234,31 +246,10 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         if (observer.onWarning) observer.onWarning(message);
     };
 
-    // One folder, one run: frames of this run are kept (and with --resume not computed again),
-    // another run's are refused unless --overwrite replaces them. Judged first without touching
-    // anything, so that a refused render leaves the folder exactly as it was; then again under
-    // the folder's lock, which decides.
-    if (const std::optional<InputError> refusal =
-            outputFolderRefusal(surveyOutputFolder(settings_.outDir, fingerprint_, settings_, false), settings_))
-        throw *refusal;
-    OutputDirectory out(settings_.outDir);
-    const FolderLock lock(out, "qsgi render");
-    if (!lock.held()) warn(lock.unguardedReason());
-    const OutputFolderSurvey folder = surveyOutputFolder(settings_.outDir, fingerprint_, settings_);
-    if (const std::optional<InputError> refusal = outputFolderRefusal(folder, settings_)) throw *refusal;
-    // Find out now, not after the first frame's work, whether files can be written here.
-    out.probeWritable();
-    // Another live run's temporaries would go too: only under the lock.
-    if (lock.held()) out.removeStaleTemporaries();
-    std::vector<FrameTiming> earlierFrames;
+    RunFolder folder(settings_.outDir, folderExpectations(settings_, fingerprint_), "qsgi render", warn);
     RunOutcome outcome;
-    if (folder.holds == OutputFolderSurvey::Holds::ThisRun) earlierFrames = folder.completeFrames;
-    else if (folder.holds != OutputFolderSurvey::Holds::Nothing) {
-        outcome.filesReplaced = int(removeEarlierRun(folder));
-    }
-    // The first frame to compute: with --resume, the first of the range this run's earlier
-    // frames do not already hold. Earlier frames outside what is computed stay in the log.
-    const int start = settings_.resume ? firstIncompleteFrame(folder, first_, last_) : first_;
+    outcome.filesReplaced = folder.filesReplaced();
+    const int start = folder.startFrame(first_, last_);
     TimingLog log;
     log.config = optionValues(settings_, OptionSelection::Logged);
     log.degenerateTriangles = ImpactCount(scene_).degenerateTriangles();
@@ -273,41 +264,16 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     log.animationDiagonal = scene_.animationBounds.extent();
     log.inputsFingerprint = fingerprint_.digest;
     log.inputs = fingerprint_.parts;
-    for (const FrameTiming& f : earlierFrames)
-        if (f.frame < start || f.frame > last_) log.frames.push_back(f);
-    outcome.framesResumed = settings_.resume ? int(log.frames.size()) : 0;
-    outcome.framesKept = settings_.resume ? 0 : int(log.frames.size());
+    const RunFolder::Started started = folder.startLog(std::move(log), start, last_, {kBakedAssetName, kUsdAssetName});
+    outcome.framesResumed = settings_.resume ? started.framesOutside : 0;
+    outcome.framesKept = settings_.resume ? 0 : started.framesOutside;
+    outcome.framesRemoved = started.framesRemoved;
     outcome.nextFrame = start;
-    // The earlier frames this run computes again stay listed until each is rewritten (with the
-    // same bytes): a run stopped or failing before it reaches them leaves them whole and listed.
-    for (const FrameTiming& f : earlierFrames)
-        if (f.frame >= start && f.frame <= last_) log.frames.push_back(f);
-    // Written before any frame, so the folder records its inputs' fingerprint from the start, and
-    // forgets the frames whose files are not as it recorded them (cut short, overwritten, replaced
-    // by a link) before their files are unlinked: the log never lists a frame that is not whole.
-    // Those this run's frames hold are computed again; the others it says how to render again.
-    if (start <= last_ || !folder.failedFrames.empty()) out.write("timing.json", log.text());
-    for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames) {
-        for (const std::string& name : frameFileNames(failed.frame)) out.remove(name);
-        const bool recomputed = failed.frame >= start && failed.frame <= last_;
-        if (!recomputed || settings_.resume)
-            warn("frame " + std::to_string(failed.frame) + " in " + settings_.outDir + " is not as timing.json records it (" +
-                 failed.reason + "): " +
-                 (recomputed ? "computing it again"
-                             : "outside --frames, so its files are removed; render it again with --frames " +
-                                   std::to_string(failed.frame) + ":" + std::to_string(failed.frame) + " --resume"));
-    }
-    outcome.framesRemoved = 0;
-    for (const OutputFolderSurvey::FailedFrame& failed : folder.failedFrames)
-        if (failed.frame < start || failed.frame > last_) ++outcome.framesRemoved;
-    // An asset of earlier frames would no longer be the folder's: gone before any frame changes.
-    if (start <= last_)
-        for (const char* name : {kBakedAssetName, kUsdAssetName}) out.remove(name);
     const std::vector<std::unique_ptr<FrameSink>> sinks = makeSinks();
     auto finish = [&] {
         for (const std::unique_ptr<FrameSink>& sink : sinks) {
             WholeRunReport report;
-            sink->finish(out, report);
+            sink->finish(folder.directory(), report);
             for (const std::string& w : report.warnings) warn(w);
             if (!report.name.empty()) outcome.wholeRunFiles.push_back(std::move(report));
         }
@@ -353,6 +319,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         timing.frame = frame;
         if (!calibrated) calibrate(result, solver.bvh());
         if (frame == start) {
+            TimingLog& log = folder.log();
             log.photonsMissingScene = timing.photonsMissingScene;
             log.emittedFraction = solver.emittedFraction();
             log.emissionMeasured = true;
@@ -364,61 +331,19 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
                 sink->prepare(solved, timing);
             }
 
-        Stopwatch clock;
+        Stopwatch encoding;
         stage("writing", 0, 0);
-        // A frame is on disk whole or not at all: every file, then timing.json listing them. A
-        // failure (a full disk) removes the files already placed, so the folder holds exactly
-        // the frames the log lists, and --resume continues from this one.
         // Every file encoded before any is written: an encoder that fails leaves nothing behind.
-        const std::vector<std::string> names = frameFileNames(frame);
-        std::vector<EncodedFile> encoded;
-        for (const std::unique_ptr<FrameSink>& sink : sinks) sink->encode(solved, encoded);
-        std::vector<std::pair<std::string, std::string>> files;
-        for (EncodedFile& file : encoded) files.emplace_back(frameFileName(frame, file.extension.c_str()), std::move(file.bytes));
-        const auto listed = std::find_if(log.frames.begin(), log.frames.end(), [&](const FrameTiming& f) { return f.frame == frame; });
-        const bool listedBefore = listed != log.frames.end();
-        const std::vector<FrameTiming> logBefore = listedBefore ? std::vector<FrameTiming>{} : log.frames;
-        std::string writing;
-        try {
-            for (const auto& [name, bytes] : files) {
-                writing = name;
-                timing.files.push_back(out.write(name, bytes));
-            }
-            timing.writeSeconds = clock.seconds();
-            if (listedBefore) *listed = timing;
-            else log.frames.push_back(timing);
-            writing = "timing.json";
-            // Rewritten after every frame, so it always describes the frames on disk (docs/design.md §7).
-            out.write("timing.json", log.text());
-        } catch (const EnvironmentError& e) {
-            std::string problem = "writing frame " + std::to_string(frame) + " failed: " + e.problem() + ". ";
-            const bool logPlaced = writing == "timing.json" && dynamic_cast<const NotDurableError*>(&e) != nullptr;
-            if (listedBefore || logPlaced) {
-                // Listed, and whole: each of its names holds the earlier bytes or the same new ones.
-                problem += "Its files are whole and listed; ";
-            } else {
-                // A frame the log on disk does not list: whatever of it was placed goes.
-                log.frames = logBefore;
-                std::string failures;
-                for (const std::string& name : names) {
-                    try {
-                        out.remove(name);
-                    } catch (const EnvironmentError& removal) {
-                        failures += (failures.empty() ? "" : "; ") + removal.problem();
-                    }
-                }
-                problem += failures.empty() ? "Its files were removed; " : "Removing its files failed too (" + failures + "); ";
-            }
-            const size_t listedFrames = log.frames.size();
-            problem += "timing.json lists the " + std::to_string(listedFrames) + (listedFrames == 1 ? " frame" : " frames") +
-                       " whole on disk; once the cause is fixed, add --resume to continue from frame " + std::to_string(frame);
-            throw EnvironmentError(settings_.outDir, problem);
-        }
+        // Then the frame is on disk whole or not at all (RunFolder::commitFrame).
+        std::vector<EncodedFile> files;
+        for (const std::unique_ptr<FrameSink>& sink : sinks) sink->encode(solved, files);
+        timing.writeSeconds = encoding.seconds();
+        folder.commitFrame(frame, files, std::move(timing));
         outcome.nextFrame = frame + 1;
         ++outcome.framesWritten;
         if (observer.onFrame)
             observer.onFrame(FrameReport{frame, frame - start, count, frameClock.seconds(),
-                                double(log.photonsMissingScene) / double(std::max<uint64_t>(settings_.trace.photons, 1))});
+                                double(folder.log().photonsMissingScene) / double(std::max<uint64_t>(settings_.trace.photons, 1))});
         if (frame < last_ && observer.stopRequested && observer.stopRequested()) {
             outcome.interrupted = true;
             return outcome;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "output/folder_survey.h"
 #include "output/frame_sink.h"
 #include "pipeline/run_fingerprint.h"
 #include "pipeline/render_settings.h"
@@ -38,6 +39,10 @@ struct StageReport {
 
 // How run() ended: every frame written, or stopped early on request with the frames before
 // `nextFrame` on disk.
+// What a run with these settings expects of its output folder (lib/output/folder_survey.h): its
+// fingerprint, the files every frame has, --resume and --overwrite.
+FolderExpectations folderExpectations(const RenderSettings& settings, const RunFingerprint& fingerprint);
+
 struct RunOutcome {
     bool interrupted = false;
     int nextFrame = 0;      // the first frame not written

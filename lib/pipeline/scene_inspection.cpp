@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <set>
 
-#include "pipeline/output_folder.h"
+#include "output/folder_survey.h"
 #include "util/json_file.h"
 #include "pipeline/render_options.h"
 #include "trace/light_sampler.h"
@@ -46,7 +46,7 @@ std::string frameRange(int first, int last) { return std::to_string(first) + ":"
 nlohmann::json outputFolderReport(const RenderJob& job) {
     using Holds = OutputFolderSurvey::Holds;
     const RenderSettings& s = job.settings();
-    const OutputFolderSurvey survey = surveyOutputFolder(s.outDir, job.fingerprint(), s);
+    const OutputFolderSurvey survey = surveyOutputFolder(s.outDir, folderExpectations(s, job.fingerprint()));
     const std::string range = frameRange(job.firstFrame(), job.lastFrame());
     nlohmann::json r = {{"path", pathJson(s.outDir)}, {"frame_files", survey.frameFiles.size()}};
     std::string render;
@@ -75,7 +75,7 @@ nlohmann::json outputFolderReport(const RenderJob& job) {
         r["differences"] = survey.differences;
         render = s.overwrite ? "unlinks the earlier run's " + std::to_string(survey.frameFiles.size()) +
                                    " frame files and timing.json (--overwrite), then renders frames " + range
-                             : std::string("refuses: ") + outputFolderRefusal(survey, s)->what();
+                             : std::string("refuses: ") + outputFolderRefusal(survey, folderExpectations(s, job.fingerprint()))->what();
     }
     if (!survey.failedFrames.empty() && survey.holds == Holds::ThisRun)
         render += "; " + std::to_string(survey.failedFrames.size()) +

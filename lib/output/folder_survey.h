@@ -6,17 +6,30 @@
 // `qsgi inspect` reports the same survey without writing anything.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "pipeline/render_settings.h"
-#include "pipeline/run_fingerprint.h"
 #include "util/error.h"
 #include "util/frame_timing.h"
 
 namespace qsgi {
+
+// What a run expects of its folder, as plain values (the pipeline derives them from its settings:
+// lib/pipeline/render_job.h's folderExpectations).
+struct FolderExpectations {
+    // The run's fingerprint (lib/pipeline/run_fingerprint.h): its digest, the parts timing.json
+    // records, and what differs between an earlier run's parts and these, one phrase each.
+    std::string digest;
+    nlohmann::json parts;
+    std::function<std::vector<std::string>(const nlohmann::json& there, const nlohmann::json& here)> differences;
+    std::vector<std::string> frameExtensions;  // the files every frame has: "ply", and "exr", "png" as the run writes them
+    bool resume = false, overwrite = false;
+};
 
 struct OutputFolderSurvey {
     enum class Holds {
@@ -54,9 +67,9 @@ std::string frameFileName(int frame, const char* extension);
 bool isFrameFileName(const std::string& name);
 
 // Why `frame`'s files in the folder open as `folderFd` are not as `record` lists them (every file
-// the settings ask for listed; every listed file verified by fileMismatch), or nullopt when they are.
+// of `extensions` listed; every listed file verified by fileMismatch), or nullopt when they are.
 // A file that cannot be read throws EnvironmentError naming it (fileMismatch): it proves nothing.
-std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& settings,
+std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const std::vector<std::string>& extensions,
                                              const std::string& folderName);
 
 // The names of a frame's files, whichever the settings write: what a failed frame's removal unlinks.
@@ -64,16 +77,16 @@ std::vector<std::string> frameFileNames(int frame);
 
 // Reads the folder; writes nothing. With `verify`, every frame file of this run's is read whole
 // to verify it; without, the frames the log lists count as complete (for a refusal's first look).
-OutputFolderSurvey surveyOutputFolder(const std::filesystem::path& folder, const RunFingerprint& fingerprint,
-                                      const RenderSettings& settings, bool verify = true);
+OutputFolderSurvey surveyOutputFolder(const std::filesystem::path& folder, const FolderExpectations& expected,
+                                      bool verify = true);
 
 // The first frame of first..last that the survey's complete frames of this run do not hold
 // (last + 1 when they hold them all): where --resume starts.
 int firstIncompleteFrame(const OutputFolderSurvey& survey, int first, int last);
 
-// Why a run with these settings (--resume, --overwrite) may not write into the surveyed folder:
-// one message naming the folder and each differing setting, or nullopt when it may.
-std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const RenderSettings& settings);
+// Why a run expecting this (--resume, --overwrite) may not write into the surveyed folder: one
+// message naming the folder and each differing setting, or nullopt when it may.
+std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const FolderExpectations& expected);
 
 // For --overwrite: unlinks the earlier run's frame files and its timing.json, nothing else (never
 // recursively: not chunks/, not slurm/, not another file of the user's). Returns how many.

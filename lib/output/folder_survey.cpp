@@ -1,4 +1,4 @@
-#include "pipeline/output_folder.h"
+#include "output/folder_survey.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -41,12 +41,11 @@ std::vector<std::string> frameFileNames(int frame) {
     return {frameFileName(frame, "ply"), frameFileName(frame, "exr"), frameFileName(frame, "png"), frameFileName(frame, "glb")};
 }
 
-std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const RenderSettings& s,
+std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& record, const std::vector<std::string>& extensions,
                                              const std::string& folderName) {
     if (record.files.empty()) return std::string("timing.json (an older qsgi's) records no checksums to verify its files by");
-    std::vector<std::string> wanted = {frameFileName(record.frame, "ply")};
-    if (s.writeExr) wanted.push_back(frameFileName(record.frame, "exr"));
-    if (s.writePng) wanted.push_back(frameFileName(record.frame, "png"));
+    std::vector<std::string> wanted;
+    for (const std::string& extension : extensions) wanted.push_back(frameFileName(record.frame, extension.c_str()));
     // Exactly the names qsgi gives this frame's files: a hand-edited name ("../x") reads nothing
     // outside the folder.
     const std::vector<std::string> names = frameFileNames(record.frame);
@@ -62,8 +61,7 @@ std::optional<std::string> frameFilesProblem(int folderFd, const FrameTiming& re
     return std::nullopt;
 }
 
-OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerprint& fingerprint,
-                                      const RenderSettings& settings, bool verify) {
+OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const FolderExpectations& expected, bool verify) {
     OutputFolderSurvey survey;
     survey.folder = folder;
     std::error_code ec;
@@ -103,9 +101,9 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
         survey.differences.push_back("its timing.json cannot be read, so nothing says which run it holds: " + e.problem());
         return survey;
     }
-    if (earlier.inputsFingerprint != fingerprint.digest) {
+    if (earlier.inputsFingerprint != expected.digest) {
         survey.holds = OutputFolderSurvey::Holds::AnotherRun;
-        survey.differences = fingerprintDifferences(earlier.inputs, fingerprint.parts);
+        if (expected.differences) survey.differences = expected.differences(earlier.inputs, expected.parts);
         // The digest also covers what the parts cannot show one by one.
         if (survey.differences.empty()) survey.differences.push_back("the inputs' fingerprints differ");
         return survey;
@@ -116,7 +114,7 @@ OutputFolderSurvey surveyOutputFolder(const fs::path& folder, const RunFingerpri
         throw InputError(folder.string(), "--out", std::string("cannot read the output folder: ") + std::strerror(errno));
     try {
         for (const FrameTiming& f : earlier.frames) {
-            const std::optional<std::string> problem = verify ? frameFilesProblem(folderFd, f, settings, folder.string()) : std::nullopt;
+            const std::optional<std::string> problem = verify ? frameFilesProblem(folderFd, f, expected.frameExtensions, folder.string()) : std::nullopt;
             if (problem) survey.failedFrames.push_back({f.frame, *problem});
             else survey.completeFrames.push_back(f);
         }
@@ -136,15 +134,15 @@ int firstIncompleteFrame(const OutputFolderSurvey& survey, int first, int last) 
     return next;
 }
 
-std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const RenderSettings& settings) {
+std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, const FolderExpectations& expected) {
     using Holds = OutputFolderSurvey::Holds;
-    const std::string place = settings.resume ? "--resume" : "--out";
+    const std::string place = expected.resume ? "--resume" : "--out";
     if (survey.notAFolder) return InputError(survey.folder.string(), "--out", "is not a folder");
     // Not even --overwrite unlinks what is not a file: refused before any work, not at its write.
     if (!survey.blockingEntries.empty())
         return InputError(survey.blockingEntries.front().string(), place,
                           "is a folder (or other non-file) where qsgi writes a frame file; move it away");
-    if (settings.overwrite || survey.holds == Holds::Nothing || survey.holds == Holds::ThisRun) return std::nullopt;
+    if (expected.overwrite || survey.holds == Holds::Nothing || survey.holds == Holds::ThisRun) return std::nullopt;
     if (survey.holds == Holds::UnknownFiles)
         return InputError(survey.folder.string(), place,
                           "holds frame files but no timing.json, so nothing says how they were made; render into an "
@@ -153,7 +151,7 @@ std::optional<InputError> outputFolderRefusal(const OutputFolderSurvey& survey, 
     for (const std::string& d : survey.differences) what += (what.empty() ? "" : "; ") + d;
     return InputError(survey.folder.string(), place,
                       "holds a render from other inputs or settings (" + what + "), so " +
-                          (settings.resume ? "--resume" : "rendering into it") +
+                          (expected.resume ? "--resume" : "rendering into it") +
                           " would mix two runs; use the same settings, render into another folder, or add --overwrite "
                           "to replace its frames and timing.json");
 }
