@@ -72,7 +72,7 @@ def comment_lines(path):
 def files_to_check():
     for folder in SOURCE_FOLDERS:
         for base, dirs, files in os.walk(os.path.join(ROOT, folder)):
-            dirs[:] = [d for d in dirs if d not in ("node_modules", "data", "golden", "__pycache__")]
+            dirs[:] = [d for d in dirs if d not in ("node_modules", "venv", "data", "golden", "__pycache__")]
             for name in files:
                 if name.endswith(SOURCE_SUFFIXES) or name == "CMakeLists.txt":
                     yield os.path.join(base, name)
@@ -240,7 +240,7 @@ def check_markdown_links(rel, lines, anchors_of, broken):
 def main():
     names = set()
     for base, dirs, files in os.walk(ROOT):
-        dirs[:] = [d for d in dirs if not d.startswith((".git", "build")) and d != "node_modules"]
+        dirs[:] = [d for d in dirs if not d.startswith((".git", "build")) and d not in ("node_modules", "venv")]
         names.update(files)
     broken = []
     for path in files_to_check():

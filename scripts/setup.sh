@@ -3,7 +3,9 @@
 #   scripts/setup.sh          building and rendering (scripts/run.sh): compiler, CMake and the libraries
 #   scripts/setup.sh --test   the above, and what the test command adds: GoogleTest and Google Benchmark,
 #                             clang with libFuzzer (scripts/fuzz.sh), oiiotool, numpy and matplotlib
-#                             (scripts/sweep.py, reference checks) and the npm packages of scripts/gltf-check
+#                             (scripts/sweep.py, reference checks), the npm packages of scripts/gltf-check
+#                             and, in a venv of the project's own (venv/ in scripts/usd-check), the pinned
+#                             OpenUSD of scripts/usd-check/requirements.txt that checks --usd-out
 # Idempotent and non-interactive: packages already installed are skipped; runs apt-get directly as
 # root, through sudo otherwise. Slurm is installed by scripts/test-slurm.sh, which alone uses it.
 set -euo pipefail
@@ -28,6 +30,7 @@ test_packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   clang libclang-rt-14-dev    # libFuzzer (scripts/fuzz.sh)
+  python3-venv              # the venv of scripts/usd-check: Debian's python3 is externally managed (PEP 668)
 )
 
 case "${1:-}" in
@@ -59,6 +62,27 @@ install_gltf_checkers() {
   (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
 }
 
+# OpenUSD's Python package (usd-core, pinned by scripts/usd-check/requirements.txt) for the checker
+# of --usd-out (scripts/usd-check/check_usd.py), after the Debian packages, in a venv of the
+# project's own made with Debian's python3: its numpy comes from python3-numpy
+# (--system-site-packages), usd-core from PyPI. Skipped when the venv already has the pinned version.
+install_usd_checker() {
+  [ "$with_tests" = 1 ] || return 0
+  local dir venv pin
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/usd-check"
+  venv="$dir/venv"
+  pin="$(sed -n 's/^usd-core==\([^[:space:]#]*\).*/\1/p' "$dir/requirements.txt")"
+  if [ -x "$venv/bin/python" ] &&
+     [ "$("$venv/bin/python" -c 'import importlib.metadata as m; print(m.version("usd-core"))' 2>/dev/null)" = "$pin" ]; then
+    return 0
+  fi
+  echo "setup: usd-core==$pin into $venv"
+  # A venv whose interpreter no longer runs (Debian's python3 upgraded or removed) is made anew.
+  "$venv/bin/python" -c '' 2>/dev/null || /usr/bin/python3 -m venv --clear --system-site-packages "$venv"
+  "$venv/bin/python" -m pip install --quiet --disable-pip-version-check --no-input --only-binary=:all: \
+    -r "$dir/requirements.txt"
+}
+
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -69,6 +93,7 @@ done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages already installed"
   install_gltf_checkers
+  install_usd_checker
   exit 0
 fi
 
@@ -78,3 +103,4 @@ export DEBIAN_FRONTEND=noninteractive
 "${sudo[@]}" apt-get update -qq
 "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 install_gltf_checkers
+install_usd_checker
