@@ -4,6 +4,8 @@
 //   - the validator reports no error code the input lacked;
 //   - the JSON equals the input's in every object once the added attributes, targets, weights,
 //     channels, samplers, accessors, views, mesh copies and the packed buffers are taken out;
+//   - every target the asset gains has a POSITION of zeros taking no bytes (issue 46: Blender
+//     makes shape keys only of targets with POSITION), the input's own targets left as they were;
 //   - glTF Transform, evaluating the morph targets under the file's weights animation at each
 //     frame's time, gets every frame's _RADIANCE = B/π and _IRRADIANCE = E of the frame's PLY back
 //     within float rounding, and COLOR_n = min(1, exposure · B/π);
@@ -75,6 +77,41 @@ std::string frameName(int frame, const char* extension) {
     return name;
 }
 
+// Every target qsgi appended to `mesh` (after the `original`'s own) holds POSITION: zeros with no
+// view, float VEC3 of the primitive's vertex count, bounds 0, so that Blender's importer makes a
+// shape key of it and nothing moves. A primitive without POSITION gets none (the validator's
+// MESH_PRIMITIVE_MORPH_TARGET_NO_BASE_ACCESSOR). `accessors`: the asset's.
+void expectAddedTargetsHoldZeroPositions(const json& mesh, const json& original, const json& accessors) {
+    for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
+        SCOPED_TRACE("primitive " + std::to_string(p));
+        const json& primitive = mesh["primitives"][p];
+        const json& before = original["primitives"][p];
+        const size_t own = before.contains("targets") ? before["targets"].size() : 0;
+        if (!primitive.contains("targets")) continue;
+        const bool positioned = primitive["attributes"].contains("POSITION");
+        const json vertices = positioned ? accessors.at(primitive["attributes"]["POSITION"].get<size_t>())["count"] : json();
+        for (size_t t = own; t < primitive["targets"].size(); ++t) {
+            const json& target = primitive["targets"][t];
+            if (!positioned) {
+                EXPECT_FALSE(target.contains("POSITION")) << "targets[" << t << "]";
+                continue;
+            }
+            if (!target.contains("POSITION")) {
+                ADD_FAILURE() << "targets[" << t << "] has no POSITION: " << target.dump();
+                continue;
+            }
+            const json& a = accessors.at(target["POSITION"].get<size_t>());
+            EXPECT_FALSE(a.contains("bufferView")) << a.dump();
+            EXPECT_FALSE(a.contains("sparse")) << a.dump();
+            EXPECT_EQ(a.value("componentType", 0), 5126) << a.dump();
+            EXPECT_EQ(a.value("type", ""), "VEC3") << a.dump();
+            EXPECT_EQ(a["count"], vertices) << a.dump();
+            EXPECT_EQ(a.value("min", json()), json::array({0, 0, 0})) << a.dump();
+            EXPECT_EQ(a.value("max", json()), json::array({0, 0, 0})) << a.dump();
+        }
+    }
+}
+
 // Takes out of `out` what --gltf-out adds to `in` and checks, as it goes, that the added parts
 // are where they belong; what is left must equal `in`. `colourSet` is --gltf-colour's (-1: none).
 // With `refined` (--subdivide), a primitive's attributes, indices and targets are new accessors of
@@ -95,6 +132,7 @@ json withoutTheBake(json out, const json& in, int colourSet, bool refined = fals
     }
     out["bufferViews"] = in["bufferViews"];
     for (size_t a = 0; a < in["accessors"].size(); ++a) EXPECT_EQ(out["accessors"][a], in["accessors"][a]) << "accessors[" << a << "]";
+    const json accessors = out["accessors"];
     out["accessors"] = in["accessors"];
     // An image's file becomes a view of its bytes.
     if (in.contains("images"))
@@ -136,6 +174,7 @@ json withoutTheBake(json out, const json& in, int colourSet, bool refined = fals
     std::vector<size_t> copyOf;  // of out's meshes beyond the input's
     for (size_t m = 0; m < out["meshes"].size(); ++m) {
         if (m < meshes) {
+            expectAddedTargetsHoldZeroPositions(out["meshes"][m], in["meshes"][m], accessors);
             out["meshes"][m] = strip(out["meshes"][m], in["meshes"][m]);
             continue;
         }
@@ -145,6 +184,7 @@ json withoutTheBake(json out, const json& in, int colourSet, bool refined = fals
             if (out["meshes"][m]["primitives"].size() == in["meshes"][i]["primitives"].size() && strip(out["meshes"][m], in["meshes"][i]) == in["meshes"][i])
                 found = i;
         EXPECT_LT(found, meshes) << "meshes[" << m << "] is no copy of an input mesh";
+        if (found < meshes) expectAddedTargetsHoldZeroPositions(out["meshes"][m], in["meshes"][found], accessors);
         copyOf.push_back(found);
     }
     out["meshes"].erase(out["meshes"].begin() + std::ptrdiff_t(meshes), out["meshes"].end());

@@ -52,7 +52,15 @@ public:
                             {"count", count}, {"type", "VEC3"}});
     }
     // Zeros without a view (glTF 2.0 §3.6.2.3: an accessor without bufferView reads as zeros).
-    int addZeroVec3(size_t count) { return addAccessor({{"componentType", kFloat}, {"count", count}, {"type", "VEC3"}}); }
+    // `bounds`: with min and max 0, which glTF requires of a morph target's POSITION (§3.7.2.2).
+    int addZeroVec3(size_t count, bool bounds = false) {
+        json accessor = {{"componentType", kFloat}, {"count", count}, {"type", "VEC3"}};
+        if (bounds) {
+            accessor["min"] = {0, 0, 0};
+            accessor["max"] = {0, 0, 0};
+        }
+        return addAccessor(std::move(accessor));
+    }
     // Zeros but at `indices` (strictly increasing), which hold `values`.
     int addSparseVec3(size_t count, const std::vector<uint32_t>& indices, const std::vector<Vec3f>& values, int indexView) {
         json accessor = {{"componentType", kFloat}, {"count", count}, {"type", "VEC3"}};
@@ -608,9 +616,20 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
         return c;
     };
     struct Target {
-        int radiance, irradiance, colour;
+        int radiance, irradiance, colour, position;  // accessors (-1: none)
     };
     std::map<std::pair<int, size_t>, std::vector<Target>> targets;  // (output mesh, primitive) → per later frame
+    // Every target added holds a POSITION of zeros (issue 46): Blender's importer makes shape keys
+    // only of targets with POSITION, and fails on a weights channel whose targets gave it none.
+    // Without a view they take no bytes, and the targets of one vertex count share one accessor.
+    // A primitive without POSITION gets none (glTF forbids a target attribute its primitive lacks).
+    std::map<size_t, int> zeroPositions;  // vertex count → accessor
+    auto zeroPositionsOf = [&](const json& primitive, size_t count) {
+        if (!primitive.contains("attributes") || !primitive["attributes"].contains("POSITION")) return -1;
+        const auto [at, added] = zeroPositions.try_emplace(count, -1);
+        if (added) at->second = bin.addZeroVec3(count, true);
+        return at->second;
+    };
     size_t animatedPrimitives = 0;
     const AccessorReader reader(document, file);
     const bool anyAnimated = std::any_of(groups.begin(), groups.end(), [](const auto& entry) {
@@ -652,9 +671,10 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                         if (g.animated) ++animatedPrimitives;
                         continue;
                     }
-                    Target target{};
+                    Target target{-1, -1, -1, zeroPositionsOf(primitive, count)};
                     if (!instance) {
-                        target = {bin.addZeroVec3(count), bin.addZeroVec3(count), -1};
+                        target.radiance = bin.addZeroVec3(count);
+                        target.irradiance = bin.addZeroVec3(count);
                     } else {
                         std::vector<uint32_t> changed;
                         std::vector<Vec3f> dRadiance, dIrradiance, dColour;
@@ -701,6 +721,7 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
                 for (const Target& t : targets[{g.mesh, p}]) {
                     json target = {{"_RADIANCE", t.radiance}, {"_IRRADIANCE", t.irradiance}};
                     if (t.colour >= 0) target[colourName(settings.colourSet)] = t.colour;
+                    if (t.position >= 0) target["POSITION"] = t.position;
                     primitive["targets"].push_back(std::move(target));
                 }
             }

@@ -6,7 +6,10 @@
 //     texture), float RGB, and on request a new COLOR_n set = min(1, exposure · B/π);
 //   - for an animation, frame 0's values as those attributes and one morph target per later frame
 //     holding the difference from frame 0 as a sparse accessor (only the vertices whose values
-//     changed), driven by a STEP weights channel (frame k shows target k − 1 at weight 1). Targets
+//     changed), driven by a STEP weights channel (frame k shows target k − 1 at weight 1). Each
+//     such target also holds a POSITION of zeros (no bufferView, min and max 0: no bytes; one
+//     accessor per vertex count; none on a primitive without POSITION), without which Blender's
+//     importer makes no shape key of it. Targets
 //     are appended after a mesh's own; the mesh's and its nodes' default weights and every
 //     animation's weights output are extended with zeros for them, and the channel goes into the
 //     animation that played (merged with its own weights channel for that node) or, for a transform
