@@ -12,6 +12,7 @@
 #include <map>
 
 #include "output/ply_reader.h"
+#include "scene/gltf_loader.h"
 #include "scene/mesh_refinement.h"
 #include "test_support.h"
 
@@ -134,6 +135,57 @@ TEST(MeshRefinement, NewVerticesCarryTheMeanOfTheirCornersAttributes) {
         EXPECT_NEAR(sum, 1.0, 1e-6) << "vertex " << i;
         EXPECT_NEAR(w0, (p.x + 1) / 2, 1e-6) << "vertex " << i;
     }
+}
+
+// One rule makes every refined value (refinedValue): the scene's own arrays and asset.glb's
+// attributes of the file alike. Its three kinds, and the scene's refined normals and positions are
+// what appendRefinedValues makes from the unrefined ones — so the asset's NORMAL is bit for bit
+// the normal the bake used.
+TEST(MeshRefinement, OneRuleMakesEveryRefinedValue) {
+    const float a[4] = {0.6f, 0.8f, 0.0f, -1.0f}, b[4] = {0.0f, 0.6f, 0.8f, 1.0f};
+    float mean[4], unit[3], tangent[4];
+    refinedValue(a, b, mean, 4, RefinedRule::Mean);
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(mean[k], float((double(a[k]) + double(b[k])) * 0.5)) << k;
+    refinedValue(a, b, unit, 3, RefinedRule::UnitNormal);
+    EXPECT_NEAR(double(unit[0]) * unit[0] + double(unit[1]) * unit[1] + double(unit[2]) * unit[2], 1.0, 1e-7);
+    EXPECT_NEAR(unit[1] / unit[0], (0.8 + 0.6) / 0.6, 1e-6);  // the direction of a + b
+    refinedValue(a, b, tangent, 4, RefinedRule::Tangent);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(tangent[k], unit[k]) << k;
+    EXPECT_EQ(tangent[3], -1.0f) << "a tangent's handedness is its first corner's";
+    const float up[3] = {0, 1, 0}, down[3] = {0, -1, 0};
+    float knife[3];
+    refinedValue(up, down, knife, 3, RefinedRule::UnitNormal);
+    EXPECT_EQ(knife[1], 1.0f) << "opposite normals take the first corner's";
+
+    // A curved mesh: the walker's figure (skinned, smooth normals), refined.
+    Warnings warnings;
+    Scene scene = loadGltfScene((sourceDir() / "data/walker/walker.gltf").string(), warnings);
+    std::vector<std::vector<float>> positions, normals;
+    for (const MeshInstance& inst : scene.instances) {
+        positions.emplace_back();
+        normals.emplace_back();
+        for (const Vec3f& p : inst.objectPositions) positions.back().insert(positions.back().end(), {p.x, p.y, p.z});
+        for (const Vec3f& n : inst.objectNormals) normals.back().insert(normals.back().end(), {n.x, n.y, n.z});
+    }
+    refineMesh(scene, 0.1);
+    size_t added = 0;
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const MeshInstance& inst = scene.instances[i];
+        added += inst.refinedFrom.size();
+        appendRefinedValues(positions[i], 3, inst.refinedFrom, RefinedRule::Mean);
+        appendRefinedValues(normals[i], 3, inst.refinedFrom, RefinedRule::UnitNormal);
+        ASSERT_EQ(positions[i].size(), size_t(inst.vertexCount) * 3);
+        ASSERT_EQ(normals[i].size(), inst.objectNormals.size() * 3);
+        for (uint32_t v = 0; v < inst.vertexCount; ++v)
+            EXPECT_TRUE(positions[i][v * 3] == inst.objectPositions[v].x && positions[i][v * 3 + 1] == inst.objectPositions[v].y &&
+                        positions[i][v * 3 + 2] == inst.objectPositions[v].z)
+                << "instance " << i << " vertex " << v;
+        for (size_t v = 0; v < inst.objectNormals.size(); ++v)
+            EXPECT_TRUE(normals[i][v * 3] == inst.objectNormals[v].x && normals[i][v * 3 + 1] == inst.objectNormals[v].y &&
+                        normals[i][v * 3 + 2] == inst.objectNormals[v].z)
+                << "instance " << i << " vertex " << v;
+    }
+    EXPECT_GT(added, 1000u);
 }
 
 // The case: a floor of two triangles under a point light, refined to 0.05, bakes the

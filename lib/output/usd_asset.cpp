@@ -238,6 +238,7 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
     std::vector<std::string> materialOrder;
     // Nodes in the order of their first mesh; meshes in scene order within a node.
     UniqueNames nodeNames;
+    nodeNames.claim("Materials");  // /Scene/Materials is taken: a node of that name becomes Materials_1
     std::map<int, size_t> nodeIndex;
     std::vector<NodePlan> nodes;
     std::vector<UniqueNames> meshNames;

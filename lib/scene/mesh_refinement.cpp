@@ -13,6 +13,18 @@ namespace {
 
 using LocalTriangle = std::array<uint32_t, 3>;
 
+// appendRefinedValues for the scene's Vec3f arrays.
+void appendRefinedVectors(std::vector<Vec3f>& values, const std::vector<std::pair<uint32_t, uint32_t>>& refinedFrom,
+                          RefinedRule rule) {
+    values.reserve(values.size() + refinedFrom.size());
+    for (const auto& [a, b] : refinedFrom) {
+        const float p[3] = {values[a].x, values[a].y, values[a].z}, q[3] = {values[b].x, values[b].y, values[b].z};
+        float m[3];
+        refinedValue(p, q, m, 3, rule);
+        values.push_back(Vec3f(m[0], m[1], m[2]));
+    }
+}
+
 // One instance's vertices (local indices) and triangles, growing as edges are split.
 class InstanceRefiner {
 public:
@@ -53,8 +65,14 @@ public:
     // from `firstVertex` and `firstTriangle` on.
     void store(MeshInstance& inst, Scene& scene, uint32_t firstVertex, uint32_t firstTriangle, uint32_t material,
                uint32_t triangleMaterial) {
+        // The added vertices' object-space data, by the one rule (each reads only earlier vertices).
+        appendRefinedVectors(positions_, refinedFrom_, RefinedRule::Mean);
+        if (!normals_.empty()) appendRefinedVectors(normals_, refinedFrom_, RefinedRule::UnitNormal);
+        for (std::vector<Vec3f>& target : morphPositions_) appendRefinedVectors(target, refinedFrom_, RefinedRule::Mean);
+        for (std::vector<Vec3f>& target : morphNormals_)
+            if (!target.empty()) appendRefinedVectors(target, refinedFrom_, RefinedRule::Mean);
         inst.firstVertex = firstVertex;
-        inst.vertexCount = uint32_t(positions_.size());
+        inst.vertexCount = uint32_t(world_.size());
         inst.firstTriangle = firstTriangle;
         inst.triangleCount = uint32_t(triangles_.size());
         inst.objectPositions = std::move(positions_);
@@ -97,20 +115,10 @@ private:
         const std::pair<uint32_t, uint32_t> pair(std::min(a, b), std::max(a, b));
         const auto found = midpoints_.find(pair);
         if (found != midpoints_.end()) return found->second;
-        const uint32_t m = uint32_t(positions_.size());
+        const uint32_t m = uint32_t(world_.size());
         midpoints_.emplace(pair, m);
         refinedFrom_.push_back({a, b});
-        auto mean = [](const Vec3f& x, const Vec3f& y) { return Vec3f((Vec3d(x) + Vec3d(y)) * 0.5); };
-        positions_.push_back(mean(positions_[a], positions_[b]));
         world_.push_back((world_[a] + world_[b]) * 0.5);
-        if (!normals_.empty()) {
-            const Vec3d n = Vec3d(normals_[a]) + Vec3d(normals_[b]);
-            // Opposite normals (a knife edge) have no mean direction: take a corner's.
-            normals_.push_back(dot(n, n) > 0 ? Vec3f(normalize(n)) : normals_[a]);
-        }
-        for (std::vector<Vec3f>& target : morphPositions_) target.push_back(mean(target[a], target[b]));
-        for (std::vector<Vec3f>& target : morphNormals_)
-            if (!target.empty()) target.push_back(mean(target[a], target[b]));
         if (inst_.influences > 0) blendInfluences(a, b);
         return m;
     }
@@ -152,6 +160,27 @@ private:
 };
 
 }  // namespace
+
+void refinedValue(const float* a, const float* b, float* out, size_t components, RefinedRule rule) {
+    const size_t mean = rule == RefinedRule::Mean ? components : 0;
+    for (size_t k = 0; k < mean; ++k) out[k] = float((double(a[k]) + double(b[k])) * 0.5);
+    if (rule == RefinedRule::Mean) return;
+    const Vec3d n = Vec3d(a[0], a[1], a[2]) + Vec3d(b[0], b[1], b[2]);
+    // Opposite directions (a knife edge) have no mean: take a corner's.
+    const Vec3f unit = dot(n, n) > 0 ? Vec3f(normalize(n)) : Vec3f(a[0], a[1], a[2]);
+    out[0] = unit.x, out[1] = unit.y, out[2] = unit.z;
+    for (size_t k = 3; k < components; ++k) out[k] = a[k];  // a tangent's handedness
+}
+
+void appendRefinedValues(std::vector<float>& values, size_t components,
+                         const std::vector<std::pair<uint32_t, uint32_t>>& refinedFrom, RefinedRule rule) {
+    values.reserve(values.size() + refinedFrom.size() * components);
+    std::vector<float> value(components);
+    for (const auto& [a, b] : refinedFrom) {
+        refinedValue(&values[size_t(a) * components], &values[size_t(b) * components], value.data(), components, rule);
+        values.insert(values.end(), value.begin(), value.end());
+    }
+}
 
 RefinementReport refineMesh(Scene& scene, double maxEdge) {
     RefinementReport report;

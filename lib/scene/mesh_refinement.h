@@ -10,18 +10,39 @@
 // always at its midpoint, whichever of its triangles reaches it first: both triangles of an edge,
 // and both sides of a seam (corners duplicated for their normals or UVs), end with the same points,
 // and no T-junction is left.
-// A new vertex takes the mean of its edge's corners: object-space position and normal
-// (renormalised), every morph target's deltas, and for a skinned mesh the union of both corners'
-// joint influences at half weight, cut to the instance's influence count (four per JOINTS_n set)
-// by weight and renormalised to sum 1. Lengths are measured on the current world positions, a new
+// A new vertex takes the mean of its edge's corners (refinedValue, the one rule, which asset.glb's
+// attributes of the file follow too): object-space position and normal (renormalised), every morph
+// target's deltas, and for a skinned mesh the union of both corners' joint influences at half
+// weight, cut to the instance's influence count (four per JOINTS_n set) by weight and renormalised
+// to sum 1. Lengths are measured on the current world positions, a new
 // vertex's taken as its corners' mean (where a skinned mesh's midpoint is posed differs slightly).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "scene/scene.h"
 
 namespace qsgi {
+
+// How a vertex the refinement adds takes a per-vertex value from its edge's two corners.
+enum class RefinedRule {
+    Mean,        // each component (a + b) / 2, in double, rounded to float: positions, deltas, UVs, colours
+    UnitNormal,  // (a + b) normalised in double; where the corners cancel (a knife edge), a's own
+    Tangent,     // xyz as UnitNormal, w (the handedness) a's
+};
+
+// The value halfway along the edge (a, b), `components` floats each (3 for UnitNormal, 4 for
+// Tangent), into `out`: the one rule for the scene's data and for asset.glb's attributes.
+void refinedValue(const float* a, const float* b, float* out, size_t components, RefinedRule rule);
+
+// Extends `values` (the instance's own vertices first, `components` floats each) with one value
+// for every vertex the refinement added, in order: vertex own + j is halfway along refinedFrom[j],
+// whose corners are earlier vertices (own or added).
+void appendRefinedValues(std::vector<float>& values, size_t components,
+                         const std::vector<std::pair<uint32_t, uint32_t>>& refinedFrom, RefinedRule rule);
 
 struct RefinementReport {
     size_t trianglesBefore = 0, trianglesAfter = 0;
