@@ -130,3 +130,43 @@ TEST(UsdOut, AnAssetOfFramesEarlierRunsWroteIsTheStraightRunsOwn) {
     ASSERT_EQ(more.exitCode, 0) << more.output;
     EXPECT_FALSE(fs::exists(out / "parts" / "asset.usda"));
 }
+
+// What tools choke on, or show where qsgi shows nothing, is left out of the layer: a triangle naming
+// a vertex twice (no area; Blender's importer drops such a mesh's primvars, or crashes), and a node
+// hidden by a scale of zero on one axis, which qsgi collapses to the node's origin (a flat sheet
+// under the singular transform would be in view, black).
+TEST(UsdOut, DegenerateTrianglesAndHiddenNodesShowAsQsgiComputedThem) {
+    Scene scene;
+    scene.materials.push_back(Material{"Grey", Vec3f(0.5f), Vec3f(0.0f)});
+    const int node = scene.addNode("Panel", Transform::fromTRS(Vec3d(1, 2, 3), {0, 0, 0, 1}, Vec3d(1.0)));
+    scene.addInstance(node, {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 0, 1), Vec3f(1, 0, 1)}, {},
+                      {0, 2, 1, 1, 2, 3, 1, 1, 3}, 0);  // the last triangle names vertex 1 twice
+    scene.finalize();
+    UsdAssetSettings settings;
+    settings.first = 0;
+    settings.last = 1;
+    settings.fps = 24;
+    settings.nodeWorldAt = [&](int frame) {
+        // Frame 1: flattened to nothing along y and z, as a glTF animation hides a node.
+        return std::vector<Transform>{Transform::fromTRS(Vec3d(1, 2, 3), {0, 0, 0, 1}, frame == 0 ? Vec3d(1.0) : Vec3d(1, 0, 0))};
+    };
+    std::string text;
+    writeUsdAsset(
+        scene, settings,
+        [&](int) {
+            VertexRadiosityPly ply;
+            for (size_t v = 0; v < scene.vertexCount(); ++v) {
+                ply.positions.push_back(Vec3f(Vec3d(scene.positions[v]) + scene.worldOrigin));
+                ply.normals.push_back(scene.normals[v]);
+                ply.radiosity.push_back(Vec3f(1.0f));
+                ply.irradiance.push_back(Vec3f(2.0f));
+            }
+            return ply;
+        },
+        [&](std::string_view piece) { text += piece; });
+    EXPECT_NE(text.find("int[] faceVertexCounts = [3,3]\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("int[] faceVertexIndices = [0,2,1,1,2,3]\n"), std::string::npos) << text;
+    // Frame 0 placed as the node is; frame 1 every point at the node's origin (1, 2, 3).
+    EXPECT_NE(text.find("0: ((1,0,0,0), (0,1,0,0), (0,0,1,0), (1,2,3,1)),"), std::string::npos) << text;
+    EXPECT_NE(text.find("1: ((0,0,0,0), (0,0,0,0), (0,0,0,0), (1,2,3,1)),"), std::string::npos) << text;
+}

@@ -105,6 +105,17 @@ struct MeshFrames {
     std::vector<Transform> transforms;   // Placement::Object only: the node's world transform
 };
 
+// The transform that places a rigid mesh as the scene does: a singular one (a scale of zero on
+// some axis: how glTF hides a node) collapses the mesh to its node's origin, as Scene::placeInstance
+// does, rather than leaving a flat sheet in view.
+Transform placing(const Transform& world) {
+    if (world.isInvertible()) return world;
+    Transform collapsed;
+    collapsed.m.fill(0);
+    for (int row = 0; row < 4; ++row) collapsed.at(row, 3) = world.at(row, 3);
+    return collapsed;
+}
+
 template <typename T>
 bool allFramesEqual(const std::vector<T>& values, size_t perFrame, size_t frames) {
     for (size_t f = 1; f < frames; ++f)
@@ -168,17 +179,23 @@ void writeMesh(UsdText& text, const Scene& scene, const MeshPlan& plan, const Me
         text << "            }\n";
     }
 
-    text << "            int[] faceVertexCounts = [";
-    for (uint32_t t = 0; t < inst.triangleCount; ++t) text << (t ? ",3" : "3");
-    text << "]\n            int[] faceVertexIndices = [";
+    // A triangle naming a vertex twice has no area and carries nothing; USD calls such a face
+    // invalid, and Blender's importer, correcting it, drops the mesh's primvars (or crashes).
+    std::vector<Triangle> faces;
     for (uint32_t t = 0; t < inst.triangleCount; ++t) {
         Triangle tri = scene.triangles[inst.firstTriangle + t];
+        if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[0] == tri.v[2]) continue;
         // The scene turned a mirrored instance's triangles to face the same way in world space;
         // over object-space points under its transform, the file's own order is right (USD, like
         // glTF, reverses the winding of a transform with a negative determinant).
         if (!world && inst.mirrored) std::swap(tri.v[1], tri.v[2]);
-        for (int k = 0; k < 3; ++k) text << (t || k ? "," : "") << (long long)(tri.v[k] - inst.firstVertex);
+        faces.push_back(tri);
     }
+    text << "            int[] faceVertexCounts = [";
+    for (size_t t = 0; t < faces.size(); ++t) text << (t ? ",3" : "3");
+    text << "]\n            int[] faceVertexIndices = [";
+    for (size_t t = 0; t < faces.size(); ++t)
+        for (int k = 0; k < 3; ++k) text << (t || k ? "," : "") << (long long)(faces[t].v[k] - inst.firstVertex);
     text << "]\n            rel material:binding = <" << plan.materialPath << ">\n";
 
     if (world)
@@ -327,7 +344,7 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
                     d.normals.insert(d.normals.end(), ply.normals.begin() + long(first), ply.normals.begin() + long(first + n));
                 } else {
                     if (worlds.empty()) worlds = settings.nodeWorldAt(frame);
-                    d.transforms.push_back(inst.node >= 0 ? worlds[size_t(inst.node)] : Transform());
+                    d.transforms.push_back(placing(inst.node >= 0 ? worlds[size_t(inst.node)] : Transform()));
                 }
             }
         }

@@ -12,8 +12,10 @@
 //                                primvars radiance (B/π) and irradiance (E), color3f, vertex
 //                                interpolation, one time sample at every frame (time code = frame
 //                                number: USD interpolates between samples, so none may be missing)
-// A rigid mesh keeps its object-space points and carries its node's world transform, time-sampled
-// where it moves; a skinned or morphing one has world-space points, time-sampled where they move.
+// A rigid mesh keeps its object-space points (and normals, when the file gives them) and carries
+// its node's world transform, time-sampled where it moves (a singular one, a hidden node, collapses
+// it to the node's origin, as qsgi does); a skinned or morphing one has world-space points and
+// normals, time-sampled where they move. Triangles that name a vertex twice are left out.
 // custom int qsgi:firstVertex / qsgi:vertexCount say which vertices of the frame PLYs a mesh holds.
 // Floats are written in shortest round-trip form.
 #pragma once

@@ -1,5 +1,5 @@
 // Prim names for asset.usda from the glTF's node, mesh and material names. A USD prim name is an
-// identifier, [A-Za-z_][A-Za-z0-9_]* (ASCII: Blender's importer and older OpenUSD accept no more),
+// identifier, [A-Za-z_][A-Za-z0-9_]* (ASCII: OpenUSD before 24.03, and the tools built on it, accept no more),
 // unique among its siblings; glTF names are any UTF-8 text, empty, or repeated.
 #pragma once
 
