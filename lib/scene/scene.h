@@ -94,7 +94,7 @@ struct MeshInstance {
 
     // --subdivide's new vertices, after the primitive's own: vertex (vertexCount − size + j) is the
     // midpoint of refinedFrom[j]'s two vertices (earlier ones, own or new), so that every attribute
-    // of the file can be refined alike (lib/output/baked_asset.cpp).
+    // of the file can be refined alike (lib/output/refined_attributes.cpp).
     std::vector<std::pair<uint32_t, uint32_t>> refinedFrom;
 
     bool deforms() const { return skin >= 0 || !morphPositions.empty(); }
