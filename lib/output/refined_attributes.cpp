@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "scene/mesh_refinement.h"
+
 namespace qsgi {
 
 using nlohmann::json;
@@ -22,25 +24,19 @@ int elementType(const std::string& type) {
 json refinedPrimitive(json primitive, const json& doc, BinaryBuilder& bin, const AccessorReader& reader,
                       const Scene& scene, const MeshInstance& inst, const std::string& place) {
     const size_t own = inst.vertexCount - inst.refinedFrom.size();
-    auto refined = [&](int index, const std::string& usedBy, bool unit, bool tangent, bool bounds) {
+    // Each added vertex by the refinement's one rule (lib/scene/mesh_refinement.h), which made the
+    // scene's own positions and normals: the asset's NORMAL is the normal the bake used.
+    auto refined = [&](int index, const std::string& usedBy, RefinedRule rule, bool bounds) {
         const json& a = doc["accessors"][size_t(index)];
         const std::string type = a.value("type", "");
         const AccessorFormat format{elementType(type), {{a.value("componentType", 0), a.value("normalized", false)}}, {}};
         const AccessorData data = reader.readUnbounded(index, usedBy, format);
         const size_t c = size_t(data.components);
         if (data.count != own) throw InputError(scene.sourcePath, usedBy, "has " + std::to_string(data.count) + " elements, not the primitive's " + std::to_string(own));
-        std::vector<float> out(size_t(inst.vertexCount) * c);
+        if ((rule == RefinedRule::UnitNormal && c != 3) || (rule == RefinedRule::Tangent && c != 4)) rule = RefinedRule::Mean;
+        std::vector<float> out(own * c);
         for (size_t i = 0; i < own * c; ++i) out[i] = float(data.values[i]);
-        for (size_t j = 0; j < inst.refinedFrom.size(); ++j) {
-            const size_t p = inst.refinedFrom[j].first, q = inst.refinedFrom[j].second;
-            float* o = &out[(own + j) * c];
-            for (size_t k = 0; k < c; ++k) o[k] = float(0.5 * (double(out[p * c + k]) + double(out[q * c + k])));
-            if (unit && c >= 3) {
-                const double n = std::sqrt(double(o[0]) * o[0] + double(o[1]) * o[1] + double(o[2]) * o[2]);
-                for (size_t k = 0; k < 3; ++k) o[k] = n > 0 ? float(o[k] / n) : out[p * c + k];
-            }
-            if (tangent && c == 4) o[3] = out[p * c + 3];
-        }
+        appendRefinedValues(out, c, inst.refinedFrom, rule);
         json accessor = {{"bufferView", bin.addView(out.data(), out.size() * 4, kArrayBuffer)}, {"componentType", kFloat},
                          {"count", inst.vertexCount}, {"type", type}};
         if (bounds) {
@@ -57,7 +53,8 @@ json refinedPrimitive(json primitive, const json& doc, BinaryBuilder& bin, const
     json& attributes = primitive["attributes"];
     for (auto& [name, index] : attributes.items()) {
         if (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) continue;  // below
-        index = refined(index.get<int>(), place + ".attributes." + name, name == "NORMAL", name == "TANGENT", name == "POSITION");
+        const RefinedRule rule = name == "NORMAL" ? RefinedRule::UnitNormal : name == "TANGENT" ? RefinedRule::Tangent : RefinedRule::Mean;
+        index = refined(index.get<int>(), place + ".attributes." + name, rule, name == "POSITION");
     }
     // The joints and weights the refinement blended (four influences a set).
     const size_t influences = size_t(inst.influences);
@@ -77,7 +74,7 @@ json refinedPrimitive(json primitive, const json& doc, BinaryBuilder& bin, const
     if (primitive.contains("targets"))
         for (size_t t = 0; t < primitive["targets"].size(); ++t)
             for (auto& [name, index] : primitive["targets"][t].items())
-                index = refined(index.get<int>(), place + ".targets[" + std::to_string(t) + "]." + name, false, false, name == "POSITION");
+                index = refined(index.get<int>(), place + ".targets[" + std::to_string(t) + "]." + name, RefinedRule::Mean, name == "POSITION");
     // The refined triangles, in the file's winding (the scene turned a mirrored instance's).
     std::vector<uint32_t> indices;
     indices.reserve(size_t(inst.triangleCount) * 3);

@@ -14,8 +14,9 @@
 namespace qsgi {
 
 // A primitive as --subdivide refined it (MeshInstance::refinedFrom): every attribute and morph
-// target the file gives, its own vertices as they are and each new vertex the mean of its edge's
-// two (normals renormalised, a tangent's handedness its first corner's), written as floats; the
+// target the file gives, its own vertices as they are and each new vertex by the refinement's one
+// rule (refinedValue: the mean of its edge's two, a normal's and a tangent's direction
+// renormalised in double, a tangent's handedness its first corner's), written as floats; the
 // skin's joints and weights as the refinement blended them; the refined triangles as indices.
 // `place` names the primitive in messages.
 nlohmann::json refinedPrimitive(nlohmann::json primitive, const nlohmann::json& doc, BinaryBuilder& bin, const AccessorReader& reader,
