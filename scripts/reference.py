@@ -26,6 +26,16 @@ LLVM 19 when it is not set.
 OUT.ply flags them in a `referenced` vertex property
 (the others hold 0) and `qsgi compare` judges a solution on them alone, region by region.
 
+--surface N: the reference where the eye looks (issue 47): N points drawn uniformly by area over the
+frame's triangles (seeded by --seed), each recorded by its triangle (the frame PLY's face index)
+and barycentrics, with its irradiance E, the standard error of E (from the spread of its samples)
+and whether it is hidden. OUT is then a PLY of `element point N`: int triangle, float b1 b2 (the
+weights of the triangle's second and third corners), float x y z (world position), float nx ny nz
+(the side that receives light: the face's normal turned towards its vertex normals), float
+irradiance_r/g/b, float stderr_r/g/b, uchar hidden. A point is hidden when no light reaches it
+and the ray along its normal meets the back of a face (it lies inside or under closed geometry:
+the floor under a block); a score leaves hidden points out.
+
 CONFIG: a qsgi config whose "lights" are added (point lights and a uniform sky only here); --sky R,G,B
 adds a uniform sky as qsgi's --sky does (Mitsuba's `constant` emitter). Light that escapes to the sky
 is the sky's emission: it is in E_direct, and subtracted from the gathered rays as a hit's emission is.
@@ -267,7 +277,9 @@ def query_points(positions, normals, faces, diagonal):
     return positions + normals * (1e-4 * diagonal) + towards * (5e-4 * diagonal)
 
 
-def irradiance(scene, origins, normals, spp, seed, chunk):
+def irradiance(scene, origins, normals, spp, seed, chunk, errors=None):
+    """E at each origin about its normal; with `errors` (an array like the result), the standard
+    error of each mean from the spread of its spp samples."""
     integrator = scene.integrator()
     out = np.zeros((len(origins), 3))
     for start in range(0, len(origins), chunk):
@@ -295,9 +307,62 @@ def irradiance(scene, origins, normals, spp, seed, chunk):
         # A ray that escapes meets the environment: si.emitter() is then the scene's sky (none: 0).
         emitted = si.emitter(scene).eval(si)
         total = direct + dr.pi * (L - emitted)
-        values = np.array(mi.TensorXf(dr.ravel(total), (size, 3)))
-        out[start:end] = values.reshape(n, spp, 3).mean(1)
+        values = np.array(mi.TensorXf(dr.ravel(total), (size, 3))).reshape(n, spp, 3).astype(np.float64)
+        out[start:end] = values.mean(1)
+        if errors is not None:
+            errors[start:end] = values.std(1, ddof=1) / np.sqrt(spp) if spp > 1 else np.inf
     return out
+
+
+def surface_points(positions, normals, faces, count, seed):
+    """`count` points uniformly by area over the triangles: face index, barycentrics (b1, b2) of
+    the second and third corners, world position, and the face's normal turned to its vertex
+    normals' side (the side that receives light)."""
+    a, b, c = positions[faces[:, 0]], positions[faces[:, 1]], positions[faces[:, 2]]
+    cross = np.cross(b - a, c - a)
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    rng = np.random.default_rng(seed)
+    triangle = rng.choice(len(faces), count, p=area / area.sum())
+    r1, r2 = rng.random(count), rng.random(count)
+    s = np.sqrt(r1)
+    b1, b2 = s * (1 - r2), s * r2  # uniform over the triangle
+    p = (1 - b1 - b2)[:, None] * a[triangle] + b1[:, None] * b[triangle] + b2[:, None] * c[triangle]
+    n = cross[triangle] / np.maximum(np.linalg.norm(cross[triangle], axis=1, keepdims=True), 1e-300)
+    vertex_side = normals[faces[triangle]].sum(1)
+    n *= np.where(np.sum(n * vertex_side, 1, keepdims=True) < 0, -1.0, 1.0)
+    return triangle, b1, b2, p, n
+
+
+def under_geometry(scene, origins, normals):
+    """Whether the ray along each normal first meets the back of a face: the point lies inside or
+    under closed geometry."""
+    o = mi.Point3f(*[mi.Float(origins[:, k].astype(np.float32)) for k in range(3)])
+    d = mi.Vector3f(*[mi.Float(normals[:, k].astype(np.float32)) for k in range(3)])
+    si = scene.ray_intersect(mi.Ray3f(o, d))
+    back = si.is_valid() & (dr.dot(si.n, d) > 0)
+    return np.array(back, dtype=bool)
+
+
+def write_surface_ply(path, triangle, b1, b2, p, n, E, errors, hidden, comment):
+    names = ["b1", "b2", "x", "y", "z", "nx", "ny", "nz", "irradiance_r", "irradiance_g", "irradiance_b",
+             "stderr_r", "stderr_g", "stderr_b"]
+    dtype = np.dtype([("triangle", "<i4")] + [(k, "<f4") for k in names] + [("hidden", "u1")])
+    v = np.zeros(len(triangle), dtype)
+    v["triangle"], v["b1"], v["b2"], v["hidden"] = triangle, b1, b2, hidden
+    for i, k in enumerate("xyz"):
+        v[k] = p[:, i]
+        v["n" + k] = n[:, i]
+    for i, k in enumerate("rgb"):
+        v["irradiance_" + k] = E[:, i]
+        v["stderr_" + k] = errors[:, i]
+    properties = "property int triangle\n" + "".join(f"property float {k}\n" for k in names) + "property uchar hidden\n"
+    header = (f"ply\nformat binary_little_endian 1.0\ncomment {comment}\nelement point {len(v)}\n{properties}"
+              "end_header\n")
+    tmp = path + ".tmp"
+    with open(tmp, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(v.tobytes())
+    os.replace(tmp, path)
 
 
 def main():
@@ -311,7 +376,11 @@ def main():
     ap.add_argument("--sky", help="R,G,B: a uniform sky of this radiance, as qsgi's --sky")
     ap.add_argument("--chunk", type=int, default=2048, help="vertices per wavefront")
     ap.add_argument("--vertices", type=int, help="only this many vertices, drawn uniformly (dense meshes)")
+    ap.add_argument("--surface", type=int, help="instead of the vertices, this many points uniformly by area over the "
+                                                "surface (OUT: a PLY of points; see above)")
     args = ap.parse_args()
+    if args.surface is not None and (args.surface < 1 or args.vertices is not None):
+        ap.error("--surface must be at least 1, and not with --vertices")
     if args.vertices is not None and args.vertices < 1:
         ap.error("--vertices must be at least 1")
 
@@ -327,6 +396,17 @@ def main():
             sky = sky * 3
         scene = build_scene(positions, faces, albedo, emission, gltf_point_lights(args.scene, args.config), sky, workdir)
     started = time.time()
+    if args.surface is not None:
+        triangle, b1, b2, p, n = surface_points(positions, normals, faces, args.surface, args.seed)
+        origins = p + n * (1e-4 * diagonal)
+        errors = np.zeros((len(p), 3))
+        E = irradiance(scene, origins, n, args.spp, args.seed, args.chunk, errors)
+        hidden = (E.max(1) == 0) & under_geometry(scene, origins, n)
+        comment = (f"qsgi surface reference: Mitsuba {mi.__version__} path tracer, {args.spp} paths + emitter samples per "
+                   f"point, seed {args.seed}, {len(p)} points ({int(hidden.sum())} hidden), {time.time() - started:.0f} s")
+        write_surface_ply(args.out, triangle, b1, b2, p, n, E, errors, hidden.astype(np.uint8), comment)
+        print(comment)
+        return
     origins = query_points(positions, normals, faces, diagonal)
     chosen = np.arange(len(positions))
     referenced = None

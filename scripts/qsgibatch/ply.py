@@ -20,6 +20,23 @@ class VertexPly:
         v = self.vertices
         return np.stack([v["radiosity_r"], v["radiosity_g"], v["radiosity_b"]], axis=1).astype(np.float64)
 
+    def irradiance(self) -> np.ndarray:
+        """(n, 3) float64 irradiance E in W/m² (qsgi writes it since issue 35)."""
+        v = self.vertices
+        if "irradiance_r" not in v.dtype.names:
+            raise ValueError("the PLY holds no irradiance (an older qsgi wrote it)")
+        return np.stack([v["irradiance_r"], v["irradiance_g"], v["irradiance_b"]], axis=1).astype(np.float64)
+
+    def triangles(self) -> np.ndarray:
+        """(T, 3) int64 vertex indices of the face list qsgi writes (`list uchar int`, triangles)."""
+        if b"element face" not in self.header:
+            return np.zeros((0, 3), np.int64)
+        count = int(self.header.split(b"element face ")[1].split(b"\n")[0])
+        faces = np.frombuffer(self.rest, np.dtype([("n", "u1"), ("v", "<i4", (3,))]), count)
+        if (faces["n"] != 3).any():
+            raise ValueError("a face that is not a triangle")
+        return faces["v"].astype(np.int64)
+
 
 def read(path) -> VertexPly:
     with open(path, "rb") as f:
@@ -50,6 +67,31 @@ def read(path) -> VertexPly:
         raise ValueError(f"{path}: truncated vertex table")
     vertices = np.frombuffer(data, dtype=dtype, count=count, offset=start).copy()
     return VertexPly(header, vertices, data[start + count * dtype.itemsize:])
+
+
+def read_points(path) -> np.ndarray:
+    """The `point` element of a surface reference (scripts/reference.py --surface) as a record array."""
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.find(b"end_header\n")
+    if not data.startswith(b"ply\n") or end < 0:
+        raise ValueError(f"{path}: not a PLY file")
+    header = data[:end + len(b"end_header\n")]
+    fields, count = [], None
+    for line in header.decode("ascii").splitlines():
+        words = line.split()
+        if words[:2] == ["element", "point"]:
+            count = int(words[2])
+        elif words[:1] == ["element"]:
+            raise ValueError(f"{path}: an element other than 'point' ({words[1]})")
+        elif words[:1] == ["property"] and count is not None:
+            fields.append((words[2], _PLY_TYPES[words[1]]))
+    if count is None:
+        raise ValueError(f"{path}: no 'point' element (not a surface reference)")
+    dtype = np.dtype(fields)
+    if len(data) < len(header) + count * dtype.itemsize:
+        raise ValueError(f"{path}: truncated point table")
+    return np.frombuffer(data, dtype=dtype, count=count, offset=len(header)).copy()
 
 
 def with_radiosity(template: VertexPly, radiosity: np.ndarray) -> bytes:
