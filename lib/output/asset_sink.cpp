@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "output/output_directory.h"
+#include "output/folder_survey.h"
 #include "output/frame_readback.h"
 #include "output/ply_writer.h"
 #include "util/stopwatch.h"
@@ -17,7 +18,7 @@ void AssetSink::finish(OutputDirectory& out, WholeRunReport& report) {
     auto frameAt = [&](size_t k) {
         if (k == 0 && firstFrame) return *firstFrame;
         const int frame = settings_.first + int(k);
-        VertexRadiosityPly ply = readFramePly((out.path() / settings_.plyName(frame)).string(), scene_.vertexCount());
+        VertexRadiosityPly ply = readFramePly(out, frame, scene_.vertexCount());
         BakedFrame baked;
         baked.seconds = fps > 0 ? frame / fps : 0;
         baked.radiance.resize(ply.radiosity.size());

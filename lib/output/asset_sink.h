@@ -12,14 +12,10 @@
 
 namespace qsgi {
 
-// --gltf-out's file: the scene's glTF with the run's frames baked in.
-inline constexpr const char* kBakedAssetName = "asset.glb";
-
 struct AssetSinkSettings {
     std::shared_ptr<const GltfDocument> document;  // the scene file as read
     int first = 0, last = 0;                       // the frames baked
     double fps = 0;                                // the animation's: a frame's time
-    std::function<std::string(int)> plyName;       // frame_NNNN.ply
     BakedAssetSettings asset;                      // all but the exposure, which the first frame sets
     std::vector<NodeMotion> motion;                // a transform file's, at every frame baked
 };

@@ -10,8 +10,6 @@
 #include <cstring>
 #include <set>
 
-#include "output/asset_sink.h"
-#include "output/usd_sink.h"
 #include "output/file_checksum.h"
 #include "output/timing_log.h"
 
@@ -26,7 +24,8 @@ std::string frameFileName(int frame, const char* extension) {
 }
 
 bool isFrameFileName(const std::string& name) {
-    if (name == kBakedAssetName || name == kUsdAssetName) return true;  // made from the frames: go with them
+    for (const char* wholeRun : kWholeRunFileNames)
+        if (name == wholeRun) return true;  // made from the frames: goes with them
     constexpr size_t kPrefix = 6;  // "frame_"
     if (name.rfind("frame_", 0) != 0) return false;
     size_t digits = 0;

@@ -60,6 +60,12 @@ struct OutputFolderSurvey {
     std::vector<std::filesystem::path> blockingEntries;
 };
 
+// The whole-run files, made from every frame after the last (--gltf-out, --usd-out): they go with
+// the frames, and a run that computes frames removes them before any frame changes.
+inline constexpr const char* kBakedAssetName = "asset.glb";
+inline constexpr const char* kUsdAssetName = "asset.usda";
+inline constexpr const char* kWholeRunFileNames[] = {kBakedAssetName, kUsdAssetName};
+
 // "frame_0012.ply" and the like.
 std::string frameFileName(int frame, const char* extension);
 // "frame_0012.ply", "frame_12345.exr": a frame file's name as frameFileName writes it, with one

@@ -1,10 +1,13 @@
 #include "output/frame_readback.h"
 
+#include "output/folder_survey.h"
+#include "output/output_directory.h"
 #include "util/error.h"
 
 namespace qsgi {
 
-VertexRadiosityPly readFramePly(const std::string& path, size_t vertexCount) {
+VertexRadiosityPly readFramePly(const OutputDirectory& folder, int frame, size_t vertexCount) {
+    const std::string path = (folder.path() / frameFileName(frame, "ply")).string();
     VertexRadiosityPly ply = readVertexRadiosityPly(path);
     if (ply.radiosity.size() != vertexCount || ply.irradiance.size() != vertexCount)
         throw InputError(path, "",

@@ -15,8 +15,10 @@ namespace qsgi {
 // (asset.glb's _RADIANCE, asset.usda's radiance).
 inline Vec3f bakedRadiance(const Vec3f& radiosity) { return radiosity * float(1 / M_PI); }
 
-// The PLY at `path`. Throws InputError naming it unless it holds `vertexCount` vertices with
-// irradiance (an older qsgi wrote none).
-VertexRadiosityPly readFramePly(const std::string& path, size_t vertexCount);
+class OutputDirectory;
+
+// Frame `frame`'s PLY in the folder. Throws InputError naming it unless it holds `vertexCount`
+// vertices with irradiance (an older qsgi wrote none).
+VertexRadiosityPly readFramePly(const OutputDirectory& folder, int frame, size_t vertexCount);
 
 }  // namespace qsgi

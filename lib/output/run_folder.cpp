@@ -43,7 +43,7 @@ int RunFolder::startFrame(int first, int last) const {
     return expected_.resume ? firstIncompleteFrame(survey_, first, last) : first;
 }
 
-RunFolder::Started RunFolder::startLog(TimingLog header, int start, int last, const std::vector<std::string>& wholeRunFiles) {
+RunFolder::Started RunFolder::startLog(TimingLog header, int start, int last) {
     log_ = std::move(header);
     const std::vector<FrameTiming> earlierFrames =
         survey_.holds == OutputFolderSurvey::Holds::ThisRun ? survey_.completeFrames : std::vector<FrameTiming>{};
@@ -69,7 +69,7 @@ RunFolder::Started RunFolder::startLog(TimingLog header, int start, int last, co
         if (!recomputed) ++started.framesRemoved;
     }
     if (start <= last)
-        for (const std::string& name : wholeRunFiles) out_.remove(name);
+        for (const char* name : kWholeRunFileNames) out_.remove(name);
     return started;
 }
 

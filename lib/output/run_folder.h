@@ -49,9 +49,10 @@ public:
     // the folder's complete frames. Written now when frames will be computed or some failed
     // verification (a resumed run computing nothing leaves the log as it is: the Slurm merge's
     // has keys of its own), so that the folder records the run's fingerprint from the start and
-    // forgets damaged frames before their files are unlinked. Whole-run files (`wholeRunFiles`)
-    // go before any frame changes: made from earlier frames, they would no longer be the folder's.
-    Started startLog(TimingLog header, int start, int last, const std::vector<std::string>& wholeRunFiles);
+    // forgets damaged frames before their files are unlinked. The whole-run files
+    // (kWholeRunFileNames) go before any frame changes: made from earlier frames, they would no
+    // longer be the folder's.
+    Started startLog(TimingLog header, int start, int last);
     TimingLog& log() { return log_; }
 
     // Writes the frame's files, then the log listing them with `timing`, whose writeSeconds (the

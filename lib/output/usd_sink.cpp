@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "output/folder_survey.h"
 #include "output/frame_readback.h"
 #include "output/output_directory.h"
 #include "util/stopwatch.h"
@@ -12,9 +13,9 @@ namespace qsgi {
 void UsdSink::finish(OutputDirectory& out, WholeRunReport& report) {
     Stopwatch clock;
     UsdAssetSummary summary;
-    auto frameAt = [&](int frame) { return readFramePly((out.path() / settings_.plyName(frame)).string(), scene_.vertexCount()); };
+    auto frameAt = [&](int frame) { return readFramePly(out, frame, scene_.vertexCount()); };
     out.writeStreamed(kUsdAssetName, [&](const OutputDirectory::PieceWriter& put) {
-        writeUsdAsset(scene_, settings_.asset, frameAt, put, &summary);
+        writeUsdAsset(scene_, settings_, frameAt, put, &summary);
     });
     report.name = kUsdAssetName;
     report.bytes = summary.bytes;

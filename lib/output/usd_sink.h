@@ -4,30 +4,21 @@
 // one straight run; written as it is made, so a long animation's text is never held whole.
 #pragma once
 
-#include <functional>
-
 #include "output/frame_sink.h"
 #include "output/usd_asset.h"
 
 namespace qsgi {
 
-// --usd-out's file.
-inline constexpr const char* kUsdAssetName = "asset.usda";
-
-struct UsdSinkSettings {
-    std::function<std::string(int)> plyName;  // frame_NNNN.ply
-    UsdAssetSettings asset;
-};
 
 class UsdSink : public FrameSink {
 public:
     // scene: the render's (its vertices are the PLYs').
-    UsdSink(const Scene& scene, UsdSinkSettings settings) : scene_(scene), settings_(std::move(settings)) {}
+    UsdSink(const Scene& scene, UsdAssetSettings settings) : scene_(scene), settings_(std::move(settings)) {}
     void finish(OutputDirectory& out, WholeRunReport& report) override;
 
 private:
     const Scene& scene_;
-    UsdSinkSettings settings_;
+    UsdAssetSettings settings_;
 };
 
 }  // namespace qsgi

@@ -264,7 +264,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     log.animationDiagonal = scene_.animationBounds.extent();
     log.inputsFingerprint = fingerprint_.digest;
     log.inputs = fingerprint_.parts;
-    const RunFolder::Started started = folder.startLog(std::move(log), start, last_, {kBakedAssetName, kUsdAssetName});
+    const RunFolder::Started started = folder.startLog(std::move(log), start, last_);
     outcome.framesResumed = settings_.resume ? started.framesOutside : 0;
     outcome.framesKept = settings_.resume ? 0 : started.framesOutside;
     outcome.framesRemoved = started.framesRemoved;
@@ -386,7 +386,6 @@ std::vector<std::unique_ptr<FrameSink>> RenderJob::makeSinks() const {
         asset.first = first_;
         asset.last = last_;
         asset.fps = animation_.fps();
-        asset.plyName = [](int frame) { return frameFileName(frame, "ply"); };
         asset.asset.colourSet = settings_.gltfColourSet;
         asset.asset.playedAnimation = playedGltfAnimation_;
         asset.asset.assetFolder = settings_.outDir;
@@ -405,16 +404,15 @@ std::vector<std::unique_ptr<FrameSink>> RenderJob::makeSinks() const {
         sinks.push_back(std::make_unique<AssetSink>(scene_, std::move(asset)));
     }
     if (settings_.writeUsd && !settings_.framesOnly) {
-        UsdSinkSettings usd;
-        usd.plyName = [](int frame) { return frameFileName(frame, "ply"); };
-        usd.asset.first = first_;
-        usd.asset.last = last_;
-        usd.asset.fps = animation_.fps();
-        usd.asset.source = settings_.scenePath;
-        usd.asset.meshNames = meshNames_;
-        usd.asset.nodeWorldAt = [this](int frame) { return scene_.worldTransforms(animation_.localsAt(frame)); };
+        UsdAssetSettings usd;
+        usd.first = first_;
+        usd.last = last_;
+        usd.fps = animation_.fps();
+        usd.source = settings_.scenePath;
+        usd.meshNames = meshNames_;
+        usd.nodeWorldAt = [this](int frame) { return scene_.worldTransforms(animation_.localsAt(frame)); };
         // Frames held while writing: a group of meshes at a time, each group reading every PLY once.
-        usd.asset.memoryBudget = std::min<uint64_t>(uint64_t(1) << 30, usableMemory().bytes / 8);
+        usd.memoryBudget = std::min<uint64_t>(uint64_t(1) << 30, usableMemory().bytes / 8);
         sinks.push_back(std::make_unique<UsdSink>(scene_, std::move(usd)));
     }
     return sinks;

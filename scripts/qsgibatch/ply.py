@@ -38,7 +38,9 @@ class VertexPly:
         return faces["v"].astype(np.int64)
 
 
-def read(path) -> VertexPly:
+def _first_table(path, element):
+    """(header bytes, the records of `element` — the file's first element, fixed-size properties —
+    or None when the file has no such element, the bytes after them)."""
     with open(path, "rb") as f:
         data = f.read()
     end = data.find(b"end_header\n")
@@ -48,50 +50,40 @@ def read(path) -> VertexPly:
     lines = header.decode("ascii").splitlines()
     if "format binary_little_endian 1.0" not in lines:
         raise ValueError(f"{path}: not a binary little-endian PLY")
-    fields, count, in_vertex = [], None, False
+    fields, count, inside = [], None, False
     for line in lines:
         words = line.split()
-        if words[:2] == ["element", "vertex"]:
-            count, in_vertex = int(words[2]), True
+        if words[:2] == ["element", element]:
+            count, inside = int(words[2]), True
         elif words[:1] == ["element"]:
-            in_vertex = False
-        elif in_vertex and words[:1] == ["property"]:
+            inside = False
+        elif inside and words[:1] == ["property"]:
             if words[1] == "list" or words[1] not in _PLY_TYPES:
-                raise ValueError(f"{path}: unsupported vertex property '{line}'")
+                raise ValueError(f"{path}: unsupported {element} property '{line}'")
             fields.append((words[2], _PLY_TYPES[words[1]]))
-    if count is None or "radiosity_r" not in dict(fields):
-        raise ValueError(f"{path}: no vertex radiosity (not written by qsgi?)")
+    if count is None:
+        return header, None, b""
     dtype = np.dtype(fields)
     start = len(header)
     if len(data) < start + count * dtype.itemsize:
-        raise ValueError(f"{path}: truncated vertex table")
-    vertices = np.frombuffer(data, dtype=dtype, count=count, offset=start).copy()
-    return VertexPly(header, vertices, data[start + count * dtype.itemsize:])
+        raise ValueError(f"{path}: truncated {element} table")
+    records = np.frombuffer(data, dtype=dtype, count=count, offset=start).copy()
+    return header, records, data[start + count * dtype.itemsize:]
+
+
+def read(path) -> VertexPly:
+    header, vertices, rest = _first_table(path, "vertex")
+    if vertices is None or "radiosity_r" not in vertices.dtype.names:
+        raise ValueError(f"{path}: no vertex radiosity (not written by qsgi?)")
+    return VertexPly(header, vertices, rest)
 
 
 def read_points(path) -> np.ndarray:
     """The `point` element of a surface reference (scripts/reference.py --surface) as a record array."""
-    with open(path, "rb") as f:
-        data = f.read()
-    end = data.find(b"end_header\n")
-    if not data.startswith(b"ply\n") or end < 0:
-        raise ValueError(f"{path}: not a PLY file")
-    header = data[:end + len(b"end_header\n")]
-    fields, count = [], None
-    for line in header.decode("ascii").splitlines():
-        words = line.split()
-        if words[:2] == ["element", "point"]:
-            count = int(words[2])
-        elif words[:1] == ["element"]:
-            raise ValueError(f"{path}: an element other than 'point' ({words[1]})")
-        elif words[:1] == ["property"] and count is not None:
-            fields.append((words[2], _PLY_TYPES[words[1]]))
-    if count is None:
+    _, points, _ = _first_table(path, "point")
+    if points is None:
         raise ValueError(f"{path}: no 'point' element (not a surface reference)")
-    dtype = np.dtype(fields)
-    if len(data) < len(header) + count * dtype.itemsize:
-        raise ValueError(f"{path}: truncated point table")
-    return np.frombuffer(data, dtype=dtype, count=count, offset=len(header)).copy()
+    return points
 
 
 def with_radiosity(template: VertexPly, radiosity: np.ndarray) -> bytes:
