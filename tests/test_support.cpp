@@ -275,11 +275,13 @@ Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo, float floorHalf) {
     return s;
 }
 
-Scene slabOnFloor(int floorCells, float half, float height, Vec3f albedo) {
+Scene slabOnFloor(int floorCells, float half, float height, Vec3f albedo) { return blockOnFloor(floorCells, 1.0f, half, height, 1, albedo); }
+
+Scene blockOnFloor(int floorCells, float floorHalf, float blockHalf, float height, int blockCells, Vec3f albedo) {
     Scene s;
     const uint32_t m = addMaterial(s, albedo);
-    addGrid(s, s.addNode("Floor", Transform()), {-1, 0, 1}, {2, 0, 0}, {0, 0, -2}, floorCells, m);
-    addBoxOnFloor(s, s.addNode("Slab", Transform()), half, height, 1, m);
+    addGrid(s, s.addNode("Floor", Transform()), {-floorHalf, 0, floorHalf}, {2 * floorHalf, 0, 0}, {0, 0, -2 * floorHalf}, floorCells, m);
+    addBoxOnFloor(s, s.addNode("Block", Transform()), blockHalf, height, blockCells, m);
     s.finalize();
     return s;
 }

@@ -90,6 +90,10 @@ qsgi::Scene boxOnFloor(int floorCells, int cubeCells, qsgi::Vec3f albedo, float 
 // A floor y = 0 (x, z in [-1, 1], `floorCells` per side, its vertices first) with a closed slab
 // standing on it: [−half, half]² and `height` high (a rug, when low).
 qsgi::Scene slabOnFloor(int floorCells, float half, float height, qsgi::Vec3f albedo);
+// A floor y = 0 (x, z in [−floorHalf, floorHalf], `floorCells` per side, its vertices first) with a
+// block standing on it: [−blockHalf, blockHalf]², `height` high, `blockCells` per face, its sides and
+// top facing out and no bottom (closed against the floor).
+qsgi::Scene blockOnFloor(int floorCells, float floorHalf, float blockHalf, float height, int blockCells, qsgi::Vec3f albedo);
 // An inside corner: floor y = 0 (x in [-1,1], z in [0,depth]) and wall z = 0 (x in [-1,1], y in
 // [0,depth]), `cells` per 2 m in every direction (cells·depth/2 across the depth).
 qsgi::Scene corner(int cells, qsgi::Vec3f albedo, float depth = 2.0f);

@@ -7,6 +7,7 @@
 #include <array>
 #include <bitset>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "estimate/own_surface.h"
@@ -310,10 +311,21 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     // surface through v (a floor vertex at the foot of a wall, where the own surface runs on under
     // the wall and gives no side to step to), and which side of it float rounding puts the start
     // on decides everything — the answer would change with the scene's unit. Light reaching v
-    // comes from the open side, so try a step to each side and keep the one that sees most.
+    // comes from the open side, so try a step to each side and keep the one that sees most —
+    // of those outside closed geometry first: a step into a block standing on the line (a floor
+    // vertex on its foot) "reaches" the cells under the block through the block's inside, and may
+    // tie with the step outward; a start whose ray along n_v first meets a back face is inside.
+    bool bestOutside = false;
     for (const Vec3f& sideStart : sideStarts) {
         VertexDisc candidate = discFrom(sideStart, disc, v, scene, bvh, frontNormals, radius, withCoverage, own, shortcuts);
-        if (candidate.reachableArea > best.reachableArea) best = std::move(candidate);
+        if (!(candidate.reachableArea > 0)) continue;
+        const auto up = bvh.intersect(sideStart, normal, 0.0f, std::numeric_limits<float>::infinity());
+        ++tally.rays;
+        const bool outside = !up || dot(frontNormals[up->triangle], normal) < 0;
+        if (outside != bestOutside ? outside : candidate.reachableArea > best.reachableArea) {
+            best = std::move(candidate);
+            bestOutside = outside;
+        }
     }
     return best;
 }

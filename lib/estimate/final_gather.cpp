@@ -180,6 +180,35 @@ void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const Vert
 }
 
 namespace {
+bool mostlyBackFaces(const GatherHit* hits, uint32_t count) {
+    uint32_t back = 0;
+    for (uint32_t j = 0; j < count; ++j) back += hits[j].triangle == GatherHit::kBackFace;
+    return 2 * back > count;
+}
+}  // namespace
+
+std::vector<uint8_t> FinalGather::coveredFromKept(const Scene& scene) const {
+    std::vector<uint8_t> covered(scene.vertexCount(), 0);
+    if (rays_ == 0 || probeHits_.empty()) return covered;
+    for (uint32_t v = 0; v < covered.size(); ++v) covered[v] = mostlyBackFaces(&probeHits_[size_t(v) * probes_], coverRays());
+    return covered;
+}
+
+std::vector<uint8_t> FinalGather::castCovered(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts) const {
+    std::vector<uint8_t> covered(scene.vertexCount(), 0);
+    if (rays_ == 0) return covered;
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
+        GatherHit hits[kCoverRays];
+        for (uint32_t v = r.begin(); v != r.end(); ++v) {
+            castVertexInto(scene, bvh, starts, frontNormals, v, 0, coverRays(), hits);
+            covered[v] = mostlyBackFaces(hits, coverRays());
+        }
+    });
+    return covered;
+}
+
+namespace {
 // A box ahead of a vertex, and the cone from the vertex's start point that holds it: a ray can
 // meet the box only if it points into the cone and reaches the box's bounding ball. The test
 // needs neither the ray's normalised direction nor a division, and rules out most kept rays

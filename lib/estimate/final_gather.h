@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "estimate/lighting_settings.h"
 #include "estimate/vertex_starts.h"
 #include "scene/scene.h"
 #include "trace/scene_bvh.h"
@@ -75,6 +76,15 @@ public:
     // Drops every kept hit.
     void clear();
 
+    // Covered vertices (docs/design.md §5.1): more than half of v's first coverRays() gather rays
+    // meet a back face — its start point lies inside closed geometry (the floor under a block
+    // standing on it). Read from the kept hits (every vertex keeps its probes, which hold those
+    // rays) or, for castAndGather, which keeps none, cast afresh: the same rays, the same answer.
+    static constexpr uint32_t kCoverRays = 16;
+    uint32_t coverRays() const { return std::min(rays_, kCoverRays); }
+    std::vector<uint8_t> coveredFromKept(const Scene& scene) const;
+    std::vector<uint8_t> castCovered(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts) const;
+
     uint32_t raysPerVertex() const { return rays_; }
     uint32_t probeRays() const { return probes_; }
     bool cached() const { return probes_ < rays_; }
@@ -122,6 +132,7 @@ private:
     std::vector<GatherHit> restHits_;
     std::vector<uint32_t> restSlot_, freeSlots_;
     uint64_t raysCast_ = 0;
+    static_assert(kCoverRays <= LightingSettings::kGatherProbeRays, "every vertex keeps the rays that decide its cover");
 };
 
 }  // namespace qsgi

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "estimate/covered_vertices.h"
 #include "util/stopwatch.h"
 
 namespace qsgi {
@@ -35,8 +36,10 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     clock.restart();
     if (settings_.gathers() && !keepForUpdates && !cache_) {
         if (progress) progress->start("gathering", scene.vertexCount());
-        gather_.castAndGather(scene, bvh, starts_, firstPass(scene, photons), out.irradiance, progress);
-        stats.gatherRays = gather_.raysCast();
+        // castAndGather keeps no hit: the rays that tell covered vertices are cast first.
+        const std::vector<uint8_t> covered = gather_.castCovered(scene, bvh, starts_);
+        gather_.castAndGather(scene, bvh, starts_, firstPass(scene, photons, covered), out.irradiance, progress);
+        stats.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
         addDirect(scene, out);
         stats.gatherSeconds = clock.seconds();
         solved_ = false;  // nothing kept to update
@@ -88,13 +91,15 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Disc
     stats.gatherSeconds = clock.seconds();
 }
 
-std::vector<Vec3f> TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons) const {
+std::vector<Vec3f> TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons,
+                                              const std::vector<uint8_t>& covered) const {
     const std::vector<Vec3f>& direct = direct_.irradiance();
     std::vector<Vec3f> first(scene.vertexCount());
     for (size_t v = 0; v < first.size(); ++v) {
         const Material& m = scene.materials[scene.vertexMaterial[v]];
         first[v] = scene.vertexHidden[v] ? Vec3f(0.0f) : m.albedo * (direct[v] + photons.irradiance[v]);
     }
+    fillCoveredFirstPass(scene, covered, first);
     return first;
 }
 
@@ -109,7 +114,7 @@ void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons
     const size_t n = scene.vertexCount();
     out.irradiance.resize(n);
     if (settings_.gathers()) {
-        gather_.gather(scene, firstPass(scene, photons), out.irradiance);
+        gather_.gather(scene, firstPass(scene, photons, gather_.coveredFromKept(scene)), out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);
         addDirect(scene, out);
         return;

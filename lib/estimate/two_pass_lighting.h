@@ -1,7 +1,9 @@
 // The second pass over the photons' solution (docs/design.md §5.1, issue 33). Per vertex v with albedo
 // ρ_v: D_v direct irradiance, exact (DirectLight); I_v the estimator's answer counting only light
 // after its first bounce; F_u = ρ_u (D_u + I_u) the first pass; then
-//   E_v = D_v + (M > 0 ? mean of F over v's gather rays (FinalGather) : I_v),  B_v = ρ_v E_v + π L_e,v.
+//   E_v = D_v + (M > 0 ? mean of F over v's gather rays (FinalGather) : I_v),  B_v = ρ_v E_v + π L_e,v,
+// where the gather reads F at covered vertices (under a block standing on the floor) as their
+// visible neighbours' (covered_vertices.h).
 // It owns what that takes — the direct light and the gather's kept hits — and keeps each up to date
 // across a move, touching only what the move can change, so that every update gives the bits a
 // from-scratch solve of the same pose gives. The rays leave from the disc regions' start points
@@ -56,8 +58,9 @@ public:
 
 private:
     void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const;
-    // F_u = ρ_u (D_u + I_u), 0 at hidden vertices.
-    std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons) const;
+    // F_u = ρ_u (D_u + I_u) as the gather reads it: 0 at hidden vertices, and at covered ones
+    // (FinalGather's rule) their visible neighbours' stand-in (fillCoveredFirstPass).
+    std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons, const std::vector<uint8_t>& covered) const;
     // E = D + the gathered mean, and B.
     void addDirect(const Scene& scene, VertexRadiosity& out) const;
     // With the cache: the records for the current pose, and the rest of their rays.
