@@ -14,6 +14,7 @@
 #include <csignal>
 
 #include "estimate/accuracy.h"
+#include "estimate/surface_accuracy.h"
 #include "output/ply_reader.h"
 #include "pipeline/render_job.h"
 #include "pipeline/render_options.h"
@@ -155,15 +156,55 @@ std::string commandLineError(const CLI::App& app, int argc, char** argv, const C
     return std::string(error.what()) + " (see " + help + ")";
 }
 
+// `qsgi compare` against a surface reference: the frame's irradiance interpolated at its points,
+// overall and by band (contact, edge, interior), with the reference's noise taken out.
+// width: the bands' (--radius; default qsgi's default radius over the frame's vertices).
+int runSurfaceCompare(const std::string& a, const std::string& b, std::optional<double> widthOption, bool json) {
+    const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(a);
+    qsgi::Bounds3f bounds;
+    for (const qsgi::Vec3f& p : solution.positions) bounds.extend(p);
+    const float width = widthOption ? float(*widthOption) : qsgi::defaultRadius(bounds);
+    const qsgi::SurfaceReferencePly reference = qsgi::readSurfaceReferencePly(b);
+    if (solution.irradiance.empty())
+        throw qsgi::InputError(a, "header", "has no irradiance_r/g/b: a surface reference scores irradiance");
+    try {
+        qsgi::checkDrawnOn(solution.positions, solution.triangles, reference.points);
+    } catch (const std::invalid_argument& e) {
+        throw qsgi::InputError(b, "", std::string(e.what()) + " than " + a + "'s");
+    }
+    const qsgi::SurfaceAccuracyReport r = qsgi::compareOverSurface(solution.positions, solution.normals, solution.triangles,
+                                                                   solution.irradiance, reference.points, width);
+    const std::pair<const char*, const qsgi::SurfaceErrorStats*> rows[] = {
+        {"all", &r.all}, {"contact", &r.contact}, {"edge", &r.edge}, {"interior", &r.interior}};
+    if (json) {
+        nlohmann::json j{{"solution", a}, {"reference", b}, {"band_width", width}, {"hidden", r.hidden}};
+        for (const auto& [name, s] : rows)
+            j[name] = {{"points", s->points}, {"relative_rms", s->relativeRms}, {"relative_bias", s->relativeBias},
+                       {"reference_noise", s->referenceNoise}, {"relative_rms_without_noise", s->withoutNoise}};
+        std::printf("%s\n", j.dump(2).c_str());
+        return 0;
+    }
+    const std::string w = std::to_string(width).substr(0, 6);
+    std::printf("%-44s %8s %13s %14s %12s %14s\n", "surface points (irradiance interpolated)", "count", "relative RMS",
+                "relative bias", "ref. noise", "without noise");
+    const std::string labels[] = {"all visible (" + std::to_string(r.hidden) + " hidden left out)",
+                                  "within " + w + " of another surface", "within " + w + " of an edge", "interior"};
+    for (size_t i = 0; i < 4; ++i)
+        std::printf("%-44s %8zu %13.5f %+14.5f %12.5f %14.5f\n", labels[i].c_str(), rows[i].second->points, rows[i].second->relativeRms,
+                    rows[i].second->relativeBias, rows[i].second->referenceNoise, rows[i].second->withoutNoise);
+    return 0;
+}
+
 // `qsgi compare`: reads both PLYs and prints the accuracy report, overall and by edge region.
 int runCompare(const std::string& a, const std::string& b, std::optional<double> radiusOption, bool json) {
+    if (radiusOption && (!(*radiusOption > 0) || !std::isfinite(*radiusOption)))
+        throw qsgi::InputError("command line", "--radius", "must be a positive distance (scene units)");
+    if (qsgi::plyFirstElement(b) == "point") return runSurfaceCompare(a, b, radiusOption, json);
     const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(a);
     const qsgi::VertexRadiosityPly reference = qsgi::readVertexRadiosityPly(b);
     if (solution.positions.size() != reference.positions.size())
         throw qsgi::InputError(a, "", "has " + std::to_string(solution.positions.size()) + " vertices but " + b + " has " +
                                           std::to_string(reference.positions.size()) + ": not the same scene");
-    if (radiusOption && (!(*radiusOption > 0) || !std::isfinite(*radiusOption)))
-        throw qsgi::InputError("command line", "--radius", "must be a positive distance (scene units)");
     // Default: qsgi's own default radius, over the reference's vertices.
     qsgi::Bounds3f bounds;
     for (const qsgi::Vec3f& p : reference.positions) bounds.extend(p);
@@ -208,11 +249,13 @@ int main(int argc, char** argv) {
     std::string compareA, compareB;
     std::optional<double> compareRadius;
     bool compareJson = false;
-    CLI::App* compare = app.add_subcommand("compare", "accuracy of one frame_NNNN.ply against a reference PLY of the same scene");
+    CLI::App* compare = app.add_subcommand("compare", "accuracy of one frame_NNNN.ply against a reference PLY of the same scene: its vertices, or "
+                                                   "points on its surface (reference.py --surface)");
     compare->add_option("PLY", compareA, "the solution to judge")->required();
     compare->add_option("REFERENCE", compareB, "the reference (e.g. the same estimator at many more photons)")->required();
     compare->add_option("--radius,--border", compareRadius,
-                        "the 'near an edge' distance, scene units (default 1.5 % of the scene diagonal, qsgi's default radius)");
+                        "the 'near an edge' distance, and against a surface reference also the 'near another surface' one, scene units "
+                        "(default 1.5 % of the scene diagonal, qsgi's default radius)");
     compare->add_flag("--json", compareJson, "print JSON instead of a table");
 
     CLI::App* inspect = app.add_subcommand(

@@ -72,23 +72,24 @@ std::string number(double v) {
     return text;
 }
 
-const char* plural(const std::string& element) { return element == "vertex" ? "vertices" : element == "face" ? "faces" : "elements"; }
+const char* plural(const std::string& element) {
+    return element == "vertex" ? "vertices" : element == "face" ? "faces" : element == "point" ? "points" : "elements";
+}
 
-}  // namespace
-
-VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
+// The header of a binary PLY whose first element is `first`: every element with its count and
+// properties, checked against the file's size before any data is read. `in` is left at the data.
+std::vector<PlyElement> readHeader(const std::string& path, std::ifstream& in, const std::string& first) {
     namespace fs = std::filesystem;
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (fs::is_directory(status)) throw InputError(path, "", "is a directory, not a PLY file");
     if (fs::exists(status) && !fs::is_regular_file(status))
         throw InputError(path, "", "is not a regular file (a device, pipe or socket), not a PLY file");
-    std::ifstream in(path, std::ios::binary);
+    in.open(path, std::ios::binary);
     if (!in) throw InputError(path, "", "cannot be opened for reading");
     const uint64_t fileSize = fs::file_size(path, ec);
     if (ec) throw InputError(path, "", "cannot be read (its size is unknown)");
 
-    // The header: every element with its count and properties, checked before any data is read.
     std::string line;
     if (!std::getline(in, line) || line != "ply") throw InputError(path, "line 1", "not a PLY file");
     std::string format;
@@ -113,7 +114,7 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
                 throw InputError(path, at, "element '" + e.name + "' needs a count, a non-negative integer ('" +
                                                count.substr(0, 40) + "' is not one)");
             e.line = lineNo;
-            if (e.name == "vertex" && !elements.empty()) throw InputError(path, at, "vertex must be the first element");
+            if (e.name == first && !elements.empty()) throw InputError(path, at, first + " must be the first element");
             elements.push_back(e);
         } else if (word == "property") {
             if (elements.empty()) throw InputError(path, at, "a property before any element");
@@ -130,8 +131,8 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
                 p.type = type;
                 if (sizeOfType(type) == 0) throw InputError(path, at, "unsupported property type '" + type + "'");
             }
-            if (e.name == "vertex" && !p.countType.empty())
-                throw InputError(path, at, "unsupported vertex property type 'list'");
+            if (e.name == first && !p.countType.empty())
+                throw InputError(path, at, "unsupported " + first + " property type 'list'");
             if (e.name == "face" && (p.countType.empty() || p.name != "vertex_indices" || !e.properties.empty()))
                 throw InputError(path, at, "faces must be a single list property vertex_indices");
             e.properties.push_back(p);
@@ -156,73 +157,87 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
         needed += e.count * each;
     }
     if (format != "binary_little_endian") throw InputError(path, "header", "only binary_little_endian PLY is read");
-    if (elements.empty() || elements[0].name != "vertex") throw InputError(path, "header", "has no vertex element");
+    if (elements.empty() || elements[0].name != first) throw InputError(path, "header", "has no " + first + " element");
+    return elements;
+}
 
-    // Vertices: every property of every vertex finite, the nine qsgi reads within float's range.
-    const PlyElement& vertex = elements[0];
+// The first element's rows, every property finite: its properties (with their offsets), the
+// row size and the bytes. `in` is left after them.
+struct PlyRows {
+    std::vector<PlyProperty> properties;
     size_t stride = 0;
-    std::vector<PlyProperty> properties = vertex.properties;
-    for (PlyProperty& p : properties) {
-        p.offset = stride;
-        stride += sizeOfType(p.type);
-    }
-    auto find = [&](const char* name) -> const PlyProperty& {
+    std::vector<char> data;
+    const PlyProperty* find(const std::string& name) const {
         for (const auto& p : properties)
-            if (p.name == name) return p;
+            if (p.name == name) return &p;
+        return nullptr;
+    }
+    double value(size_t row, const PlyProperty& p) const { return readScalar(data.data() + row * stride + p.offset, p.type); }
+};
+
+PlyRows readFirstElementRows(const std::string& path, std::ifstream& in, const PlyElement& element) {
+    PlyRows rows;
+    rows.properties = element.properties;
+    for (PlyProperty& p : rows.properties) {
+        p.offset = rows.stride;
+        rows.stride += sizeOfType(p.type);
+    }
+    const size_t count = size_t(element.count);
+    if (count > (size_t(1) << 31)) throw InputError(path, "header", "implausible " + element.name + " count");
+    rows.data.resize(count * rows.stride);
+    if (!in.read(rows.data.data(), std::streamsize(rows.data.size())))
+        throw InputError(path, element.name + " data", "ends before " + std::to_string(count) + " " + plural(element.name));
+    for (size_t r = 0; r < count; ++r)
+        for (const PlyProperty& p : rows.properties) {
+            const double value = rows.value(r, p);
+            if (!std::isfinite(value))
+                throw InputError(path, element.name + " " + std::to_string(r),
+                                 "property '" + p.name + "' is " + number(value) + ", not a finite number");
+        }
+    return rows;
+}
+
+}  // namespace
+
+VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
+    std::ifstream in;
+    const std::vector<PlyElement> elements = readHeader(path, in, "vertex");
+    // Vertices: every property of every vertex finite, the nine qsgi reads within float's range.
+    const PlyRows rows = readFirstElementRows(path, in, elements[0]);
+    auto find = [&](const char* name) -> const PlyProperty& {
+        if (const PlyProperty* p = rows.find(name)) return *p;
         throw InputError(path, "header", std::string("has no vertex property '") + name + "'");
     };
     const PlyProperty* fields[9] = {&find("x"), &find("y"), &find("z"), &find("nx"), &find("ny"), &find("nz"),
                                     &find("radiosity_r"), &find("radiosity_g"), &find("radiosity_b")};
     // Irradiance, which qsgi writes since issue 35 (the asset's _IRRADIANCE is read from it): all
     // three or none.
-    const PlyProperty* irradiance[3] = {nullptr, nullptr, nullptr};
-    for (const auto& p : properties)
-        for (int c = 0; c < 3; ++c)
-            if (p.name == std::string("irradiance_") + "rgb"[c]) irradiance[c] = &p;
+    const PlyProperty* irradiance[3] = {rows.find("irradiance_r"), rows.find("irradiance_g"), rows.find("irradiance_b")};
     const bool hasIrradiance = irradiance[0] && irradiance[1] && irradiance[2];
-    const PlyProperty* referenced = nullptr;
-    for (const auto& p : properties)
-        if (p.name == "referenced") referenced = &p;
-    const size_t vertexCount = size_t(vertex.count);
-    if (vertexCount > (size_t(1) << 31)) throw InputError(path, "header", "implausible vertex count");
-    std::vector<char> data(vertexCount * stride);
-    if (!in.read(data.data(), std::streamsize(data.size())))
-        throw InputError(path, "vertex data", "ends before " + std::to_string(vertexCount) + " vertices");
+    const PlyProperty* referenced = rows.find("referenced");
+    const size_t vertexCount = size_t(elements[0].count);
     VertexRadiosityPly out;
     out.positions.resize(vertexCount);
     out.normals.resize(vertexCount);
     out.radiosity.resize(vertexCount);
     if (hasIrradiance) out.irradiance.resize(vertexCount);
     if (referenced) out.referenced.resize(vertexCount);
+    auto asFloat = [&](size_t v, const PlyProperty& p) {
+        const double value = rows.value(v, p);
+        const float f = float(value);
+        if (!std::isfinite(f))
+            throw InputError(path, "vertex " + std::to_string(v), "property '" + p.name + "' is " + number(value) + ", beyond the range of float");
+        return f;
+    };
     for (size_t v = 0; v < vertexCount; ++v) {
-        const char* row = data.data() + v * stride;
-        for (const PlyProperty& p : properties) {
-            const double value = readScalar(row + p.offset, p.type);
-            if (!std::isfinite(value))
-                throw InputError(path, "vertex " + std::to_string(v),
-                                 "property '" + p.name + "' is " + number(value) + ", not a finite number");
-        }
         float f[9];
-        for (int i = 0; i < 9; ++i) {
-            const double value = readScalar(row + fields[i]->offset, fields[i]->type);
-            f[i] = float(value);
-            if (!std::isfinite(f[i]))
-                throw InputError(path, "vertex " + std::to_string(v),
-                                 "property '" + fields[i]->name + "' is " + number(value) + ", beyond the range of float");
-        }
+        for (int i = 0; i < 9; ++i) f[i] = asFloat(v, *fields[i]);
         out.positions[v] = {f[0], f[1], f[2]};
         out.normals[v] = {f[3], f[4], f[5]};
         out.radiosity[v] = {f[6], f[7], f[8]};
-        if (referenced) out.referenced[v] = readScalar(row + referenced->offset, referenced->type) != 0;
-        if (hasIrradiance) {
-            for (int c = 0; c < 3; ++c) {
-                const double value = readScalar(row + irradiance[c]->offset, irradiance[c]->type);
-                out.irradiance[v][c] = float(value);
-                if (!std::isfinite(out.irradiance[v][c]))
-                    throw InputError(path, "vertex " + std::to_string(v),
-                                     "property '" + irradiance[c]->name + "' is " + number(value) + ", beyond the range of float");
-            }
-        }
+        if (referenced) out.referenced[v] = rows.value(v, *referenced) != 0;
+        if (hasIrradiance)
+            for (int c = 0; c < 3; ++c) out.irradiance[v][c] = asFloat(v, *irradiance[c]);
     }
 
     // Faces (fanned into triangles), for the edge regions of `qsgi compare`. Elements between the
@@ -274,6 +289,60 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
             }
     }
     return out;
+}
+
+SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
+    std::ifstream in;
+    const std::vector<PlyElement> elements = readHeader(path, in, "point");
+    const PlyRows rows = readFirstElementRows(path, in, elements[0]);
+    auto find = [&](const std::string& name) -> const PlyProperty& {
+        if (const PlyProperty* p = rows.find(name)) return *p;
+        throw InputError(path, "header", "has no point property '" + name + "'");
+    };
+    const PlyProperty& triangle = find("triangle");
+    const PlyProperty &b1 = find("b1"), &b2 = find("b2"), &hidden = find("hidden");
+    const PlyProperty* position[3] = {&find("x"), &find("y"), &find("z")};
+    const PlyProperty* irradiance[3] = {&find("irradiance_r"), &find("irradiance_g"), &find("irradiance_b")};
+    const PlyProperty* standardError[3] = {&find("stderr_r"), &find("stderr_g"), &find("stderr_b")};
+    SurfaceReferencePly out;
+    out.points.resize(size_t(elements[0].count));
+    for (size_t i = 0; i < out.points.size(); ++i) {
+        SurfacePoint& p = out.points[i];
+        const std::string where = "point " + std::to_string(i);
+        const double t = rows.value(i, triangle);
+        if (!(t >= 0 && t < 4294967295.0 && t == std::floor(t))) throw InputError(path, where, "its triangle is not a face index");
+        p.triangle = uint32_t(t);
+        p.b1 = float(rows.value(i, b1));
+        p.b2 = float(rows.value(i, b2));
+        if (!(p.b1 >= 0 && p.b2 >= 0 && double(p.b1) + double(p.b2) <= 1 + 1e-6))
+            throw InputError(path, where, "its barycentrics b1, b2 do not name a point of a triangle");
+        for (int c = 0; c < 3; ++c) {
+            p.position[c] = float(rows.value(i, *position[c]));
+            p.irradiance[c] = float(rows.value(i, *irradiance[c]));
+            p.standardError[c] = float(rows.value(i, *standardError[c]));
+            if (!std::isfinite(p.position[c]) || !std::isfinite(p.irradiance[c]) || !std::isfinite(p.standardError[c]) ||
+                !(p.standardError[c] >= 0))
+                throw InputError(path, where, "its position, irradiance or standard error is beyond float's range, or the error negative");
+        }
+        p.hidden = rows.value(i, hidden) != 0;
+    }
+    return out;
+}
+
+std::string plyFirstElement(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return "";
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    if (!std::getline(in, line) || line != "ply") return "";
+    for (int lines = 0; lines < 1000 && std::getline(in, line); ++lines) {
+        std::istringstream words(line);
+        std::string word, name;
+        words >> word;
+        if (word == "end_header") break;
+        if (word == "element" && (words >> name)) return name;
+    }
+    return "";
 }
 
 }  // namespace qsgi

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "estimate/surface_accuracy.h"
 #include "scene/scene.h"
 #include "util/vecmath.h"
 
@@ -21,5 +22,16 @@ struct VertexRadiosityPly {
 
 // Throws InputError naming the file for anything it cannot read.
 VertexRadiosityPly readVertexRadiosityPly(const std::string& path);
+
+// A surface reference (scripts/reference.py --surface N): `element point N` with the properties
+// SurfacePoint names (x y z and the normal are read by the scripts only).
+struct SurfaceReferencePly {
+    std::vector<SurfacePoint> points;
+};
+SurfaceReferencePly readSurfaceReferencePly(const std::string& path);
+
+// The name of a PLY's first element ("vertex", "point"), or "" if it is not a PLY header: which
+// of the two readers a file is for. Opens a regular file only (anything else: "").
+std::string plyFirstElement(const std::string& path);
 
 }  // namespace qsgi

@@ -1,0 +1,65 @@
+// Accuracy where the eye looks (issue 47): a frame's vertex irradiance interpolated linearly across
+// each triangle — what a viewer, Blender or an engine shows — against a path tracer's irradiance at
+// points spread uniformly by area (scripts/reference.py --surface N), overall and by band: where
+// two surfaces touch or nearly do (a block's foot, the ceiling round a panel), along the edges of a
+// surface, and the interior. The reference's own noise (each point's standard error) is reported
+// and taken out.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "scene/scene.h"
+#include "util/vecmath.h"
+
+namespace qsgi {
+
+// One point of a surface reference: on `triangle` (a face index of the frame's mesh) at weights
+// (1 − b1 − b2, b1, b2) of its corners; its world position as drawn; E and its standard error;
+// hidden (no light reaches it and it lies inside or under closed geometry: left out of scores).
+struct SurfacePoint {
+    uint32_t triangle = 0;
+    float b1 = 0, b2 = 0;
+    Vec3f position{0.0f};
+    Vec3f irradiance{0.0f}, standardError{0.0f};
+    bool hidden = false;
+};
+
+// The bands partition the points that are not hidden, in this order of precedence:
+// Contact: within `width` of a triangle of another piece of surface (edgeConnectedPieces: a piece
+//   is joined across shared edges, so a block on a floor is another piece, a box's walls one).
+// Edge: within `width` of an edge of a surface (MeshEdges: border, non-manifold, crease > 45°).
+// Interior: the rest.
+enum class SurfaceBand : uint8_t { Contact, Edge, Interior };
+std::vector<SurfaceBand> surfaceBands(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
+                                      const std::vector<Triangle>& triangles, const std::vector<SurfacePoint>& points,
+                                      float width);
+
+struct SurfaceErrorStats {
+    size_t points = 0;
+    double relativeRms = 0;     // sqrt(mean |E_interp − E_ref|²) / mean |E_ref|, over points and RGB
+    double relativeBias = 0;    // mean (E_interp − E_ref) / mean |E_ref|
+    double referenceNoise = 0;  // sqrt(mean stderr²) / mean |E_ref|: what the reference's noise adds
+    double withoutNoise = 0;    // sqrt(max(0, mean |E_interp − E_ref|² − mean stderr²)) / mean |E_ref|
+};
+
+struct SurfaceAccuracyReport {
+    size_t hidden = 0;
+    SurfaceErrorStats all, contact, edge, interior;
+};
+
+// The vertex irradiance `values` (per vertex of positions) interpolated at each point. Throws
+// std::invalid_argument when a point names a triangle the mesh does not have.
+Vec3f interpolatedAt(const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values, const SurfacePoint& point);
+
+// Throws std::invalid_argument, saying which point, when the points were not drawn on this mesh:
+// a triangle it does not have, or a point's recorded position off the place its barycentrics
+// name by more than 10⁻⁴ of the mesh's extent (float storage moves it far less).
+void checkDrawnOn(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles, const std::vector<SurfacePoint>& points);
+
+SurfaceAccuracyReport compareOverSurface(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
+                                         const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values,
+                                         const std::vector<SurfacePoint>& points, float width);
+
+}  // namespace qsgi
