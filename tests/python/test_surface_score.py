@@ -4,7 +4,11 @@
 A field linear on each triangle is interpolated exactly, so a bake holding it at its vertices
 scores 0 against a reference holding it at the points; a hidden point, however wrong, counts for
 nothing; a known error at one vertex gives the error its barycentric weight predicts; and the
-reference's noise is taken out as its mean squared standard error."""
+reference's noise is taken out as its mean squared standard error.
+
+With --qsgi PATH it also renders data/cornell's frame 0 (cheap settings) and checks that `qsgi compare`
+against the committed surface reference gives, overall, the figures this script's independent
+numpy interpolation gives."""
 import os
 import subprocess
 import sys
@@ -124,5 +128,37 @@ class SurfaceScore(unittest.TestCase):
         self.assertIn("another mesh", out.stderr)
 
 
+QSGI = None
+
+
+class CompareMatchesNumpy(unittest.TestCase):
+    def test_qsgi_compare_over_the_surface_equals_the_numpy_interpolation(self):
+        if QSGI is None:
+            self.skipTest("no --qsgi given")
+        out = tempfile.mkdtemp(prefix="qsgi-surface-compare-")
+        reference = os.path.join(ROOT, "tests", "reference", "cornell_f0000_surface.ply")
+        render = subprocess.run([QSGI, "render", os.path.join(ROOT, "data", "cornell", "cornell.gltf"), "--animation",
+                                 os.path.join(ROOT, "data", "cornell", "animation.json"), "--frames", "0:0", "--out", out,
+                                 "--photons", "20000", "--gather", "16", "--direct-samples", "4", "--no-exr", "--quiet"],
+                                capture_output=True, text=True)
+        self.assertEqual(render.returncode, 0, render.stderr)
+        frame = os.path.join(out, "frame_0000.ply")
+        compare = subprocess.run([QSGI, "compare", frame, reference, "--json"], capture_output=True, text=True)
+        self.assertEqual(compare.returncode, 0, compare.stderr)
+        import json
+        ours = json.loads(compare.stdout)
+        theirs = surface_score.score(ply.read(frame).irradiance(), ply.read(frame).triangles(), ply.read_points(reference))
+        self.assertEqual(ours["all"]["points"], theirs["points"])
+        self.assertEqual(ours["hidden"], theirs["hidden"])
+        for key in ("relative_rms", "reference_noise", "relative_rms_without_noise"):
+            self.assertAlmostEqual(ours["all"][key], theirs[key], delta=1e-6 * theirs[key], msg=key)
+        # The bands partition the visible points.
+        self.assertEqual(sum(ours[b]["points"] for b in ("contact", "edge", "interior")), ours["all"]["points"])
+
+
 if __name__ == "__main__":
+    if "--qsgi" in sys.argv:
+        i = sys.argv.index("--qsgi")
+        QSGI = sys.argv[i + 1]
+        del sys.argv[i:i + 2]
     unittest.main()
