@@ -167,13 +167,13 @@ int runSurfaceCompare(const std::string& a, const std::string& b, std::optional<
     const qsgi::SurfaceReferencePly reference = qsgi::readSurfaceReferencePly(b);
     if (solution.irradiance.empty())
         throw qsgi::InputError(a, "header", "has no irradiance_r/g/b: a surface reference scores irradiance");
+    qsgi::SurfaceAccuracyReport r;
     try {
-        qsgi::checkDrawnOn(solution.positions, solution.triangles, reference.points);
+        r = qsgi::compareOverSurface(solution.positions, solution.normals, solution.triangles, solution.irradiance,
+                                     reference.points, width);
     } catch (const std::invalid_argument& e) {
-        throw qsgi::InputError(b, "", std::string(e.what()) + " than " + a + "'s");
+        throw qsgi::InputError(b, "", std::string(e.what()) + " (the frame: " + a + ")");
     }
-    const qsgi::SurfaceAccuracyReport r = qsgi::compareOverSurface(solution.positions, solution.normals, solution.triangles,
-                                                                   solution.irradiance, reference.points, width);
     const std::pair<const char*, const qsgi::SurfaceErrorStats*> rows[] = {
         {"all", &r.all}, {"contact", &r.contact}, {"edge", &r.edge}, {"interior", &r.interior}};
     if (json) {

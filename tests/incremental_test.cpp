@@ -13,6 +13,7 @@
 
 #include "pipeline/frame_solver.h"
 #include "scene/animation.h"
+#include "estimate/final_gather.h"
 #include "test_support.h"
 
 using namespace qsgi;
@@ -127,7 +128,10 @@ void expectIncrementalEqualsFull(const AnimatedScene& a, const EstimatorCase& e,
     if (lighting.gathers()) {
         EXPECT_GT(gatherRecast, 0u);
         EXPECT_LT(gatherRecast, gatherFull);
-        EXPECT_EQ(gatherFull, uint64_t(a.frames - 1) * incScene.vertexCount() * lighting.gatherRays);
+        // A full recomputation keeps no hits: it casts each vertex's first rays once more to tell
+        // covered vertices (FinalGather::castCovered).
+        EXPECT_EQ(gatherFull, uint64_t(a.frames - 1) * incScene.vertexCount() *
+                                  (lighting.gatherRays + std::min(lighting.gatherRays, FinalGather::kCoverRays)));
     }
     // A lowered generation limit is there to make the renumbering run.
     if (generations < TrackedPaths::kGenerations) {

@@ -59,12 +59,15 @@ struct Pinned {
 TEST(PlyPin, PhotonOnlyRendersKeepTheirBytesForEveryEstimator) {
     const Pinned cases[] = {
         {"impact-count", "--estimator impact-count", {{"310accccacd0cabf", "322a39e4977144bf"}}},
-        {"photon-map", "--estimator photon-map --k 30",
-         {{"db796966f032e12d", "9f0509f407210cfb"}, {"a6065ca5f685afa9", "60c677e2e4be722a"}}},
-        {"detp clip", "--estimator detp --detp-boundary clip",
-         {{"00d82a572b961de7", "f02f8316f4b9c451"}, {"ae2a5f3de02e6b85", "4ad1517d5662beed"}}},
-        {"detp linear", "--estimator detp --detp-boundary linear",
-         {{"a493c1a81e9eb827", "8cf055f8eb3010d1"}, {"2c9f3494ba8f0f4e", "a3c6da44795c6d6a"}}},
+        // The estimators that read the disc regions: issue 47 changed frame 0 on purpose. The 13 floor
+        // vertices on the block's foot line (x = −0.75) had their start side-stepped into the block
+        // and read 0; their start now steps outward (disc_regions.cpp) and they read their visible
+        // side's light. No other vertex, and nothing of frame 2 (the block has moved off the line),
+        // changed. The AVX-512 machine's frame-0 pins are re-taken; the AVX2 machine's pairs
+        // predate the change and are left out until measured there (its frame 2 would still match).
+        {"photon-map", "--estimator photon-map --k 30", {{"118336703f86fe1b", "60c677e2e4be722a"}}},
+        {"detp clip", "--estimator detp --detp-boundary clip", {{"9b71829800aaa301", "4ad1517d5662beed"}}},
+        {"detp linear", "--estimator detp --detp-boundary linear", {{"72464fbc54115c1f", "a3c6da44795c6d6a"}}},
     };
     const fs::path cornell = sourceDir() / "data" / "cornell";
     const fs::path dir = testScratchDir("ply-pin");

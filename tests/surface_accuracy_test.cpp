@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "estimate/surface_accuracy.h"
+#include "scene/mesh_refinement.h"
 #include "test_support.h"
 
 using namespace qsgi;
@@ -38,6 +39,7 @@ std::vector<SurfacePoint> drawPoints(const Scene& scene, size_t count, uint32_t 
         const Vec3d at = Vec3d(scene.positions[T.v[0]]) * (1 - b1 - b2) + Vec3d(scene.positions[T.v[1]]) * b1 +
                          Vec3d(scene.positions[T.v[2]]) * b2;
         p.position = Vec3f(at);
+        p.normal = frontFaceNormal(scene.positions, scene.normals, T);
         p.irradiance = field(at + scene.worldOrigin);
     }
     return points;
@@ -74,7 +76,8 @@ TEST(SurfaceAccuracy, BandsFollowTheGeometryALinearFieldIsExactAndTheReferencesN
     for (uint32_t v = 0; v < scene.vertexCount(); ++v) linear[v] = linearField(Vec3d(scene.positions[v]) + scene.worldOrigin);
     std::vector<SurfacePoint> points = drawPoints(scene, 20000, 5, linearField);
 
-    const std::vector<SurfaceBand> bands = surfaceBands(scene.positions, scene.normals, scene.triangles, points, kWidth);
+    const std::vector<PointOnMesh> located = locateOnMesh(scene.positions, scene.normals, scene.triangles, points);
+    const std::vector<SurfaceBand> bands = surfaceBands(scene.positions, scene.normals, scene.triangles, located, kWidth);
     size_t decided = 0, counts[3] = {0, 0, 0};
     for (size_t i = 0; i < points.size(); ++i) {
         const int expected = expectedBand(Vec3d(points[i].position) + scene.worldOrigin);
@@ -113,14 +116,38 @@ TEST(SurfaceAccuracy, BandsFollowTheGeometryALinearFieldIsExactAndTheReferencesN
     EXPECT_NEAR(noisy.all.withoutNoise, std::sqrt(d * d - s * s) / scale, 1e-5);
 }
 
-TEST(SurfaceAccuracy, PointsDrawnOnAnotherMeshAreRefused) {
+// Points are found on the frame's mesh by position, so a refined frame (--subdivide) is scored at
+// the same places: a field linear on the refined triangles is exact there, each point falls on the
+// refined triangle inside its own, and the bands are those of the unrefined mesh.
+TEST(SurfaceAccuracy, ARefinedFrameIsScoredAtTheSamePlaces) {
+    const Scene coarse = blockScene();
+    Scene fine = blockScene();
+    refineMesh(fine, 0.04);
+    ASSERT_GT(fine.triangleCount(), 4 * coarse.triangleCount());
+    const std::vector<SurfacePoint> points = drawPoints(coarse, 5000, 9, linearField);
+    std::vector<Vec3f> linear(fine.vertexCount());
+    for (uint32_t v = 0; v < fine.vertexCount(); ++v) linear[v] = linearField(Vec3d(fine.positions[v]) + fine.worldOrigin);
+    const SurfaceAccuracyReport r = compareOverSurface(fine.positions, fine.normals, fine.triangles, linear, points, kWidth);
+    EXPECT_EQ(r.all.points, points.size());
+    EXPECT_LT(r.all.relativeRms, 1e-6);
+    const std::vector<PointOnMesh> onCoarse = locateOnMesh(coarse.positions, coarse.normals, coarse.triangles, points);
+    const std::vector<PointOnMesh> onFine = locateOnMesh(fine.positions, fine.normals, fine.triangles, points);
+    const std::vector<SurfaceBand> coarseBands = surfaceBands(coarse.positions, coarse.normals, coarse.triangles, onCoarse, kWidth);
+    const std::vector<SurfaceBand> fineBands = surfaceBands(fine.positions, fine.normals, fine.triangles, onFine, kWidth);
+    size_t same = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+        same += coarseBands[i] == fineBands[i];
+        // Unrefined, the point is found on the triangle it was drawn on, at its own barycentrics.
+        EXPECT_NEAR(onCoarse[i].b1 + onCoarse[i].b2, double(points[i].b1) + double(points[i].b2), 1e-4) << "point " << i;
+    }
+    // Only points within rounding of a band's edge may differ (float midpoints).
+    EXPECT_GE(same, points.size() - 5);
+}
+
+TEST(SurfaceAccuracy, PointsDrawnOnAnotherSceneOrPoseAreRefused) {
     const Scene scene = blockScene();
     std::vector<SurfacePoint> points = drawPoints(scene, 100, 7, linearField);
-    EXPECT_NO_THROW(checkDrawnOn(scene.positions, scene.triangles, points));
-    std::vector<SurfacePoint> beyond = points;
-    beyond[3].triangle = uint32_t(scene.triangleCount());
-    EXPECT_THROW(checkDrawnOn(scene.positions, scene.triangles, beyond), std::invalid_argument);
-    std::vector<SurfacePoint> moved = points;
-    moved[5].position.x += 0.01f;  // 1 cm in a 2 m scene: far beyond float storage
-    EXPECT_THROW(checkDrawnOn(scene.positions, scene.triangles, moved), std::invalid_argument);
+    EXPECT_NO_THROW(locateOnMesh(scene.positions, scene.normals, scene.triangles, points));
+    points[5].position = points[5].position + points[5].normal * 0.01f;  // 1 cm off the surface, 2 m scene
+    EXPECT_THROW(locateOnMesh(scene.positions, scene.normals, scene.triangles, points), std::invalid_argument);
 }

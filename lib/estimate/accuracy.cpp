@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "estimate/mesh_bands.h"
+#include "scene/triangle_grid.h"
 #include "estimate/point_index.h"
 #include "scene/mesh_topology.h"
 

@@ -5,14 +5,28 @@
 #include <string>
 
 #include "estimate/mesh_bands.h"
+#include "scene/triangle_grid.h"
 #include "scene/mesh_topology.h"
 
 namespace qsgi {
 
 namespace {
-Vec3d pointOn(const std::vector<Vec3f>& positions, const Triangle& t, const SurfacePoint& p) {
-    const double b1 = p.b1, b2 = p.b2, b0 = 1 - b1 - b2;
-    return Vec3d(positions[t.v[0]]) * b0 + Vec3d(positions[t.v[1]]) * b1 + Vec3d(positions[t.v[2]]) * b2;
+Vec3d pointOn(const std::vector<Vec3f>& positions, const Triangle& t, double b1, double b2) {
+    return Vec3d(positions[t.v[0]]) * (1 - b1 - b2) + Vec3d(positions[t.v[1]]) * b1 + Vec3d(positions[t.v[2]]) * b2;
+}
+
+// Barycentrics (of corners 1 and 2) of p's projection onto the triangle's plane, clamped into it.
+std::pair<double, double> barycentricsOf(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    const Vec3d ab = b - a, ac = c - a, ap = p - a;
+    const double d00 = dot(ab, ab), d01 = dot(ab, ac), d11 = dot(ac, ac), d20 = dot(ap, ab), d21 = dot(ap, ac);
+    const double det = d00 * d11 - d01 * d01;
+    if (!(det > 0)) return {0.0, 0.0};  // a degenerate triangle: its first corner
+    double b1 = std::max(0.0, (d11 * d20 - d01 * d21) / det), b2 = std::max(0.0, (d00 * d21 - d01 * d20) / det);
+    if (b1 + b2 > 1) {
+        const double sum = b1 + b2;
+        b1 /= sum, b2 /= sum;
+    }
+    return {b1, b2};
 }
 
 SurfaceErrorStats statsOf(const std::vector<Vec3f>& interpolated, const std::vector<SurfacePoint>& points,
@@ -41,43 +55,56 @@ SurfaceErrorStats statsOf(const std::vector<Vec3f>& interpolated, const std::vec
 }
 }  // namespace
 
-Vec3f interpolatedAt(const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values, const SurfacePoint& point) {
-    if (point.triangle >= triangles.size())
-        throw std::invalid_argument("a point names triangle " + std::to_string(point.triangle) + " of a mesh of " +
-                                    std::to_string(triangles.size()));
-    const Triangle& t = triangles[point.triangle];
-    const double b1 = point.b1, b2 = point.b2, b0 = 1 - b1 - b2;
-    return Vec3f(Vec3d(values[t.v[0]]) * b0 + Vec3d(values[t.v[1]]) * b1 + Vec3d(values[t.v[2]]) * b2);
-}
-
-void checkDrawnOn(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles, const std::vector<SurfacePoint>& points) {
+std::vector<PointOnMesh> locateOnMesh(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
+                                      const std::vector<Triangle>& triangles, const std::vector<SurfacePoint>& points) {
     Bounds3f bounds;
     for (const Vec3f& p : positions) bounds.extend(p);
     const double tolerance = 1e-4 * double(maxComponent(bounds.diagonal()));
+    const TriangleGrid grid(positions, triangles, float(tolerance));
+    std::vector<PointOnMesh> located(points.size());
     for (size_t i = 0; i < points.size(); ++i) {
-        const std::string which = "point " + std::to_string(i);
-        if (points[i].triangle >= triangles.size())
-            throw std::invalid_argument(which + " names triangle " + std::to_string(points[i].triangle) + " but the frame has " +
-                                        std::to_string(triangles.size()) + ": another mesh");
-        const Vec3d off = pointOn(positions, triangles[points[i].triangle], points[i]) - Vec3d(points[i].position);
-        if (!(length(off) <= tolerance))
-            throw std::invalid_argument(which + " lies " + std::to_string(length(off)) +
-                                        " from the place its triangle and barycentrics name in the frame: another mesh or pose");
+        const Vec3d p(points[i].position);
+        const Vec3f n = points[i].normal;
+        int64_t best = -1;
+        double bestFacing = 0, bestDistance = 0;
+        for (uint32_t t : grid.near(p)) {
+            const Triangle& T = triangles[t];
+            const double d2 = squaredDistanceToTriangle(p, Vec3d(positions[T.v[0]]), Vec3d(positions[T.v[1]]), Vec3d(positions[T.v[2]]));
+            if (!(d2 <= tolerance * tolerance)) continue;
+            const double facing = double(dot(frontFaceNormal(positions, normals, T), n));
+            if (best < 0 || facing > bestFacing + 1e-6 || (facing >= bestFacing - 1e-6 && d2 < bestDistance)) {
+                best = t;
+                bestFacing = facing;
+                bestDistance = d2;
+            }
+        }
+        if (best < 0)
+            throw std::invalid_argument("point " + std::to_string(i) + " lies on no triangle of the frame (none within " +
+                                        std::to_string(tolerance) + "): drawn on another scene or pose");
+        const Triangle& T = triangles[size_t(best)];
+        const auto [b1, b2] = barycentricsOf(p, Vec3d(positions[T.v[0]]), Vec3d(positions[T.v[1]]), Vec3d(positions[T.v[2]]));
+        located[i] = {uint32_t(best), b1, b2};
     }
+    return located;
+}
+
+Vec3f interpolatedAt(const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values, const PointOnMesh& at) {
+    const Triangle& t = triangles[at.triangle];
+    return Vec3f(Vec3d(values[t.v[0]]) * (1 - at.b1 - at.b2) + Vec3d(values[t.v[1]]) * at.b1 + Vec3d(values[t.v[2]]) * at.b2);
 }
 
 std::vector<SurfaceBand> surfaceBands(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
-                                      const std::vector<Triangle>& triangles, const std::vector<SurfacePoint>& points,
+                                      const std::vector<Triangle>& triangles, const std::vector<PointOnMesh>& located,
                                       float width) {
     const MeshTopology topology(positions, triangles);
-    const std::vector<uint32_t> piece = edgeConnectedPieces(triangles, topology);
+    const std::vector<uint32_t> piece = topology.edgeConnectedPieces(triangles);
     const MeshEdges edges(positions, normals, triangles, topology, width);
     const TriangleGrid grid(positions, triangles, width);
     const double width2 = double(width) * double(width);
-    std::vector<SurfaceBand> band(points.size(), SurfaceBand::Interior);
-    for (size_t i = 0; i < points.size(); ++i) {
-        const uint32_t own = piece.at(points[i].triangle);
-        const Vec3d p = pointOn(positions, triangles[points[i].triangle], points[i]);
+    std::vector<SurfaceBand> band(located.size(), SurfaceBand::Interior);
+    for (size_t i = 0; i < located.size(); ++i) {
+        const uint32_t own = piece.at(located[i].triangle);
+        const Vec3d p = pointOn(positions, triangles[located[i].triangle], located[i].b1, located[i].b2);
         bool contact = false;
         for (uint32_t t : grid.near(p)) {
             if (piece[t] == own) continue;
@@ -95,9 +122,10 @@ std::vector<SurfaceBand> surfaceBands(const std::vector<Vec3f>& positions, const
 SurfaceAccuracyReport compareOverSurface(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
                                          const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values,
                                          const std::vector<SurfacePoint>& points, float width) {
+    const std::vector<PointOnMesh> located = locateOnMesh(positions, normals, triangles, points);
     std::vector<Vec3f> interpolated(points.size());
-    for (size_t i = 0; i < points.size(); ++i) interpolated[i] = interpolatedAt(triangles, values, points[i]);
-    const std::vector<SurfaceBand> band = surfaceBands(positions, normals, triangles, points, width);
+    for (size_t i = 0; i < points.size(); ++i) interpolated[i] = interpolatedAt(triangles, values, located[i]);
+    const std::vector<SurfaceBand> band = surfaceBands(positions, normals, triangles, located, width);
     SurfaceAccuracyReport r;
     auto counted = [&](auto&& in) {
         std::vector<uint8_t> keep(points.size());

@@ -302,6 +302,7 @@ SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
     const PlyProperty& triangle = find("triangle");
     const PlyProperty &b1 = find("b1"), &b2 = find("b2"), &hidden = find("hidden");
     const PlyProperty* position[3] = {&find("x"), &find("y"), &find("z")};
+    const PlyProperty* normal[3] = {&find("nx"), &find("ny"), &find("nz")};
     const PlyProperty* irradiance[3] = {&find("irradiance_r"), &find("irradiance_g"), &find("irradiance_b")};
     const PlyProperty* standardError[3] = {&find("stderr_r"), &find("stderr_g"), &find("stderr_b")};
     SurfaceReferencePly out;
@@ -318,9 +319,10 @@ SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
             throw InputError(path, where, "its barycentrics b1, b2 do not name a point of a triangle");
         for (int c = 0; c < 3; ++c) {
             p.position[c] = float(rows.value(i, *position[c]));
+            p.normal[c] = float(rows.value(i, *normal[c]));
             p.irradiance[c] = float(rows.value(i, *irradiance[c]));
             p.standardError[c] = float(rows.value(i, *standardError[c]));
-            if (!std::isfinite(p.position[c]) || !std::isfinite(p.irradiance[c]) || !std::isfinite(p.standardError[c]) ||
+            if (!std::isfinite(p.position[c]) || !std::isfinite(p.normal[c]) || !std::isfinite(p.irradiance[c]) || !std::isfinite(p.standardError[c]) ||
                 !(p.standardError[c] >= 0))
                 throw InputError(path, where, "its position, irradiance or standard error is beyond float's range, or the error negative");
         }

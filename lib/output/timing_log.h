@@ -25,6 +25,9 @@ struct TimingLog {
     std::string scene;
     uint64_t vertices = 0, triangles = 0, dynamicVertices = 0, lights = 0;
     uint64_t degenerateTriangles = 0;
+    uint64_t inputVertices = 0;  // before --subdivide and --refine-contacts
+    // --refine-contacts: the vertices it added and the frames whose poses it judged (null without it).
+    nlohmann::json contactRefinement;
     double animationDiagonal = 0;  // the diagonal of the whole animation's bounds (default radius = 1.5 % of it)
     // runFingerprint of the inputs and settings; --resume continues only a folder whose log has it.
     std::string inputsFingerprint;

@@ -26,6 +26,7 @@
 #include "pipeline/frame_solver.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
+#include "scene/contact_refinement.h"
 #include "scene/mesh_refinement.h"
 #include "trace/photon_tracer.h"
 #include "util/memory.h"
@@ -108,6 +109,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     } else animation_ = Animation::fromTransformFile(settings_.animationPath, scene_);
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, animationSource);
     scene_.setRestPose(animation_.poseAt(0));
+    inputVertices_ = scene_.vertexCount();
     if (settings_.subdivide > 0) {
         const size_t estimate = estimatedRefinedTriangles(scene_, settings_.subdivide);
         if (double(estimate) > kMaxRefinedTriangles) {
@@ -117,6 +119,19 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
             throw InputError("subdivide (--subdivide)", "", text);
         }
         refineMesh(scene_, settings_.subdivide);
+    }
+    if (settings_.refineContacts > 0) {
+        const std::optional<ContactRefinementReport> refined =
+            refineContacts(scene_, settings_.refineContacts, animation_.lastFrame(), [&](int frame) { return animation_.poseAt(frame); },
+                           size_t(kMaxRefinedTriangles));
+        if (!refined) {
+            char text[200];
+            std::snprintf(text, sizeof text, "%g would refine %zu triangles into more than %.0e: choose a longer distance",
+                          double(settings_.refineContacts), scene_.triangleCount(), kMaxRefinedTriangles);
+            throw InputError("refine_contacts (--refine-contacts)", "", text);
+        }
+        contactRefinement_ = {{"vertices_added", refined->mesh.verticesAfter - refined->mesh.verticesBefore},
+                              {"poses_judged", refined->posesJudged}};
     }
     if (settings_.writeGltf) {
         // Refused now, not after the render, if the asset cannot take the bake.
@@ -262,6 +277,8 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     for (uint8_t d : scene_.vertexDynamic) log.dynamicVertices += d;
     log.lights = scene_.lights.size();
     log.animationDiagonal = scene_.animationBounds.extent();
+    log.inputVertices = inputVertices_;
+    log.contactRefinement = contactRefinement_;
     log.inputsFingerprint = fingerprint_.digest;
     log.inputs = fingerprint_.parts;
     const RunFolder::Started started = folder.startLog(std::move(log), start, last_);

@@ -119,6 +119,8 @@ private:
     RunFingerprint fingerprint_;
     bool lit_ = false;
     MeshResolution resolution_;
+    uint64_t inputVertices_ = 0;           // before --subdivide and --refine-contacts
+    nlohmann::json contactRefinement_;     // what --refine-contacts added (timing.json), null without it
 };
 
 }  // namespace qsgi

@@ -202,7 +202,7 @@ json getCamera(const RenderSettings& s) {
 // radiusGiven, qmcBouncesGiven, gatherGiven, framesSource, EnvironmentSettings' source), EmissionAim's margin (FrameSolver
 // sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
 // added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 36, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 37, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
 static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
@@ -497,6 +497,17 @@ std::vector<RenderOption> declareOptions() {
                      if (!(s.subdivide > 0)) throw InputError(src.file, src.place, "is below single precision's smallest length");
                  },
                  [](const RenderSettings& s) { return s.subdivide > 0 ? json(s.subdivide) : json(nullptr); }});
+    o.push_back({"refine_contacts", "--refine-contacts", T::Number, 0, kMaxSceneExtent, "", {}, true, "DISTANCE", "off",
+                 "refine, until at most DISTANCE/2 long, every edge that passes within DISTANCE of another piece of "
+                 "surface in any frame (a block's foot, feet on a floor, the ceiling round a fixture), once on the rest "
+                 "pose, after --subdivide and without T-junctions; every output holds the refined mesh (docs/method.md: "
+                 "contacts)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource& src) {
+                     s.refineContacts = v.get<float>();
+                     if (!(s.refineContacts > 0)) throw InputError(src.file, src.place, "is below single precision's smallest length");
+                 },
+                 [](const RenderSettings& s) { return s.refineContacts > 0 ? json(s.refineContacts) : json(nullptr); }});
     // Images
     o.push_back({"width", "--width", T::Integer, 1, double(kMaxImageSide), "", {}, true, "W", "640",
                  "image width in pixels", true, false,

@@ -52,6 +52,7 @@ struct RenderSettings {
     std::vector<PunctualLight> extraLights;  // world space, from the config
     EnvironmentSettings environment;         // a sky or an HDR map (--sky, --environment, "lights")
     float subdivide = 0;  // refine triangles with an edge longer than this (scene units) on the rest pose; 0: off
+    float refineContacts = 0;  // refine edges within this of another piece of surface in any frame (contact_refinement.h); 0: off
 
     // Images (docs/design.md §7)
     int width = 640, height = 480;

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <map>
+#include <optional>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -28,7 +31,9 @@ void appendRefinedVectors(std::vector<Vec3f>& values, const std::vector<std::pai
 // One instance's vertices (local indices) and triangles, growing as edges are split.
 class InstanceRefiner {
 public:
-    InstanceRefiner(const Scene& scene, const MeshInstance& inst)
+    // tracks: per tracked pose, every scene vertex's world position (RefinementTracks); pieces: the
+    // scene triangles' pieces (RefinementTracks::pieces), or empty.
+    InstanceRefiner(const Scene& scene, const MeshInstance& inst, const RefinementTracks* tracks = nullptr)
         : inst_(inst), positions_(inst.objectPositions), normals_(inst.objectNormals), joints_(inst.skinJoints),
           weights_(inst.skinWeights), morphPositions_(inst.morphPositions), morphNormals_(inst.morphNormals) {
         world_.reserve(inst.vertexCount);
@@ -36,18 +41,30 @@ public:
         for (uint32_t t = 0; t < inst.triangleCount; ++t) {
             const Triangle& tri = scene.triangles[inst.firstTriangle + t];
             triangles_.push_back({tri.v[0] - inst.firstVertex, tri.v[1] - inst.firstVertex, tri.v[2] - inst.firstVertex});
+            piece_.push_back(tracks && !tracks->pieces.empty() ? tracks->pieces[inst.firstTriangle + t] : 0);
         }
+        if (tracks)
+            for (const std::vector<Vec3f>& pose : tracks->poses)
+                tracks_.emplace_back(pose.begin() + inst.firstVertex, pose.begin() + inst.firstVertex + inst.vertexCount);
     }
 
-    void refine(double maxEdge) {
+    // Splits until no edge needs it: `needs(length, piece, a, b)` for an edge of `length` (current
+    // pose) between local vertices a and b of a triangle of `piece`. A pure function of the edge, so
+    // both triangles of an edge agree and no T-junction is left. Returns false, leaving the instance
+    // partly refined, as soon as more than `triangleLimit` triangles would be made.
+    template <typename Needs>
+    bool refine(Needs&& needs, size_t triangleLimit) {
         for (bool changed = true; changed;) {
             changed = false;
             std::vector<LocalTriangle> next;
+            std::vector<uint32_t> nextPiece;
             next.reserve(triangles_.size() * 2);
-            for (const LocalTriangle& t : triangles_) {
-                const int e = edgeToSplit(t, maxEdge);
+            for (size_t i = 0; i < triangles_.size(); ++i) {
+                const LocalTriangle& t = triangles_[i];
+                const int e = edgeToSplit(t, [&](double len, uint32_t a, uint32_t b) { return needs(len, piece_[i], a, b); });
                 if (e < 0) {
                     next.push_back(t);
+                    nextPiece.push_back(piece_[i]);
                     continue;
                 }
                 const uint32_t p = t[size_t(e)], q = t[size_t(e + 1) % 3], r = t[size_t(e + 2) % 3];
@@ -55,11 +72,19 @@ public:
                 // (p, q, r) counter-clockwise gives (p, m, r) and (m, q, r), counter-clockwise.
                 next.push_back({p, m, r});
                 next.push_back({m, q, r});
+                nextPiece.insert(nextPiece.end(), 2, piece_[i]);
                 changed = true;
             }
             triangles_ = std::move(next);
+            piece_ = std::move(nextPiece);
+            if (triangles_.size() > triangleLimit) return false;
         }
+        return true;
     }
+
+    size_t triangleCount() const { return triangles_.size(); }
+    // Vertex v's world position in tracked pose k.
+    const Vec3f& tracked(size_t k, uint32_t v) const { return tracks_[k][v]; }
 
     // Writes the refined instance back: its object-space data, and its block of the scene's arrays
     // from `firstVertex` and `firstTriangle` on.
@@ -98,14 +123,16 @@ private:
 
     double edgeLength(uint32_t a, uint32_t b) const { return length(world_[b] - world_[a]); }
 
-    // The edge (0, 1, 2: from corner e to corner e + 1) to split: the longest, if it exceeds
-    // maxEdge; else −1.
-    int edgeToSplit(const LocalTriangle& t, double maxEdge) const {
+    // The edge (0, 1, 2: from corner e to corner e + 1) to split: the longest of those that need it
+    // (needs(length, a, b), asked with the corners in increasing order); else −1.
+    template <typename Needs>
+    int edgeToSplit(const LocalTriangle& t, Needs&& needs) const {
         int longest = -1;
-        double longestLength = maxEdge;
+        double longestLength = 0;
         for (int e = 0; e < 3; ++e) {
-            const double len = edgeLength(t[size_t(e)], t[size_t(e + 1) % 3]);
-            if (len > longestLength) longest = e, longestLength = len;
+            const uint32_t a = t[size_t(e)], b = t[size_t(e + 1) % 3];
+            const double len = edgeLength(a, b);
+            if (len > longestLength && needs(len, std::min(a, b), std::max(a, b))) longest = e, longestLength = len;
         }
         return longest;
     }
@@ -119,6 +146,7 @@ private:
         midpoints_.emplace(pair, m);
         refinedFrom_.push_back({a, b});
         world_.push_back((world_[a] + world_[b]) * 0.5);
+        for (std::vector<Vec3f>& track : tracks_) track.push_back(Vec3f((Vec3d(track[a]) + Vec3d(track[b])) * 0.5));
         if (inst_.influences > 0) blendInfluences(a, b);
         return m;
     }
@@ -155,6 +183,8 @@ private:
     std::vector<std::vector<Vec3f>> morphPositions_, morphNormals_;
     std::vector<Vec3d> world_;  // the current pose's, for lengths
     std::vector<LocalTriangle> triangles_;
+    std::vector<uint32_t> piece_;                 // per triangle: its piece of surface (RefinementTracks)
+    std::vector<std::vector<Vec3f>> tracks_;      // per tracked pose, per vertex: its world position
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints_;
     std::vector<std::pair<uint32_t, uint32_t>> refinedFrom_;  // per new vertex, in order
 };
@@ -182,15 +212,54 @@ void appendRefinedValues(std::vector<float>& values, size_t components,
     }
 }
 
+namespace {
+// Writes the refiners' instances back into the scene and re-places them.
+RefinementReport storeRefined(Scene& scene, std::vector<InstanceRefiner>& refiners, RefinementReport report);
+}  // namespace
+
 RefinementReport refineMesh(Scene& scene, double maxEdge) {
     RefinementReport report;
     report.trianglesBefore = scene.triangleCount();
     report.verticesBefore = scene.vertexCount();
     std::vector<InstanceRefiner> refiners;
-    std::vector<uint32_t> materials, triangleMaterials;
     for (const MeshInstance& inst : scene.instances) {
         refiners.emplace_back(scene, inst);
-        refiners.back().refine(maxEdge);
+        refiners.back().refine([&](double len, uint32_t, uint32_t, uint32_t) { return len > maxEdge; }, SIZE_MAX);
+    }
+    return storeRefined(scene, refiners, report);
+}
+
+std::optional<RefinementReport> refineMeshWhere(Scene& scene, const RefinementTracks& tracks, const EdgeSplitTest& needs,
+                                                size_t triangleLimit) {
+    RefinementReport report;
+    report.trianglesBefore = scene.triangleCount();
+    report.verticesBefore = scene.vertexCount();
+    std::vector<InstanceRefiner> refiners;
+    size_t made = 0;
+    std::vector<Vec3f> a(tracks.poses.size()), b(tracks.poses.size());
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        refiners.emplace_back(scene, scene.instances[i], &tracks);
+        InstanceRefiner& refiner = refiners.back();
+        // Each pass asks about every edge of every triangle again: an edge's answer is kept.
+        std::unordered_map<uint64_t, bool> decided;
+        const bool within = refiner.refine(
+            [&](double len, uint32_t piece, uint32_t p, uint32_t q) {
+                const auto [it, added] = decided.emplace(uint64_t(p) << 32 | q, false);
+                if (!added) return it->second;
+                for (size_t k = 0; k < a.size(); ++k) a[k] = refiner.tracked(k, p), b[k] = refiner.tracked(k, q);
+                return it->second = needs(EdgeToSplit{i, piece, len, a, b});
+            },
+            triangleLimit - std::min(triangleLimit, made));
+        if (!within) return std::nullopt;
+        made += refiner.triangleCount();
+    }
+    return storeRefined(scene, refiners, report);
+}
+
+namespace {
+RefinementReport storeRefined(Scene& scene, std::vector<InstanceRefiner>& refiners, RefinementReport report) {
+    std::vector<uint32_t> materials, triangleMaterials;
+    for (const MeshInstance& inst : scene.instances) {
         materials.push_back(inst.vertexCount ? scene.vertexMaterial[inst.firstVertex] : 0);
         triangleMaterials.push_back(inst.triangleCount ? scene.triangleMaterial[inst.firstTriangle] : 0);
     }
@@ -210,6 +279,7 @@ RefinementReport refineMesh(Scene& scene, double maxEdge) {
     report.verticesAfter = scene.vertexCount();
     return report;
 }
+}  // namespace
 
 size_t estimatedRefinedTriangles(const Scene& scene, double maxEdge) {
     double total = 0;

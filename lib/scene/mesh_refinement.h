@@ -20,6 +20,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -52,6 +54,34 @@ struct RefinementReport {
 // Refines `scene` in place (its instances, vertex and triangle arrays) and re-places every
 // instance with what it was last placed with. maxEdge > 0.
 RefinementReport refineMesh(Scene& scene, double maxEdge);
+
+// What refineMeshWhere follows the mesh through: every vertex's world position in each of some
+// poses (poses[k][v], scene order; the refinement gives a new vertex its edge's midpoint in each),
+// and each triangle's piece of surface (MeshTopology::edgeConnectedPieces; its pieces inherit it).
+struct RefinementTracks {
+    std::vector<std::vector<Vec3f>> poses;
+    std::vector<uint32_t> pieces;
+};
+
+// An edge refineMeshWhere asks about: of scene instance `instance`, its triangles of `piece`, its
+// `length` in the current pose, and its corners' world positions in each tracked pose (a[k], b[k]:
+// the corners in the order of their indices, the same from both its triangles).
+struct EdgeToSplit {
+    size_t instance;
+    uint32_t piece;
+    double length;
+    const std::vector<Vec3f>& a;
+    const std::vector<Vec3f>& b;
+};
+// Whether an edge must be split: a pure function of the edge, so that both triangles of an edge
+// agree and the refined mesh is conforming. It must say no to every edge short enough.
+using EdgeSplitTest = std::function<bool(const EdgeToSplit&)>;
+
+// Longest-edge bisection as refineMesh, splitting an edge when `needs` says (each triangle splits
+// the longest of its edges that need it). Nothing is changed, and nullopt returned, when more
+// than `triangleLimit` triangles would be made.
+std::optional<RefinementReport> refineMeshWhere(Scene& scene, const RefinementTracks& tracks, const EdgeSplitTest& needs,
+                                                size_t triangleLimit);
 
 // About how many triangles refineMesh(scene, maxEdge) makes (each triangle as (longest edge /
 // maxEdge)² pieces): what a run checks before refining, so that a LENGTH far too small is refused

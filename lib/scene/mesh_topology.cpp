@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <numeric>
 #include <tuple>
 
@@ -69,6 +70,39 @@ std::vector<uint32_t> MeshTopology::vertexPieces(const std::vector<Triangle>& tr
     std::vector<uint32_t> pieces(parent.size());
     for (uint32_t v = 0; v < pieces.size(); ++v) pieces[v] = root(v);
     return pieces;
+}
+
+std::vector<uint32_t> MeshTopology::edgeConnectedPieces(const std::vector<Triangle>& triangles) const {
+    std::vector<uint32_t> parent(triangles.size());
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto root = [&](uint32_t t) {
+        while (parent[t] != t) t = parent[t] = parent[parent[t]];
+        return t;
+    };
+    // Every edge (welded) with the triangles that use it; (0, 0) until a first, then a second.
+    std::map<std::pair<uint32_t, uint32_t>, std::pair<uint32_t, uint32_t>> users;
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> useCount;
+    for (uint32_t t = 0; t < triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t a = weldedId(triangles[t].v[k]), b = weldedId(triangles[t].v[(k + 1) % 3]);
+            if (a == b) continue;
+            const auto edge = std::minmax(a, b);
+            const uint32_t n = ++useCount[edge];
+            if (n == 1) users[edge].first = t;
+            else if (n == 2) users[edge].second = t;
+        }
+    // Joined across edges that exactly two triangles use: an edge with a third is where one
+    // surface stands on another (a block's foot along a row of floor edges), not where one turns.
+    for (const auto& [edge, count] : useCount) {
+        if (count != 2) continue;
+        const auto& [t0, t1] = users[edge];
+        // The smaller root stays: every piece is named by its smallest triangle.
+        const uint32_t ra = root(t0), rb = root(t1);
+        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    std::vector<uint32_t> piece(triangles.size());
+    for (uint32_t t = 0; t < triangles.size(); ++t) piece[t] = root(t);
+    return piece;
 }
 
 }  // namespace qsgi

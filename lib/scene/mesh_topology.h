@@ -24,6 +24,12 @@ public:
     // Each vertex's piece of surface: the vertices joined to it through triangles and welds, named
     // by the piece's smallest vertex index, so the numbering depends on the geometry alone.
     std::vector<uint32_t> vertexPieces(const std::vector<Triangle>& triangles) const;
+    // Each triangle's piece of surface joined across edges (welded) that exactly two triangles use,
+    // whatever their crease, named by the piece's smallest triangle index: a block standing on a
+    // floor, a panel under a ceiling and a character's foot are pieces of their own even where a
+    // corner meets a floor vertex or a foot runs along a row of floor edges (used by three); a
+    // box's walls are one.
+    std::vector<uint32_t> edgeConnectedPieces(const std::vector<Triangle>& triangles) const;
 
 private:
     std::vector<uint32_t> welded_;
