@@ -58,7 +58,7 @@ std::vector<Row> readCsv(const fs::path& path, std::vector<std::string>& header)
 fs::path tinyConfigWithBothSamplers(const fs::path& dir) {
     const fs::path data = sourceDir() / "tests" / "data";
     nlohmann::json config = nlohmann::json::parse(readFileBytes(data / "sweep-tiny.json"));
-    for (const char* key : {"scene", "animation", "reference"})
+    for (const char* key : {"scene", "animation", "reference", "surface_reference"})
         config[key] = (data / config.at(key).get<std::string>()).lexically_normal().string();
     config["grid"]["samplers"] = {"random", "sobol"};
     const fs::path path = dir / "sweep-tiny-samplers.json";
@@ -111,6 +111,13 @@ TEST(Sweep, TinyGridTabulatesFallingErrorNoNonFiniteValuesAndResumesWithoutRecom
         EXPECT_EQ(r.at("nan_count"), "0");
         EXPECT_EQ(r.at("inf_count"), "0");
         EXPECT_TRUE(std::isfinite(std::stod(r.at("rms_all")))) << r.at("rms_all");
+        // Scored over the surface too (the config's surface reference): every band counted, the
+        // bands partitioning the visible points.
+        EXPECT_TRUE(std::isfinite(std::stod(r.at("surface_rms_all")))) << r.at("surface_rms_all");
+        EXPECT_EQ(std::stoi(r.at("surface_points_contact")) + std::stoi(r.at("surface_points_edge")) +
+                      std::stoi(r.at("surface_points_interior")),
+                  std::stoi(r.at("surface_points_all")));
+        EXPECT_GT(std::stoi(r.at("surface_points_contact")), 0);
         EXPECT_TRUE(r.at("sampler") == "random" || r.at("sampler") == "sobol") << r.at("sampler");
         // qsgi's own record of K: none under random, its default under plain "sobol".
         EXPECT_EQ(r.at("qmc_bounces").empty(), r.at("sampler") == "random") << r.at("qmc_bounces");

@@ -33,7 +33,7 @@ import re
 ESTIMATORS = ("impact-count", "photon-map", "photon-map:paper", "detp", "detp:clip", "detp:linear", "detp:paper")
 DEFAULT_K = 50
 DEFAULT_RADIUS_FRACTION = 0.015  # qsgi's default radius (render_settings.cpp: defaultRadius)
-KNOWN_KEYS = {"scene", "animation", "reference", "frames", "seeds", "grid", "extremes", "quick",
+KNOWN_KEYS = {"scene", "animation", "reference", "surface_reference", "frames", "seeds", "grid", "extremes", "quick",
               "reference_build", "jobs"}
 GRID_KEYS = {"photons", "radius_fraction", "k", "estimators", "full_recompute_radius_fraction", "samplers",
              "direct", "gather", "direct_samples"}
@@ -137,6 +137,9 @@ class SweepConfig:
     reference_build: dict   # photons, seeds, radius_fraction of the built reference
     points: list
     jobs: int
+    # A surface reference of frame 0 (scripts/reference.py --surface N), or "": each point is also
+    # scored where the eye looks, its irradiance interpolated at the reference's points (issue 47).
+    surface_reference: str = ""
 
 
 def _fail(path, where, problem):
@@ -330,4 +333,5 @@ def load(path: str, quick: bool) -> SweepConfig:
     return SweepConfig(path=os.path.abspath(path), scene=input_file("scene", True),
                        animation=input_file("animation", False), reference=input_file("reference", False),
                        frames=frames, seeds=tuple(seeds), reference_build=build, points=unique,
-                       jobs=_count(path, "jobs", raw.get("jobs", 1), 1, 256))
+                       jobs=_count(path, "jobs", raw.get("jobs", 1), 1, 256),
+                       surface_reference=input_file("surface_reference", False))

@@ -30,7 +30,8 @@ from . import ply
 from .grid import DEFAULT_RADIUS_FRACTION
 from .output_folder import open_folder, open_subfolder, write_file
 
-RESULT_VERSION = 2  # 2: points have a sampler (results of 1 came from qsgi before Sobol: random photons)
+RESULT_VERSION = 3  # 2: points have a sampler (results of 1 came from qsgi before Sobol: random photons);
+# 3: the surface figures (a result of 2 has none, whether or not the config names a surface reference)
 
 
 class Occupancy:
@@ -299,6 +300,14 @@ class Sweep:
             result[f"rms_{region}"] = errors[region]["relative_rms"]
             result[f"bias_{region}"] = errors[region]["relative_bias"]
             result[f"vertices_{region}"] = errors[region]["vertices"]
+        if self.config.surface_reference:
+            # Where the eye looks: frame 0's irradiance interpolated at the surface reference's points.
+            surface = self.qsgi.compare(frame0, self.config.surface_reference, radius)
+            for band in ("all", "contact", "edge", "interior"):
+                result[f"surface_rms_{band}"] = surface[band]["relative_rms"]
+                result[f"surface_points_{band}"] = surface[band]["points"]
+            result["surface_rms_all_without_noise"] = surface["all"]["relative_rms_without_noise"]
+            result["surface_reference_noise"] = surface["all"]["reference_noise"]
         result.update(_frame_seconds(timing))
         return result
 

@@ -14,6 +14,11 @@ COLUMNS = [
     "rms_all", "bias_all", "rms_edge", "bias_edge", "rms_near_edge", "bias_near_edge", "rms_interior",
     "bias_interior", "noise", "edge_radius", "vertices_all", "vertices_edge", "vertices_near_edge",
     "vertices_interior",
+    # over the surface (with "surface_reference"): frame 0's irradiance interpolated across its
+    # triangles at the reference's points, by band, and the reference's own noise
+    "surface_rms_all", "surface_rms_all_without_noise", "surface_reference_noise", "surface_rms_contact",
+    "surface_rms_edge", "surface_rms_interior", "surface_points_all", "surface_points_contact", "surface_points_edge",
+    "surface_points_interior",
     # stability
     "nan_count", "inf_count",
     # time (seconds, from timing.json; frame = photon update + density estimation + the second pass:
