@@ -71,16 +71,13 @@ std::vector<bool> touchingOtherSurfaces(const std::vector<Vec3f>& positions, con
     const double tolerance2 = double(tolerance) * double(tolerance);
     for (uint32_t v = 0; v < positions.size(); ++v) {
         const Vec3d p(positions[v]);
-        for (uint32_t t : grid.near(p)) {
+        touching[v] = grid.anyNear(p, [&](uint32_t t) {
             // Its own triangles (at its welded position) do not count.
-            if (std::binary_search(topology.trianglesBegin(v), topology.trianglesEnd(v), t)) continue;
+            if (std::binary_search(topology.trianglesBegin(v), topology.trianglesEnd(v), t)) return false;
             const Triangle& tri = triangles[t];
-            if (squaredDistanceToTriangle(p, Vec3d(positions[tri.v[0]]), Vec3d(positions[tri.v[1]]), Vec3d(positions[tri.v[2]])) <=
-                tolerance2) {
-                touching[v] = true;
-                break;
-            }
-        }
+            return squaredDistanceToTriangle(p, Vec3d(positions[tri.v[0]]), Vec3d(positions[tri.v[1]]), Vec3d(positions[tri.v[2]])) <=
+                   tolerance2;
+        });
     }
     return touching;
 }

@@ -20,19 +20,22 @@ void fillCoveredFirstPass(const Scene& scene, const std::vector<uint8_t>& covere
                 if (topology.weldedId(u) != topology.weldedId(v) && dot(scene.normals[u], scene.normals[v]) > kOwnSurfaceCos)
                     visit(u);
     };
+    // Ring by ring: a ring's covered vertices take the mean of their neighbours known before it
+    // (the order within a ring changes nothing); the next ring is every covered vertex not yet
+    // known that neighbours one filled now, with those of this ring that had no known neighbour
+    // (a split twin reached through its twin's triangles) asked again. It ends when a ring fills
+    // none.
     std::vector<uint32_t> ring;
     for (uint32_t v = 0; v < n; ++v) {
-        if (!covered[v]) continue;
+        if (!covered[v] || known[v]) continue;
         bool nearKnown = false;
         forEachNeighbour(v, [&](uint32_t u) { nearKnown = nearKnown || known[u]; });
         if (nearKnown) ring.push_back(v);
     }
     std::vector<uint8_t> queued(n, 0);
-    for (uint32_t v : ring) queued[v] = 1;
     std::vector<Vec3f> values;
     std::vector<uint8_t> filled;
     while (!ring.empty()) {
-        // Every value of a ring from the rings before it only: the order within a ring changes nothing.
         values.assign(ring.size(), Vec3f(0.0f));
         filled.assign(ring.size(), 0);
         for (size_t i = 0; i < ring.size(); ++i) {
@@ -43,24 +46,32 @@ void fillCoveredFirstPass(const Scene& scene, const std::vector<uint8_t>& covere
                 sum += Vec3d(firstPass[u]);
                 ++count;
             });
-            // None known (a split twin reached through its twin's triangles): it keeps its value.
             if (count == 0) continue;
             values[i] = Vec3f(sum / double(count));
             filled[i] = 1;
         }
-        std::vector<uint32_t> next;
+        bool any = false;
         for (size_t i = 0; i < ring.size(); ++i) {
             if (!filled[i]) continue;
             firstPass[ring[i]] = values[i];
             known[ring[i]] = 1;
+            any = true;
         }
-        for (uint32_t v : ring)
-            forEachNeighbour(v, [&](uint32_t u) {
+        if (!any) break;
+        std::vector<uint32_t> next;
+        for (size_t i = 0; i < ring.size(); ++i) {
+            if (!filled[i]) {
+                if (!queued[ring[i]]) queued[ring[i]] = 1, next.push_back(ring[i]);
+                continue;
+            }
+            forEachNeighbour(ring[i], [&](uint32_t u) {
                 if (covered[u] && !known[u] && !queued[u]) {
                     queued[u] = 1;
                     next.push_back(u);
                 }
             });
+        }
+        for (uint32_t u : next) queued[u] = 0;  // it only keeps a ring free of repeats
         ring = std::move(next);
     }
 }

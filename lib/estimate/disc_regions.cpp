@@ -7,7 +7,6 @@
 #include <array>
 #include <bitset>
 #include <cmath>
-#include <limits>
 #include <optional>
 
 #include "estimate/own_surface.h"
@@ -314,14 +313,19 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     // comes from the open side, so try a step to each side and keep the one that sees most —
     // of those outside closed geometry first: a step into a block standing on the line (a floor
     // vertex on its foot) "reaches" the cells under the block through the block's inside, and may
-    // tie with the step outward; a start whose ray along n_v first meets a back face is inside.
+    // tie with the step outward. A step that crossed a surface from its front — the ray back from
+    // the side start toward v's lifted point, twice the step long, meets a back face — went in.
+    // The ray stays within two side steps of v, inside the region a move's recompute covers
+    // (touchedBy), so an update decides as a full recomputation does.
     bool bestOutside = false;
-    for (const Vec3f& sideStart : sideStarts) {
+    for (int k = 0; k < 4; ++k) {
+        const Vec3f& sideStart = sideStarts[k];
         VertexDisc candidate = discFrom(sideStart, disc, v, scene, bvh, frontNormals, radius, withCoverage, own, shortcuts);
         if (!(candidate.reachableArea > 0)) continue;
-        const auto up = bvh.intersect(sideStart, normal, 0.0f, std::numeric_limits<float>::infinity());
+        const Vec3f back(-sides[k]);
+        const auto crossed = bvh.intersect(sideStart, back, 0.0f, float(2 * sideStep));
         ++tally.rays;
-        const bool outside = !up || dot(frontNormals[up->triangle], normal) < 0;
+        const bool outside = !crossed || dot(frontNormals[crossed->triangle], back) < 0;
         if (outside != bestOutside ? outside : candidate.reachableArea > best.reachableArea) {
             best = std::move(candidate);
             bestOutside = outside;

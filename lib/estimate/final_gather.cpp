@@ -180,17 +180,18 @@ void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const Vert
 }
 
 namespace {
-bool mostlyBackFaces(const GatherHit* hits, uint32_t count) {
-    uint32_t back = 0;
-    for (uint32_t j = 0; j < count; ++j) back += hits[j].triangle == GatherHit::kBackFace;
-    return 2 * back > count;
+bool allBackFaces(const GatherHit* hits, uint32_t count) {
+    if (count == 0) return false;
+    for (uint32_t j = 0; j < count; ++j)
+        if (hits[j].triangle != GatherHit::kBackFace) return false;
+    return true;
 }
 }  // namespace
 
 std::vector<uint8_t> FinalGather::coveredFromKept(const Scene& scene) const {
     std::vector<uint8_t> covered(scene.vertexCount(), 0);
     if (rays_ == 0 || probeHits_.empty()) return covered;
-    for (uint32_t v = 0; v < covered.size(); ++v) covered[v] = mostlyBackFaces(&probeHits_[size_t(v) * probes_], coverRays());
+    for (uint32_t v = 0; v < covered.size(); ++v) covered[v] = allBackFaces(&probeHits_[size_t(v) * probes_], coverRays());
     return covered;
 }
 
@@ -202,7 +203,7 @@ std::vector<uint8_t> FinalGather::castCovered(const Scene& scene, const SceneBvh
         GatherHit hits[kCoverRays];
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             castVertexInto(scene, bvh, starts, frontNormals, v, 0, coverRays(), hits);
-            covered[v] = mostlyBackFaces(hits, coverRays());
+            covered[v] = allBackFaces(hits, coverRays());
         }
     });
     return covered;

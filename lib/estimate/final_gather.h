@@ -76,12 +76,14 @@ public:
     // Drops every kept hit.
     void clear();
 
-    // Covered vertices (docs/design.md §5.1): more than half of v's first coverRays() gather rays
-    // meet a back face — its start point lies inside closed geometry (the floor under a block
-    // standing on it). Read from the kept hits (every vertex keeps its probes, which hold those
-    // rays) or, for castAndGather, which keeps none, cast afresh: the same rays, the same answer.
+    // Covered vertices (docs/design.md §5.1): every one of v's first coverRays() gather rays meets
+    // a back face — its start point lies inside closed geometry (the floor under a block standing
+    // on it). Not a vertex under a single-sided sheet (a table top facing up): its grazing rays
+    // escape or meet front faces. Read from the kept hits (every vertex keeps its probes, which
+    // hold those rays) or, for castAndGather, which keeps none, cast afresh: the same rays, the
+    // same answer.
     static constexpr uint32_t kCoverRays = 16;
-    uint32_t coverRays() const { return std::min(rays_, kCoverRays); }
+    uint32_t coverRays() const { return std::min({rays_, probes_, kCoverRays}); }
     std::vector<uint8_t> coveredFromKept(const Scene& scene) const;
     std::vector<uint8_t> castCovered(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts) const;
 

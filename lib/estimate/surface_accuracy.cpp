@@ -1,6 +1,8 @@
 #include "estimate/surface_accuracy.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -44,7 +46,10 @@ SurfaceErrorStats statsOf(const std::vector<Vec3f>& interpolated, const std::vec
         }
         ++s.points;
     }
-    if (s.points == 0) return s;
+    if (s.points == 0) {  // nothing to score: no figure, not a perfect one
+        s.relativeRms = s.relativeBias = s.referenceNoise = s.withoutNoise = std::numeric_limits<double>::quiet_NaN();
+        return s;
+    }
     const double n = 3.0 * double(s.points);
     const double scale = reference / n > 0 ? reference / n : 1.0;
     s.relativeRms = std::sqrt(squared / n) / scale;
@@ -67,17 +72,18 @@ std::vector<PointOnMesh> locateOnMesh(const std::vector<Vec3f>& positions, const
         const Vec3f n = points[i].normal;
         int64_t best = -1;
         double bestFacing = 0, bestDistance = 0;
-        for (uint32_t t : grid.near(p)) {
+        grid.anyNear(p, [&](uint32_t t) {
             const Triangle& T = triangles[t];
             const double d2 = squaredDistanceToTriangle(p, Vec3d(positions[T.v[0]]), Vec3d(positions[T.v[1]]), Vec3d(positions[T.v[2]]));
-            if (!(d2 <= tolerance * tolerance)) continue;
+            if (!(d2 <= tolerance * tolerance)) return false;
             const double facing = double(dot(frontFaceNormal(positions, normals, T), n));
             if (best < 0 || facing > bestFacing + 1e-6 || (facing >= bestFacing - 1e-6 && d2 < bestDistance)) {
                 best = t;
                 bestFacing = facing;
                 bestDistance = d2;
             }
-        }
+            return false;
+        });
         if (best < 0)
             throw std::invalid_argument("point " + std::to_string(i) + " lies on no triangle of the frame (none within " +
                                         std::to_string(tolerance) + "): drawn on another scene or pose");
@@ -105,14 +111,11 @@ std::vector<SurfaceBand> surfaceBands(const std::vector<Vec3f>& positions, const
     for (size_t i = 0; i < located.size(); ++i) {
         const uint32_t own = piece.at(located[i].triangle);
         const Vec3d p = pointOn(positions, triangles[located[i].triangle], located[i].b1, located[i].b2);
-        bool contact = false;
-        for (uint32_t t : grid.near(p)) {
-            if (piece[t] == own) continue;
+        const bool contact = grid.anyNear(p, [&](uint32_t t) {
             const Triangle& T = triangles[t];
-            if ((contact = squaredDistanceToTriangle(p, Vec3d(positions[T.v[0]]), Vec3d(positions[T.v[1]]), Vec3d(positions[T.v[2]])) <=
-                           width2))
-                break;
-        }
+            return piece[t] != own &&
+                   squaredDistanceToTriangle(p, Vec3d(positions[T.v[0]]), Vec3d(positions[T.v[1]]), Vec3d(positions[T.v[2]])) <= width2;
+        });
         if (contact) band[i] = SurfaceBand::Contact;
         else if (edges.within(Vec3f(p))) band[i] = SurfaceBand::Edge;
     }

@@ -58,6 +58,8 @@ std::vector<SurfaceBand> surfaceBands(const std::vector<Vec3f>& positions, const
                                       const std::vector<Triangle>& triangles, const std::vector<PointOnMesh>& located,
                                       float width);
 
+// NaN figures where no point counts (an empty band): no figure, not a perfect one. A reference whose
+// mean is 0 (a black scene) gives absolute figures, as ErrorStats does.
 struct SurfaceErrorStats {
     size_t points = 0;
     double relativeRms = 0;     // sqrt(mean |E_interp − E_ref|²) / mean |E_ref|, over points and RGB

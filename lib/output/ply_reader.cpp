@@ -175,13 +175,19 @@ struct PlyRows {
     double value(size_t row, const PlyProperty& p) const { return readScalar(data.data() + row * stride + p.offset, p.type); }
 };
 
-PlyRows readFirstElementRows(const std::string& path, std::ifstream& in, const PlyElement& element) {
+// The first element's properties with their offsets in a row, and the row's size.
+PlyRows layoutOf(const PlyElement& element) {
     PlyRows rows;
     rows.properties = element.properties;
     for (PlyProperty& p : rows.properties) {
         p.offset = rows.stride;
         rows.stride += sizeOfType(p.type);
     }
+    return rows;
+}
+
+// Reads the rows of `rows`' layout (layoutOf), every property finite.
+void readFirstElementRows(const std::string& path, std::ifstream& in, const PlyElement& element, PlyRows& rows) {
     const size_t count = size_t(element.count);
     if (count > (size_t(1) << 31)) throw InputError(path, "header", "implausible " + element.name + " count");
     rows.data.resize(count * rows.stride);
@@ -194,7 +200,6 @@ PlyRows readFirstElementRows(const std::string& path, std::ifstream& in, const P
                 throw InputError(path, element.name + " " + std::to_string(r),
                                  "property '" + p.name + "' is " + number(value) + ", not a finite number");
         }
-    return rows;
 }
 
 }  // namespace
@@ -202,8 +207,9 @@ PlyRows readFirstElementRows(const std::string& path, std::ifstream& in, const P
 VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     std::ifstream in;
     const std::vector<PlyElement> elements = readHeader(path, in, "vertex");
-    // Vertices: every property of every vertex finite, the nine qsgi reads within float's range.
-    const PlyRows rows = readFirstElementRows(path, in, elements[0]);
+    // Vertices: every property of every vertex finite, the nine qsgi reads within float's range
+    // (the properties are looked for before any row is read).
+    PlyRows rows = layoutOf(elements[0]);
     auto find = [&](const char* name) -> const PlyProperty& {
         if (const PlyProperty* p = rows.find(name)) return *p;
         throw InputError(path, "header", std::string("has no vertex property '") + name + "'");
@@ -215,6 +221,7 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     const PlyProperty* irradiance[3] = {rows.find("irradiance_r"), rows.find("irradiance_g"), rows.find("irradiance_b")};
     const bool hasIrradiance = irradiance[0] && irradiance[1] && irradiance[2];
     const PlyProperty* referenced = rows.find("referenced");
+    readFirstElementRows(path, in, elements[0], rows);
     const size_t vertexCount = size_t(elements[0].count);
     VertexRadiosityPly out;
     out.positions.resize(vertexCount);
@@ -294,7 +301,8 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
 SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
     std::ifstream in;
     const std::vector<PlyElement> elements = readHeader(path, in, "point");
-    const PlyRows rows = readFirstElementRows(path, in, elements[0]);
+    if (elements[0].count == 0) throw InputError(path, "header", "has no points: nothing to score");
+    PlyRows rows = layoutOf(elements[0]);
     auto find = [&](const std::string& name) -> const PlyProperty& {
         if (const PlyProperty* p = rows.find(name)) return *p;
         throw InputError(path, "header", "has no point property '" + name + "'");
@@ -305,6 +313,7 @@ SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
     const PlyProperty* normal[3] = {&find("nx"), &find("ny"), &find("nz")};
     const PlyProperty* irradiance[3] = {&find("irradiance_r"), &find("irradiance_g"), &find("irradiance_b")};
     const PlyProperty* standardError[3] = {&find("stderr_r"), &find("stderr_g"), &find("stderr_b")};
+    readFirstElementRows(path, in, elements[0], rows);
     SurfaceReferencePly out;
     out.points.resize(size_t(elements[0].count));
     for (size_t i = 0; i < out.points.size(); ++i) {

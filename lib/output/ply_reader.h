@@ -23,8 +23,10 @@ struct VertexRadiosityPly {
 // Throws InputError naming the file for anything it cannot read.
 VertexRadiosityPly readVertexRadiosityPly(const std::string& path);
 
-// A surface reference (scripts/reference.py --surface N): `element point N` with the properties
-// SurfacePoint names (x y z and the normal are read by the scripts only).
+// A surface reference (scripts/reference.py --surface N): `element point N` (N ≥ 1) with the
+// properties SurfacePoint holds: int triangle, float b1 b2 x y z nx ny nz irradiance_r/g/b
+// stderr_r/g/b, uchar hidden. `qsgi compare` finds each point on the frame by x y z and the normal
+// (surface_accuracy.h); the triangle and barycentrics are checked, and read by the scripts.
 struct SurfaceReferencePly {
     std::vector<SurfacePoint> points;
 };

@@ -121,6 +121,13 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         refineMesh(scene_, settings_.subdivide);
     }
     if (settings_.refineContacts > 0) {
+        const double size = double(scene_.bounds().extent());
+        if (double(settings_.refineContacts) < 1e-4 * size) {
+            char text[200];
+            std::snprintf(text, sizeof text, "%g is below 1e-4 of the scene's size (%g): its contact lines would be refined into more "
+                          "triangles than a run can hold", double(settings_.refineContacts), size);
+            throw InputError("refine_contacts (--refine-contacts)", "", text);
+        }
         const std::optional<ContactRefinementReport> refined =
             refineContacts(scene_, settings_.refineContacts, animation_.lastFrame(), [&](int frame) { return animation_.poseAt(frame); },
                            size_t(kMaxRefinedTriangles));

@@ -10,6 +10,7 @@ namespace qsgi {
 
 namespace {
 constexpr double kTrackBudgetBytes = double(1u << 30);
+constexpr double kMostSamples = 4096;
 
 // The frames judged: all of 0…lastFrame, or as many evenly spaced (first and last kept) as the budget holds.
 std::vector<int> framesJudged(int lastFrame, size_t vertices) {
@@ -62,16 +63,23 @@ std::optional<ContactRefinementReport> refineContacts(Scene& scene, double dista
     const double d2 = distance * distance, fine = kContactEdgeShare * distance;
     const std::vector<Triangle>& triangles = scene.triangles;
     auto nearOtherPiece = [&](const TriangleGrid& grid, const std::vector<Vec3f>& pose, const Vec3d& p, uint32_t piece) {
-        for (uint32_t t : grid.near(p)) {
-            if (tracks.pieces[t] == piece) continue;
+        return grid.anyNear(p, [&](uint32_t t) {
             const Triangle& T = triangles[t];
-            if (squaredDistanceToTriangle(p, Vec3d(pose[T.v[0]]), Vec3d(pose[T.v[1]]), Vec3d(pose[T.v[2]])) <= d2) return true;
-        }
-        return false;
+            return tracks.pieces[t] != piece &&
+                   squaredDistanceToTriangle(p, Vec3d(pose[T.v[0]]), Vec3d(pose[T.v[1]]), Vec3d(pose[T.v[2]])) <= d2;
+        });
     };
     const EdgeSplitTest needs = [&](const EdgeToSplit& e) {
         if (!(e.length > fine)) return false;
-        const int steps = int(std::ceil(e.length / (0.5 * fine)));
+        // Points at most DISTANCE/4 apart in every pose (a deforming edge may be longer in some).
+        double longest = e.length;
+        for (size_t k = 0; k < e.a.size(); ++k) longest = std::max(longest, length(Vec3d(e.b[k]) - Vec3d(e.a[k])));
+        const double spacing = 0.5 * fine;
+        // An edge more than kMostSamples spacings long is split without asking (its halves are
+        // asked in turn): no point it could pass near is skipped, and the count of samples stays
+        // bounded whatever DISTANCE is.
+        if (!(longest <= kMostSamples * spacing)) return true;
+        const int steps = std::max(1, int(std::ceil(longest / spacing)));
         bool edgeMoves = false;
         for (size_t k = 1; k < e.a.size() && !edgeMoves; ++k) edgeMoves = !(e.a[k] == e.a[0]) || !(e.b[k] == e.b[0]);
         for (size_t k = 0; k < e.a.size(); ++k) {

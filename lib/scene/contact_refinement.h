@@ -11,9 +11,11 @@
 // the floor along a mover's path is refined), on the unrefined geometry's poses; an edge's place in a
 // pose is its corners' there, a new vertex its edge's midpoint (exact for rigid movers, the
 // skinned mesh's chord for a deforming one). Distance is measured at points along the edge no more
-// than DISTANCE / 4 apart, so an edge passing nearer than DISTANCE only between them is missed by at
-// most that much. Where the poses' positions would take more than 1 GiB, evenly spaced frames are
-// judged (the first and last always).
+// than DISTANCE / 4 apart in any pose, so an edge passing nearer than DISTANCE only between them is
+// missed by at most DISTANCE / 8; an edge longer than 4096 such spacings is split without asking
+// (its halves are asked). Where the poses' positions would take more than 1 GiB, evenly spaced
+// frames are judged (the first and last always). RenderJob refuses a DISTANCE below 10⁻⁴ of the
+// scene's size, which would refine contact lines into more triangles than any run can hold.
 #pragma once
 
 #include <cstddef>

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -58,8 +59,10 @@ public:
             changed = false;
             std::vector<LocalTriangle> next;
             std::vector<uint32_t> nextPiece;
-            next.reserve(triangles_.size() * 2);
+            next.reserve(std::min(triangles_.size() * 2, triangleLimit == SIZE_MAX ? triangles_.size() * 2 : triangleLimit + 2));
             for (size_t i = 0; i < triangles_.size(); ++i) {
+                // Refused as soon as the limit is passed, not after a pass that may double the mesh.
+                if (next.size() > triangleLimit) return false;
                 const LocalTriangle& t = triangles_[i];
                 const int e = edgeToSplit(t, [&](double len, uint32_t a, uint32_t b) { return needs(len, piece_[i], a, b); });
                 if (e < 0) {
@@ -246,6 +249,11 @@ std::optional<RefinementReport> refineMeshWhere(Scene& scene, const RefinementTr
             [&](double len, uint32_t piece, uint32_t p, uint32_t q) {
                 const auto [it, added] = decided.emplace(uint64_t(p) << 32 | q, false);
                 if (!added) return it->second;
+                // The corners in the order of their places, not their indices: the two sides of a
+                // seam (corners duplicated for their normals) ask about the same edge with the same
+                // floats, and so agree to the bit.
+                const Vec3f &pAt = refiner.tracked(0, p), &qAt = refiner.tracked(0, q);
+                if (std::tie(qAt.x, qAt.y, qAt.z) < std::tie(pAt.x, pAt.y, pAt.z)) std::swap(p, q);
                 for (size_t k = 0; k < a.size(); ++k) a[k] = refiner.tracked(k, p), b[k] = refiner.tracked(k, q);
                 return it->second = needs(EdgeToSplit{i, piece, len, a, b});
             },

@@ -65,7 +65,8 @@ struct RefinementTracks {
 
 // An edge refineMeshWhere asks about: of scene instance `instance`, its triangles of `piece`, its
 // `length` in the current pose, and its corners' world positions in each tracked pose (a[k], b[k]:
-// the corners in the order of their indices, the same from both its triangles).
+// the corners in the order of their places in the current pose, so that both its triangles, and
+// both sides of a seam, ask with the same floats).
 struct EdgeToSplit {
     size_t instance;
     uint32_t piece;

@@ -19,6 +19,7 @@ TriangleGrid::TriangleGrid(const std::vector<Vec3f>& positions, const std::vecto
         ++count;
     }
     if (count == 0) return;
+    bounds_ = bounds_.expanded(reach);
     meanSize /= double(count);
     const double extent = std::max(double(maxComponent(bounds_.diagonal())), 1e-30);
     cell_ = std::max({meanSize, double(reach), extent / 1024.0});
@@ -28,21 +29,28 @@ TriangleGrid::TriangleGrid(const std::vector<Vec3f>& positions, const std::vecto
         Bounds3f b;
         for (uint32_t v : triangles[t].v) b.extend(positions[v]);
         b = b.expanded(reach);
-        for (int64_t x = cellOf(b.lower.x, 0); x <= cellOf(b.upper.x, 0); ++x)
-            for (int64_t y = cellOf(b.lower.y, 1); y <= cellOf(b.upper.y, 1); ++y)
-                for (int64_t z = cellOf(b.lower.z, 2); z <= cellOf(b.upper.z, 2); ++z)
+        const int64_t x0 = cellOf(b.lower.x, 0), x1 = cellOf(b.upper.x, 0), y0 = cellOf(b.lower.y, 1), y1 = cellOf(b.upper.y, 1),
+                      z0 = cellOf(b.lower.z, 2), z1 = cellOf(b.upper.z, 2);
+        if (double(x1 - x0 + 1) * double(y1 - y0 + 1) * double(z1 - z0 + 1) > double(kMostCells)) {
+            large_.push_back(t);
+            continue;
+        }
+        for (int64_t x = x0; x <= x1; ++x)
+            for (int64_t y = y0; y <= y1; ++y)
+                for (int64_t z = z0; z <= z1; ++z)
                     cells_[uint64_t(x & 0x1FFFFF) << 42 | uint64_t(y & 0x1FFFFF) << 21 | uint64_t(z & 0x1FFFFF)].push_back(t);
     }
+}
+
+bool TriangleGrid::inside(const Vec3d& p) const {
+    // Written so that NaN is outside.
+    return p.x >= bounds_.lower.x && p.x <= bounds_.upper.x && p.y >= bounds_.lower.y && p.y <= bounds_.upper.y &&
+           p.z >= bounds_.lower.z && p.z <= bounds_.upper.z;
 }
 
 uint64_t TriangleGrid::key(const Vec3d& p) const {
     auto cellOf = [&](double x, int axis) { return int64_t(std::floor((x - double(bounds_.lower[axis])) / cell_)); };
     return uint64_t(cellOf(p.x, 0) & 0x1FFFFF) << 42 | uint64_t(cellOf(p.y, 1) & 0x1FFFFF) << 21 | uint64_t(cellOf(p.z, 2) & 0x1FFFFF);
-}
-
-const std::vector<uint32_t>& TriangleGrid::near(const Vec3d& p) const {
-    const auto it = cells_.find(key(p));
-    return it == cells_.end() ? none_ : it->second;
 }
 
 double squaredDistanceToTriangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {

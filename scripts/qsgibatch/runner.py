@@ -303,11 +303,13 @@ class Sweep:
         if self.config.surface_reference:
             # Where the eye looks: frame 0's irradiance interpolated at the surface reference's points.
             surface = self.qsgi.compare(frame0, self.config.surface_reference, radius)
+            def figure(value):  # an empty band has none (null), not 0
+                return math.nan if value is None else value
             for band in ("all", "contact", "edge", "interior"):
-                result[f"surface_rms_{band}"] = surface[band]["relative_rms"]
+                result[f"surface_rms_{band}"] = figure(surface[band]["relative_rms"])
                 result[f"surface_points_{band}"] = surface[band]["points"]
-            result["surface_rms_all_without_noise"] = surface["all"]["relative_rms_without_noise"]
-            result["surface_reference_noise"] = surface["all"]["reference_noise"]
+            result["surface_rms_all_without_noise"] = figure(surface["all"]["relative_rms_without_noise"])
+            result["surface_reference_noise"] = figure(surface["all"]["reference_noise"])
         result.update(_frame_seconds(timing))
         return result
 
