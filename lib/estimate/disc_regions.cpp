@@ -313,19 +313,22 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     // comes from the open side, so try a step to each side and keep the one that sees most —
     // of those outside closed geometry first: a step into a block standing on the line (a floor
     // vertex on its foot) "reaches" the cells under the block through the block's inside, and may
-    // tie with the step outward. A step that crossed a surface from its front — the ray back from
-    // the side start toward v's lifted point, twice the step long, meets a back face — went in.
-    // The ray stays within two side steps of v, inside the region a move's recompute covers
-    // (touchedBy), so an update decides as a full recomputation does.
+    // tie with the step outward. A start is inside when a ray from it along any of the four side
+    // directions, two steps long, first meets a back face: the step that crossed the block's wall
+    // sees it from behind on the way back, and so does a step along the wall from a lifted point
+    // that rounding put a hair inside. The rays stay within three side steps of v, inside the
+    // region a move's recompute covers (touchedBy), so an update decides as a full one does.
     bool bestOutside = false;
-    for (int k = 0; k < 4; ++k) {
-        const Vec3f& sideStart = sideStarts[k];
+    for (const Vec3f& sideStart : sideStarts) {
         VertexDisc candidate = discFrom(sideStart, disc, v, scene, bvh, frontNormals, radius, withCoverage, own, shortcuts);
         if (!(candidate.reachableArea > 0)) continue;
-        const Vec3f back(-sides[k]);
-        const auto crossed = bvh.intersect(sideStart, back, 0.0f, float(2 * sideStep));
-        ++tally.rays;
-        const bool outside = !crossed || dot(frontNormals[crossed->triangle], back) < 0;
+        bool outside = true;
+        for (const Vec3d& side : sides) {
+            const Vec3f direction(side);
+            const auto hit = bvh.intersect(sideStart, direction, 0.0f, float(2 * sideStep));
+            ++tally.rays;
+            if (hit && dot(frontNormals[hit->triangle], direction) > 0) outside = false;
+        }
         if (outside != bestOutside ? outside : candidate.reachableArea > best.reachableArea) {
             best = std::move(candidate);
             bestOutside = outside;
