@@ -29,32 +29,47 @@ Pose poseAt(const Scene& scene, int frame) {
     return Pose(locals);
 }
 
-// The least distance from the edge (sampled at 64 points) to a triangle of another piece, by brute
-// force over the triangles whose bounds come within 2 DISTANCE of the edge's (farther: reported as 1).
-double distanceToOtherPieces(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles,
-                             const std::vector<uint32_t>& piece, uint32_t ownPiece, const Vec3f& a, const Vec3f& b) {
-    Bounds3f edge;
-    edge.extend(a);
-    edge.extend(b);
-    edge = edge.expanded(float(2 * kDistance));
-    std::vector<uint32_t> near;
-    for (uint32_t t = 0; t < triangles.size(); ++t) {
-        if (piece[t] == ownPiece) continue;
-        Bounds3f box;
-        for (uint32_t v : triangles[t].v) box.extend(positions[v]);
-        if (box.overlaps(edge)) near.push_back(t);
-    }
-    double least = 1;
-    for (int i = 0; i <= 64 && !near.empty(); ++i) {
-        const Vec3d p = Vec3d(a) + (Vec3d(b) - Vec3d(a)) * (i / 64.0);
-        for (uint32_t t : near) {
-            const Triangle& T = triangles[t];
-            least = std::min(least, std::sqrt(squaredDistanceToTriangle(p, Vec3d(positions[T.v[0]]), Vec3d(positions[T.v[1]]),
-                                                                          Vec3d(positions[T.v[2]]))));
+// A pose of the refined scene with each triangle's bounds, made once.
+struct PosedTriangles {
+    const Scene& scene;
+    const std::vector<uint32_t>& piece;
+    std::vector<Bounds3f> bounds;
+    std::map<std::pair<uint32_t, uint32_t>, double> distances;  // by edge (its corners, in order)
+    PosedTriangles(const Scene& s, const std::vector<uint32_t>& pieces) : scene(s), piece(pieces) {
+        for (const Triangle& T : s.triangles) {
+            Bounds3f box;
+            for (uint32_t v : T.v) box.extend(s.positions[v]);
+            bounds.push_back(box);
         }
     }
-    return least;
-}
+
+    // The least distance from the edge va–vb of a triangle of `ownPiece` (sampled at 64 points) to a
+    // triangle of another piece, by brute force over the triangles whose bounds come within
+    // 2 DISTANCE of the edge's (farther: reported as 1). Each edge is measured once.
+    double distanceToOtherPieces(uint32_t ownPiece, uint32_t va, uint32_t vb) {
+        const auto key = std::minmax(va, vb);
+        if (const auto it = distances.find(key); it != distances.end()) return it->second;
+        const Vec3f &a = scene.positions[va], &b = scene.positions[vb];
+        Bounds3f edge;
+        edge.extend(a);
+        edge.extend(b);
+        edge = edge.expanded(float(2 * kDistance));
+        std::vector<uint32_t> near;
+        for (uint32_t t = 0; t < scene.triangleCount(); ++t)
+            if (piece[t] != ownPiece && bounds[t].overlaps(edge)) near.push_back(t);
+        double least = 1;
+        for (int i = 0; i <= 64 && !near.empty(); ++i) {
+            const Vec3d p = Vec3d(a) + (Vec3d(b) - Vec3d(a)) * (i / 64.0);
+            for (uint32_t t : near) {
+                const Triangle& T = scene.triangles[t];
+                least = std::min(least, std::sqrt(squaredDistanceToTriangle(p, Vec3d(scene.positions[T.v[0]]),
+                                                                              Vec3d(scene.positions[T.v[1]]),
+                                                                              Vec3d(scene.positions[T.v[2]]))));
+            }
+        }
+        return distances[key] = least;
+    }
+};
 
 // Every edge of a piece used by two of its triangles, or by one on its border: the floor's outer
 // edge, the block's foot (its bottom is open). Anything else is a T-junction.
@@ -94,15 +109,14 @@ TEST(ContactRefinement, EdgesNearAnotherPieceInAnyFrameEndShortAndTheRestAreLeft
     moved.applyPose(poseAt(moved, 1));
     // The rule measures at points DISTANCE/4 apart: it may miss by DISTANCE/8 (contact_refinement.h).
     const double sure = kDistance - kDistance / 8;
+    PosedTriangles rest(scene, piece), frame1(moved, piece);
     size_t nearEdges = 0, farLongEdges = 0;
     for (uint32_t t = 0; t < scene.triangleCount(); ++t)
         for (int e = 0; e < 3; ++e) {
             const uint32_t va = scene.triangles[t].v[e], vb = scene.triangles[t].v[(e + 1) % 3];
             const double len = length(Vec3d(scene.positions[vb]) - Vec3d(scene.positions[va]));
-            const double here = distanceToOtherPieces(scene.positions, scene.triangles, piece, piece[t], scene.positions[va],
-                                                      scene.positions[vb]);
-            const double there = distanceToOtherPieces(moved.positions, moved.triangles, piece, piece[t], moved.positions[va],
-                                                       moved.positions[vb]);
+            const double here = rest.distanceToOtherPieces(piece[t], va, vb);
+            const double there = frame1.distanceToOtherPieces(piece[t], va, vb);
             if (std::min(here, there) <= sure) {
                 ++nearEdges;
                 EXPECT_LE(len, kContactEdgeShare * kDistance * (1 + 1e-6)) << "triangle " << t << " edge " << e << ", "

@@ -30,23 +30,14 @@ std::vector<bool> verticesNearCreases(const std::vector<Vec3f>& positions, const
 }
 
 ErrorStats errorStats(const std::vector<Vec3f>& values, const std::vector<Vec3f>& reference, const std::vector<bool>& subset) {
+    RelativeErrorSums sums;
+    for (size_t v = 0; v < values.size() && v < reference.size(); ++v)
+        if (subset.empty() || subset[v]) sums.add(values[v], reference[v]);
     ErrorStats s;
-    double sq = 0, diff = 0, ref = 0;
-    for (size_t v = 0; v < values.size() && v < reference.size(); ++v) {
-        if (!subset.empty() && !subset[v]) continue;
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(values[v][c]) - double(reference[v][c]);
-            sq += d * d;
-            diff += d;
-            ref += std::fabs(double(reference[v][c]));
-        }
-        ++s.vertices;
-    }
+    s.vertices = sums.count;
     if (s.vertices == 0) return s;
-    const double n = 3.0 * double(s.vertices);
-    const double meanRef = ref / n;
-    s.relativeRms = meanRef > 0 ? std::sqrt(sq / n) / meanRef : std::sqrt(sq / n);
-    s.relativeBias = meanRef > 0 ? (diff / n) / meanRef : diff / n;
+    s.relativeRms = sums.relativeRms();
+    s.relativeBias = sums.relativeBias();
     return s;
 }
 

@@ -3,6 +3,7 @@
 // trade that photon count and radius buy.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -45,6 +46,27 @@ std::vector<EdgeRegion> edgeRegions(const std::vector<Vec3f>& positions, const s
 // from theirs (inside corners, convex edges, silhouettes).
 std::vector<bool> verticesNearCreases(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
                                       float distance);
+
+// What ErrorStats and the surface's figures (surface_accuracy.h) are made from: each value against
+// its reference, channel by channel, in the order added; the figures relative to the reference's
+// mean |·| (absolute where that mean is 0).
+struct RelativeErrorSums {
+    double squared = 0, difference = 0, reference = 0;
+    size_t count = 0;  // values added (three channels each)
+    void add(const Vec3f& value, const Vec3f& referenceValue) {
+        for (int c = 0; c < 3; ++c) {
+            const double d = double(value[c]) - double(referenceValue[c]);
+            squared += d * d;
+            difference += d;
+            reference += std::fabs(double(referenceValue[c]));
+        }
+        ++count;
+    }
+    double channels() const { return 3.0 * double(count); }
+    double scale() const { return reference / channels() > 0 ? reference / channels() : 1.0; }
+    double relativeRms() const { return std::sqrt(squared / channels()) / scale(); }
+    double relativeBias() const { return difference / channels() / scale(); }
+};
 
 ErrorStats errorStats(const std::vector<Vec3f>& values, const std::vector<Vec3f>& reference,
                       const std::vector<bool>& subset = {});

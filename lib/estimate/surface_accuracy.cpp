@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "estimate/accuracy.h"
 #include "estimate/mesh_bands.h"
 #include "scene/triangle_grid.h"
 #include "scene/mesh_topology.h"
@@ -13,8 +14,9 @@
 namespace qsgi {
 
 namespace {
-Vec3d pointOn(const std::vector<Vec3f>& positions, const Triangle& t, double b1, double b2) {
-    return Vec3d(positions[t.v[0]]) * (1 - b1 - b2) + Vec3d(positions[t.v[1]]) * b1 + Vec3d(positions[t.v[2]]) * b2;
+// A per-vertex quantity (positions, values) at weights (1 − b1 − b2, b1, b2) of the triangle's corners.
+Vec3d mixedAt(const std::vector<Vec3f>& perVertex, const Triangle& t, double b1, double b2) {
+    return Vec3d(perVertex[t.v[0]]) * (1 - b1 - b2) + Vec3d(perVertex[t.v[1]]) * b1 + Vec3d(perVertex[t.v[2]]) * b2;
 }
 
 // Barycentrics (of corners 1 and 2) of p's projection onto the triangle's plane, clamped into it.
@@ -33,29 +35,23 @@ std::pair<double, double> barycentricsOf(const Vec3d& p, const Vec3d& a, const V
 
 SurfaceErrorStats statsOf(const std::vector<Vec3f>& interpolated, const std::vector<SurfacePoint>& points,
                           const std::vector<uint8_t>& counted) {
-    SurfaceErrorStats s;
-    double squared = 0, difference = 0, reference = 0, noise = 0;
+    RelativeErrorSums sums;
+    double noise = 0;
     for (size_t i = 0; i < points.size(); ++i) {
         if (!counted[i]) continue;
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(interpolated[i][c]) - double(points[i].irradiance[c]);
-            squared += d * d;
-            difference += d;
-            reference += std::fabs(double(points[i].irradiance[c]));
-            noise += double(points[i].standardError[c]) * double(points[i].standardError[c]);
-        }
-        ++s.points;
+        sums.add(interpolated[i], points[i].irradiance);
+        for (int c = 0; c < 3; ++c) noise += double(points[i].standardError[c]) * double(points[i].standardError[c]);
     }
+    SurfaceErrorStats s;
+    s.points = sums.count;
     if (s.points == 0) {  // nothing to score: no figure, not a perfect one
         s.relativeRms = s.relativeBias = s.referenceNoise = s.withoutNoise = std::numeric_limits<double>::quiet_NaN();
         return s;
     }
-    const double n = 3.0 * double(s.points);
-    const double scale = reference / n > 0 ? reference / n : 1.0;
-    s.relativeRms = std::sqrt(squared / n) / scale;
-    s.relativeBias = difference / n / scale;
-    s.referenceNoise = std::sqrt(noise / n) / scale;
-    s.withoutNoise = std::sqrt(std::max(0.0, (squared - noise) / n)) / scale;
+    s.relativeRms = sums.relativeRms();
+    s.relativeBias = sums.relativeBias();
+    s.referenceNoise = std::sqrt(noise / sums.channels()) / sums.scale();
+    s.withoutNoise = std::sqrt(std::max(0.0, (sums.squared - noise) / sums.channels())) / sums.scale();
     return s;
 }
 }  // namespace
@@ -95,8 +91,7 @@ std::vector<PointOnMesh> locateOnMesh(const std::vector<Vec3f>& positions, const
 }
 
 Vec3f interpolatedAt(const std::vector<Triangle>& triangles, const std::vector<Vec3f>& values, const PointOnMesh& at) {
-    const Triangle& t = triangles[at.triangle];
-    return Vec3f(Vec3d(values[t.v[0]]) * (1 - at.b1 - at.b2) + Vec3d(values[t.v[1]]) * at.b1 + Vec3d(values[t.v[2]]) * at.b2);
+    return Vec3f(mixedAt(values, triangles[at.triangle], at.b1, at.b2));
 }
 
 std::vector<SurfaceBand> surfaceBands(const std::vector<Vec3f>& positions, const std::vector<Vec3f>& normals,
@@ -110,7 +105,7 @@ std::vector<SurfaceBand> surfaceBands(const std::vector<Vec3f>& positions, const
     std::vector<SurfaceBand> band(located.size(), SurfaceBand::Interior);
     for (size_t i = 0; i < located.size(); ++i) {
         const uint32_t own = piece.at(located[i].triangle);
-        const Vec3d p = pointOn(positions, triangles[located[i].triangle], located[i].b1, located[i].b2);
+        const Vec3d p = mixedAt(positions, triangles[located[i].triangle], located[i].b1, located[i].b2);
         const bool contact = grid.anyNear(p, [&](uint32_t t) {
             const Triangle& T = triangles[t];
             return piece[t] != own &&

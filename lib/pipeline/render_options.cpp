@@ -96,6 +96,15 @@ void parseEnvironmentMap(const json& j, const OptionSource& src, EnvironmentSett
     e = out;
 }
 
+// A length option that is off at 0 (--subdivide, --refine-contacts): a float whose positive
+// range the declaration checks, refused where float rounds it to 0; null in the log when off.
+float positiveLength(const json& v, const OptionSource& src) {
+    const float length = v.get<float>();
+    if (!(length > 0)) throw InputError(src.file, src.place, "is below single precision's smallest length");
+    return length;
+}
+json lengthOrOff(float length) { return length > 0 ? json(length) : json(nullptr); }
+
 json environmentJson(const EnvironmentSettings& e) {
     if (e.image.empty()) return nullptr;
     return {{"image", pathJson(e.image)}, {"intensity", e.intensity}, {"rotation", e.rotationDegrees}};
@@ -492,22 +501,16 @@ std::vector<RenderOption> declareOptions() {
                  "refine every triangle with an edge longer than LENGTH (scene units) before the bake, once on the "
                  "rest pose, without T-junctions; every output holds the refined mesh (docs/inputs.md: coarse meshes)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource& src) {
-                     s.subdivide = v.get<float>();
-                     if (!(s.subdivide > 0)) throw InputError(src.file, src.place, "is below single precision's smallest length");
-                 },
-                 [](const RenderSettings& s) { return s.subdivide > 0 ? json(s.subdivide) : json(nullptr); }});
+                 [](RenderSettings& s, const json& v, const OptionSource& src) { s.subdivide = positiveLength(v, src); },
+                 [](const RenderSettings& s) { return lengthOrOff(s.subdivide); }});
     o.push_back({"refine_contacts", "--refine-contacts", T::Number, 0, kMaxSceneExtent, "", {}, true, "DISTANCE", "off",
                  "refine, until at most DISTANCE/2 long, every edge that passes within DISTANCE of another piece of "
                  "surface in any frame (a block's foot, feet on a floor, the ceiling round a fixture), once on the rest "
                  "pose, after --subdivide and without T-junctions; every output holds the refined mesh (docs/method.md: "
                  "contacts)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource& src) {
-                     s.refineContacts = v.get<float>();
-                     if (!(s.refineContacts > 0)) throw InputError(src.file, src.place, "is below single precision's smallest length");
-                 },
-                 [](const RenderSettings& s) { return s.refineContacts > 0 ? json(s.refineContacts) : json(nullptr); }});
+                 [](RenderSettings& s, const json& v, const OptionSource& src) { s.refineContacts = positiveLength(v, src); },
+                 [](const RenderSettings& s) { return lengthOrOff(s.refineContacts); }});
     // Images
     o.push_back({"width", "--width", T::Integer, 1, double(kMaxImageSide), "", {}, true, "W", "640",
                  "image width in pixels", true, false,

@@ -59,7 +59,7 @@ public:
             changed = false;
             std::vector<LocalTriangle> next;
             std::vector<uint32_t> nextPiece;
-            next.reserve(std::min(triangles_.size() * 2, triangleLimit == SIZE_MAX ? triangles_.size() * 2 : triangleLimit + 2));
+            next.reserve(std::min(triangles_.size() * 2, triangleLimit));
             for (size_t i = 0; i < triangles_.size(); ++i) {
                 // Refused as soon as the limit is passed, not after a pass that may double the mesh.
                 if (next.size() > triangleLimit) return false;
