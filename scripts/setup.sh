@@ -22,6 +22,7 @@ run_packages=(
   libtbb-dev
   nlohmann-json3-dev
   libcli11-dev
+  libeigen3-dev             # the least-squares vertex fit's sparse factorisation (lib/estimate/vertex_fit.cpp)
 )
 test_packages=(
   python3 python3-numpy python3-matplotlib   # scripts/sweep.py, tests/data/make_inputs.py, reference checks

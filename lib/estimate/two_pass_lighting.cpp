@@ -37,8 +37,8 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     if (settings_.gathers() && !keepForUpdates && !cache_) {
         if (progress) progress->start("gathering", scene.vertexCount());
         // castAndGather keeps no hit: the rays that tell covered vertices are cast first.
-        const std::vector<uint8_t> covered = gather_.castCovered(scene, bvh, starts_);
-        gather_.castAndGather(scene, bvh, starts_, firstPass(scene, photons, covered), out.irradiance, progress);
+        covered_ = gather_.castCovered(scene, bvh, starts_);
+        gather_.castAndGather(scene, bvh, starts_, firstPass(scene, photons, covered_), out.irradiance, progress);
         stats.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
         addDirect(scene, out);
         stats.gatherSeconds = clock.seconds();
@@ -109,16 +109,18 @@ void TwoPassLighting::addDirect(const Scene& scene, VertexRadiosity& out) const 
     computeRadiosity(scene, out);
 }
 
-void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const {
+void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) {
     const std::vector<Vec3f>& direct = direct_.irradiance();
     const size_t n = scene.vertexCount();
     out.irradiance.resize(n);
     if (settings_.gathers()) {
-        gather_.gather(scene, firstPass(scene, photons, gather_.coveredFromKept(scene)), out.irradiance);
+        covered_ = gather_.coveredFromKept(scene);
+        gather_.gather(scene, firstPass(scene, photons, covered_), out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);
         addDirect(scene, out);
         return;
     }
+    covered_.clear();
     for (size_t v = 0; v < n; ++v) out.irradiance[v] = direct[v] + photons.irradiance[v];
     computeRadiosity(scene, out);
 }

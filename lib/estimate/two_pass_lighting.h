@@ -55,9 +55,11 @@ public:
     size_t stateBytes() const;
     // The gather cache of the last solve or update (nullptr without one).
     const GatherCache* gatherCache() const { return cache_ ? &*cache_ : nullptr; }
+    // The covered vertices of the last solve or update (FinalGather's rule; empty without a gather).
+    const std::vector<uint8_t>& covered() const { return covered_; }
 
 private:
-    void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) const;
+    void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out);
     // F_u = ρ_u (D_u + I_u) as the gather reads it: 0 at hidden vertices, and at covered ones
     // (FinalGather's rule) their visible neighbours' stand-in (fillCoveredFirstPass).
     std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons, const std::vector<uint8_t>& covered) const;
@@ -71,6 +73,7 @@ private:
     DirectLight direct_;
     FinalGather gather_;
     std::optional<GatherCache> cache_;  // with --gather-cache A
+    std::vector<uint8_t> covered_;
     bool solved_ = false;
 };
 

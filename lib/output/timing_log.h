@@ -28,6 +28,8 @@ struct TimingLog {
     uint64_t inputVertices = 0;  // before --subdivide and --refine-contacts
     // --refine-contacts: the vertices it added and the frames whose poses it judged (null without it).
     nlohmann::json contactRefinement;
+    // --vertex-fit least-squares: the sampling mesh's vertices, which the frames are solved on (0 without it).
+    uint64_t fitSamples = 0;
     double animationDiagonal = 0;  // the diagonal of the whole animation's bounds (default radius = 1.5 % of it)
     // runFingerprint of the inputs and settings; --resume continues only a folder whose log has it.
     std::string inputsFingerprint;

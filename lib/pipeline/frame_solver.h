@@ -80,6 +80,12 @@ public:
     const TrackedPaths* trackedPaths() const { return tracked_.get(); }
     // The tracer, with the settings the solver gave it (emission aimed at the estimator's reach).
     const PhotonTracer& tracer() const { return tracer_; }
+    // The vertices the last frame found covered — inside or under closed geometry (FinalGather's
+    // rule) — or empty when it casts no gather rays.
+    const std::vector<uint8_t>& coveredVertices() const {
+        static const std::vector<uint8_t> none;
+        return lighting_ ? lighting_->covered() : none;
+    }
 
 private:
     // What the solver holds between frames: one of these, never a mix.

@@ -26,6 +26,7 @@
 #include "pipeline/frame_solver.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
+#include "estimate/vertex_fit.h"
 #include "scene/contact_refinement.h"
 #include "scene/mesh_refinement.h"
 #include "trace/photon_tracer.h"
@@ -148,6 +149,23 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     }
     scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
+    if (settings_.vertexFit == VertexFitKind::LeastSquares) {
+        // The sampling mesh: the output's, refined where surfaces touch as --refine-contacts R
+        // refines (R the default radius, 1.5 % of the animation's diagonal: the score's contact
+        // band), every frame judged (docs/method.md: the least-squares vertex fit).
+        samplingScene_ = scene_;
+        const std::optional<ContactRefinementReport> sampled =
+            refineContacts(*samplingScene_, defaultRadius(scene_), animation_.lastFrame(),
+                           [&](int frame) { return animation_.poseAt(frame); }, size_t(kMaxRefinedTriangles));
+        if (!sampled) {
+            char text[200];
+            std::snprintf(text, sizeof text, "its samples near contacts would refine %zu triangles into more than %.0e",
+                          scene_.triangleCount(), kMaxRefinedTriangles);
+            throw InputError("vertex_fit (--vertex-fit)", "", text);
+        }
+        samplingScene_->markDynamic(animation_.movedNodes(), animation_.morphedNodes());
+        sweepAnimationBounds(*samplingScene_, animation_);
+    }
     checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
     if (!settings_.animationPath.empty())
         checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");
@@ -286,6 +304,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     log.animationDiagonal = scene_.animationBounds.extent();
     log.inputVertices = inputVertices_;
     log.contactRefinement = contactRefinement_;
+    log.fitSamples = samplingScene_ ? samplingScene_->vertexCount() : 0;
     log.inputsFingerprint = fingerprint_.digest;
     log.inputs = fingerprint_.parts;
     const RunFolder::Started started = folder.startLog(std::move(log), start, last_);
@@ -312,20 +331,44 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
                                              settings_.update};
     // Built in the rest pose, before any frame: every run refits the same BVHs (docs/design.md §6.0).
     scene_.applyPose(scene_.restPose());
-    FrameSolver solver(scene_, device, solverSettings);
+    // With the fit, the frames are solved on the sampling mesh, and the output mesh has its own BVH
+    // for the images.
+    Scene& solvedScene = samplingScene_ ? *samplingScene_ : scene_;
+    solvedScene.applyPose(solvedScene.restPose());
+    FrameSolver solver(solvedScene, device, solverSettings);
+    std::optional<VertexFit> fit;
+    std::optional<SceneBvh> outputBvh;
+    VertexRadiosity fitted;
+    if (samplingScene_) {
+        fit.emplace(scene_, solvedScene);
+        outputBvh.emplace(device, scene_);
+    }
+    // The frame's solve and, with the fit, the output's pose and values: what the sinks see.
+    auto solveFrame = [&](int frame, FrameTiming& timing, bool updateFollows) -> SolvedFrame {
+        const Pose pose = animation_.poseAt(frame);
+        const VertexRadiosity& result = solver.solve(pose, timing, updateFollows);
+        if (!fit) return SolvedFrame{frame, scene_, solver.bvh(), result};
+        Stopwatch clock;
+        scene_.applyPose(pose);
+        outputBvh->updateDynamic(scene_);
+        const VertexFit::Report report = fit->fit(scene_, solvedScene, result.irradiance, solver.coveredVertices(), fitted);
+        timing.fitSeconds = clock.seconds();
+        timing.fitFactorisations = report.factorisations;
+        timing.fitClampedVertices = report.clampedVertices;
+        return SolvedFrame{frame, scene_, *outputBvh, fitted};
+    };
 
     // Previews are tonemapped as frame 0 of the animation is (docs/design.md §6.0), so that any frame
     // range writes the bytes one sequential run would. A run that starts later computes frame 0
     // once for it, then the state at its first frame from scratch.
     bool calibrated = false;
-    auto calibrate = [&](const VertexRadiosity& result, const SceneBvh& bvh) {
-        const SolvedFrame frame0{0, scene_, bvh, result};
+    auto calibrate = [&](const SolvedFrame& frame0) {
         for (const std::unique_ptr<FrameSink>& sink : sinks) sink->calibrate(frame0);
         calibrated = true;
     };
     if (start > 0) {
         FrameTiming ignored;
-        calibrate(solver.solve(animation_.poseAt(0), ignored, false), solver.bvh());
+        calibrate(solveFrame(0, ignored, false));
         solver.reset();
     }
 
@@ -339,16 +382,15 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         current = frame;
         Stopwatch frameClock;
         FrameTiming timing;
-        const VertexRadiosity& result = solver.solve(animation_.poseAt(frame), timing, frame < last_);
+        const SolvedFrame solved = solveFrame(frame, timing, frame < last_);
         timing.frame = frame;
-        if (!calibrated) calibrate(result, solver.bvh());
+        if (!calibrated) calibrate(solved);
         if (frame == start) {
             TimingLog& log = folder.log();
             log.photonsMissingScene = timing.photonsMissingScene;
             log.emittedFraction = solver.emittedFraction();
             log.emissionMeasured = true;
         }
-        const SolvedFrame solved{frame, scene_, solver.bvh(), result};
         for (const std::unique_ptr<FrameSink>& sink : sinks)
             if (const char* preparing = sink->preparingStage()) {
                 stage(preparing, 0, 0);

@@ -211,7 +211,7 @@ json getCamera(const RenderSettings& s) {
 // radiusGiven, qmcBouncesGiven, gatherGiven, framesSource, EnvironmentSettings' source), EmissionAim's margin (FrameSolver
 // sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
 // added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 37, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 38, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
 static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
@@ -511,6 +511,14 @@ std::vector<RenderOption> declareOptions() {
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource& src) { s.refineContacts = positiveLength(v, src); },
                  [](const RenderSettings& s) { return lengthOrOff(s.refineContacts); }});
+    o.push_back({"vertex_fit", "--vertex-fit", T::Choice, 0, 0, "", namesOf(kVertexFitNames), true, "", "point",
+                 "each vertex's value: point (its own irradiance) or least-squares (the values whose interpolation "
+                 "across the triangles is closest to the irradiance sampled over them; the samples are the vertices of "
+                 "the mesh refined near contacts as --refine-contacts R would, R 1.5 % of the animation's diagonal, "
+                 "hidden and covered ones left out; the output keeps its vertices; docs/method.md: the least-squares vertex fit)",
+                 true, true,
+                 [](RenderSettings& s, const json& v, const OptionSource&) { s.vertexFit = choiceValue(kVertexFitNames, v); },
+                 [](const RenderSettings& s) { return json(nameOf(kVertexFitNames, s.vertexFit)); }});
     // Images
     o.push_back({"width", "--width", T::Integer, 1, double(kMaxImageSide), "", {}, true, "W", "640",
                  "image width in pixels", true, false,

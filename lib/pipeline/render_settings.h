@@ -12,6 +12,7 @@
 
 #include "estimate/estimator_settings.h"
 #include "estimate/lighting_settings.h"
+#include "estimate/vertex_fit_settings.h"
 #include "pipeline/update_settings.h"
 #include "scene/scene.h"
 #include "trace/trace_settings.h"
@@ -53,6 +54,8 @@ struct RenderSettings {
     EnvironmentSettings environment;         // a sky or an HDR map (--sky, --environment, "lights")
     float subdivide = 0;  // refine triangles with an edge longer than this (scene units) on the rest pose; 0: off
     float refineContacts = 0;  // refine edges within this of another piece of surface in any frame (contact_refinement.h); 0: off
+    // Each output vertex's value: its own irradiance, or fitted over its triangles (vertex_fit.h).
+    VertexFitKind vertexFit = VertexFitKind::Point;
 
     // Images (docs/design.md §7)
     int width = 640, height = 480;

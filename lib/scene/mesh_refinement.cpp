@@ -232,6 +232,21 @@ RefinementReport refineMesh(Scene& scene, double maxEdge) {
     return storeRefined(scene, refiners, report);
 }
 
+RefinementReport bisectEveryEdge(Scene& scene) {
+    RefinementReport report;
+    report.trianglesBefore = scene.triangleCount();
+    report.verticesBefore = scene.vertexCount();
+    std::vector<InstanceRefiner> refiners;
+    for (const MeshInstance& inst : scene.instances) {
+        refiners.emplace_back(scene, inst);
+        // An edge between two of the mesh's own vertices is split (once: its halves end at the new
+        // midpoint); a degenerate one is not (edgeToSplit never splits a zero length).
+        const uint32_t own = inst.vertexCount;
+        refiners.back().refine([&](double, uint32_t, uint32_t a, uint32_t b) { return a < own && b < own; }, SIZE_MAX);
+    }
+    return storeRefined(scene, refiners, report);
+}
+
 std::optional<RefinementReport> refineMeshWhere(Scene& scene, const RefinementTracks& tracks, const EdgeSplitTest& needs,
                                                 size_t triangleLimit) {
     RefinementReport report;

@@ -55,6 +55,12 @@ struct RefinementReport {
 // instance with what it was last placed with. maxEdge > 0.
 RefinementReport refineMesh(Scene& scene, double maxEdge);
 
+// Splits every edge of every mesh once, at its midpoint (a triangle becomes four, by the same
+// bisection): a sampling mesh with samples on every triangle for the least-squares vertex fit
+// (lib/estimate/vertex_fit.h), whose vertices are the mesh's own, in their order, then one per
+// edge. Each added vertex's refinedFrom names two of the mesh's own vertices.
+RefinementReport bisectEveryEdge(Scene& scene);
+
 // What refineMeshWhere follows the mesh through: every vertex's world position in each of some
 // poses (poses[k][v], scene order; the refinement gives a new vertex its edge's midpoint in each),
 // and each triangle's piece of surface (MeshTopology::edgeConnectedPieces; its pieces inherit it).

@@ -60,6 +60,11 @@ struct FrameTiming {
     // With the gather cache (--gather-cache A): the vertices that gathered all M rays (the rest
     // are interpolated; 0 without the cache).
     uint64_t gatherRecords = 0;
+    // --vertex-fit least-squares (lib/estimate/vertex_fit.h): the fit's time, the meshes whose
+    // system was factorised afresh (the others' weights and geometry were unchanged), and the
+    // output vertices whose fitted irradiance was negative in some channel and written as 0.
+    double fitSeconds = 0;
+    uint64_t fitFactorisations = 0, fitClampedVertices = 0;
     // The frame's files as written, which --resume verifies before it trusts them ("files" in
     // timing.json; not a timing, so not in forEachTimingField's list).
     std::vector<FileRecord> files;
@@ -109,6 +114,9 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("gather_s", f.gatherSeconds);
     visit("gather_rays", f.gatherRays);
     visit("gather_records", f.gatherRecords);
+    visit("fit_s", f.fitSeconds);
+    visit("fit_factorisations", f.fitFactorisations);
+    visit("fit_clamped_vertices", f.fitClampedVertices);
 }
 
 }  // namespace qsgi
