@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "estimate/final_gather.h"
+#include "estimate/surface_accuracy.h"
 #include "estimate/vertex_fit.h"
 #include "scene/contact_refinement.h"
 #include "scene/mesh_refinement.h"
@@ -43,29 +44,12 @@ double worstRelative(const std::vector<Vec3f>& got, const std::vector<Vec3f>& wa
     return worst;
 }
 
-// The barycentrics of p's projection on triangle t of `scene` (b0, b1, b2), and its distance from the plane.
-struct Located {
-    uint32_t triangle = UINT32_MAX;
-    double b[3] = {0, 0, 0};
-};
-Located locate(const Scene& scene, const Vec3d& p, uint32_t firstTriangle, uint32_t triangleCount) {
-    for (uint32_t t = firstTriangle; t < firstTriangle + triangleCount; ++t) {
-        const Triangle& tri = scene.triangles[t];
-        const Vec3d a(scene.positions[tri.v[0]]), b(scene.positions[tri.v[1]]), c(scene.positions[tri.v[2]]);
-        const Vec3d n = cross(b - a, c - a);
-        const double n2 = dot(n, n);
-        if (!(n2 > 0) || std::fabs(dot(p - a, n)) > 1e-6 * std::sqrt(n2)) continue;
-        const double b1 = dot(cross(p - a, c - a), n) / n2, b2 = dot(cross(b - a, p - a), n) / n2, b0 = 1 - b1 - b2;
-        if (b0 >= -1e-9 && b1 >= -1e-9 && b2 >= -1e-9) return Located{t, {b0, b1, b2}};
-    }
-    return Located{};
-}
-
-double interpolated(const Scene& scene, const Located& at, const std::vector<Vec3f>& values, int channel) {
-    const Triangle& tri = scene.triangles[at.triangle];
-    double sum = 0;
-    for (int k = 0; k < 3; ++k) sum += at.b[k] * double(values[tri.v[k]][channel]);
-    return sum;
+// Where each of `points` (with the normal of the mesh they lie on) lies on `scene`'s mesh: the
+// score's own locator (surface_accuracy.h), independent of the refinement's records.
+std::vector<PointOnMesh> locate(const Scene& scene, const std::vector<Vec3f>& points, const Vec3f& normal) {
+    std::vector<SurfacePoint> at(points.size());
+    for (size_t i = 0; i < points.size(); ++i) at[i].position = points[i], at[i].normal = normal;
+    return locateOnMesh(scene.positions, scene.normals, scene.triangles, at);
 }
 
 }  // namespace
@@ -97,7 +81,7 @@ TEST(VertexFit, AFieldLinearOnEachMeshIsReproducedExactly) {
 // A piecewise-linear field on a refined output mesh (any values at its vertices, interpolated):
 // the samples, wherever they lie, read it off the output's triangles, and the fit without a
 // regulariser gives the vertex values back. The samples' values are found by locating each sample
-// on the output mesh, independently of the fit's own bookkeeping.
+// on the output mesh (the score's locator), independently of the fit's own bookkeeping.
 TEST(VertexFit, APiecewiseLinearFieldOnARefinedMeshIsReproducedExactly) {
     Scene output = testscenes::plane(1.0f, 3, Vec3f(0.5f));
     refineMesh(output, 0.3);  // a refined output mesh, its triangles of several sizes and shapes
@@ -108,18 +92,102 @@ TEST(VertexFit, APiecewiseLinearFieldOnARefinedMeshIsReproducedExactly) {
         const double h = std::sin(double(v) * 12.9898) * 43758.5453;  // fixed scattered values in [1, 2]
         want[v] = Vec3f(float(1 + (h - std::floor(h))), float(1.5), float(2 - (h - std::floor(h))));
     }
+    const std::vector<PointOnMesh> places = locate(output, samples.positions, Vec3f(0, 1, 0));
     std::vector<Vec3f> sampled(samples.vertexCount());
-    for (size_t s = 0; s < sampled.size(); ++s) {
-        const Located at = locate(output, Vec3d(samples.positions[s]), 0, uint32_t(output.triangleCount()));
-        ASSERT_NE(at.triangle, UINT32_MAX) << "sample " << s;
-        for (int k = 0; k < 3; ++k) sampled[s][k] = float(interpolated(output, at, want, k));
-    }
+    for (size_t s = 0; s < sampled.size(); ++s) sampled[s] = interpolatedAt(output.triangles, want, places[s]);
     VertexFit fit(output, samples, 0.0);
     VertexRadiosity out;
     fit.fit(output, samples, sampled, std::vector<uint8_t>(samples.vertexCount(), 0), out);
     // The samples' values are rounded to float (2^-24 relative): the solve amplifies that by the
     // conditioning of a mass matrix (a few units), far below 1e-5.
     EXPECT_LT(worstRelative(out.irradiance, want), 1e-5);
+}
+
+// Values no linear field carries (scattered, as noise is): the fit is the weighted least-squares
+// solution, which the test finds on its own — each sample's weight a third of the area of the
+// sampling triangles round it, its place located on the output mesh by the score's locator, and
+// the dense normal equations (with the same ridge toward the point values) solved by Gaussian
+// elimination. Wrong weights or places change the answer by far more than 10⁻⁶.
+TEST(VertexFit, ScatteredValuesGetTheWeightedLeastSquaresSolution) {
+    Scene output = testscenes::plane(1.0f, 3, Vec3f(0.5f));
+    refineMesh(output, 0.5);  // triangles of two sizes: weights that differ
+    Scene samples = output;
+    bisectEveryEdge(samples);
+    const uint32_t n = uint32_t(output.vertexCount()), m = uint32_t(samples.vertexCount());  // 32 bits: n + 1 cannot wrap
+    std::vector<Vec3f> sampled(m);
+    for (size_t s = 0; s < m; ++s) {
+        const double h = std::sin(double(s) * 78.233) * 43758.5453;
+        sampled[s] = Vec3f(float(1 + (h - std::floor(h))), float(2 - (h - std::floor(h))), 1.0f);
+    }
+    std::vector<double> weight(m, 0.0);
+    for (uint32_t t = 0; t < samples.triangleCount(); ++t)
+        for (uint32_t v : samples.triangles[t].v) weight[v] += double(samples.triangleArea(t)) / 3;
+    const std::vector<PointOnMesh> places = locate(output, samples.positions, Vec3f(0, 1, 0));
+    // Normal equations A x = b (channel 0), dense.
+    std::vector<std::vector<double>> a(n, std::vector<double>(size_t(n) + 1, 0.0));
+    double total = 0;
+    for (size_t s = 0; s < m; ++s) {
+        const Triangle& tri = output.triangles[places[s].triangle];
+        const double beta[3] = {1 - places[s].b1 - places[s].b2, places[s].b1, places[s].b2};
+        for (int r = 0; r < 3; ++r) {
+            for (int q = 0; q < 3; ++q) a[tri.v[r]][tri.v[q]] += weight[s] * beta[r] * beta[q];
+            a[tri.v[r]][n] += weight[s] * beta[r] * double(sampled[s].x);
+        }
+        total += weight[s];
+    }
+    const double ridge = VertexFit::kRidge * total / double(n);
+    for (size_t u = 0; u < n; ++u) a[u][u] += ridge, a[u][n] += ridge * double(sampled[u].x);  // own vertices come first
+    for (size_t c = 0; c < n; ++c) {  // Gaussian elimination with partial pivoting
+        size_t pivot = c;
+        for (size_t r = c + 1; r < n; ++r)
+            if (std::fabs(a[r][c]) > std::fabs(a[pivot][c])) pivot = r;
+        std::swap(a[c], a[pivot]);
+        for (size_t r = 0; r < n; ++r) {
+            if (r == c) continue;
+            const double f = a[r][c] / a[c][c];
+            for (size_t k = c; k <= n; ++k) a[r][k] -= f * a[c][k];
+        }
+    }
+    VertexFit fit(output, samples, 0.0);
+    VertexRadiosity out;
+    fit.fit(output, samples, sampled, {}, out);
+    double worst = 0;
+    for (size_t u = 0; u < n; ++u) worst = std::max(worst, std::fabs(double(out.irradiance[u].x) - a[u][n] / a[u][u]));
+    EXPECT_LT(worst, 1e-5);  // float output of values about 1.5: a few float ulps
+}
+
+// The regulariser decides what the samples leave free: where every sample is unseen (the far half of
+// a floor, as under a block), a vertex with λ > 0 continues the field of the seen half linearly —
+// no jump of gradient across any hinge — while with λ = 0 it keeps its own point value (the ridge).
+TEST(VertexFit, TheRegulariserContinuesTheSeenFieldWhereNoSampleIsSeen) {
+    const Scene output = testscenes::plane(1.0f, 8, Vec3f(0.5f));
+    Scene samples = output;
+    bisectEveryEdge(samples);
+    auto field = [](const Vec3f& p) { return Vec3f(3.0f + p.x, 2.0f - 0.5f * p.z, 1.0f); };
+    std::vector<Vec3f> sampled(samples.vertexCount());
+    std::vector<uint8_t> unseen(samples.vertexCount(), 0);
+    for (size_t s = 0; s < sampled.size(); ++s) {
+        unseen[s] = samples.positions[s].x > 0.25f;
+        sampled[s] = unseen[s] ? Vec3f(0.0f) : field(samples.positions[s]);  // unseen: read as 0, as covered samples are
+    }
+    size_t free = 0;
+    for (const double smoothing : {1.0, 0.0}) {
+        VertexFit fit(output, samples, smoothing);
+        VertexRadiosity out;
+        fit.fit(output, samples, sampled, unseen, out);
+        for (size_t v = 0; v < output.vertexCount(); ++v) {
+            if (output.positions[v].x <= 0.25f + 0.25f) continue;  // a vertex all of whose samples are unseen
+            ++free;
+            if (smoothing > 0) {
+                // The ridge's pull toward 0 is 10⁻⁶ of the data's weight, spread over the free half.
+                EXPECT_NEAR(out.irradiance[v].x, field(output.positions[v]).x, 1e-3) << v;
+                EXPECT_NEAR(out.irradiance[v].y, field(output.positions[v]).y, 1e-3) << v;
+            } else {
+                EXPECT_EQ(out.irradiance[v].x, 0.0f) << v;
+            }
+        }
+    }
+    EXPECT_GT(free, 20u);
 }
 
 // With one sample at each vertex (the sampling mesh is the output itself) and no regulariser, the
@@ -187,24 +255,28 @@ TEST(VertexFit, TheVisibleFloorRoundABlocksFootIsFittedWithoutTheCoveredFloorsSa
     fit.fit(output, samples, sampled, covered, fitted);
 
     // Points 5 mm apart over the visible floor within 15 cm of the foot.
-    double pointAll = 0, fitAll = 0, pointCut = 0, fitCut = 0, pointCutBias = 0, fitCutBias = 0;
-    size_t all = 0, cut = 0;
+    std::vector<Vec3f> points;
     for (double x = -0.5; x <= 0.5; x += 0.005)
         for (double z = -0.5; z <= 0.5; z += 0.005) {
             const Vec3f p(float(x), floorY, float(z));
             const double d = distanceFromFoot(p);
-            if (inside(p) || d > 0.15 || d == 0) continue;
-            const Located at = locate(output, Vec3d(p), 0, floorTriangles);
-            ASSERT_NE(at.triangle, UINT32_MAX);
-            const double truth = light(p);
-            const double ePoint = interpolated(output, at, point, 0) - truth, eFit = interpolated(output, at, fitted.irradiance, 0) - truth;
-            pointAll += ePoint * ePoint, fitAll += eFit * eFit, ++all;
-            bool cutTriangle = false;
-            for (uint32_t v : output.triangles[at.triangle].v) cutTriangle = cutTriangle || inside(output.positions[v]);
-            if (!cutTriangle) continue;
-            pointCut += ePoint * ePoint, fitCut += eFit * eFit, ++cut;
-            pointCutBias += ePoint, fitCutBias += eFit;
+            if (!inside(p) && d > 0 && d <= 0.15) points.push_back(p);
         }
+    const std::vector<PointOnMesh> places = locate(output, points, Vec3f(0, 1, 0));
+    double pointAll = 0, fitAll = 0, pointCut = 0, fitCut = 0, pointCutBias = 0, fitCutBias = 0;
+    size_t all = 0, cut = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+        ASSERT_LT(places[i].triangle, floorTriangles) << "a floor point located off the floor";
+        const double truth = light(points[i]);
+        const double ePoint = interpolatedAt(output.triangles, point, places[i]).x - truth;
+        const double eFit = interpolatedAt(output.triangles, fitted.irradiance, places[i]).x - truth;
+        pointAll += ePoint * ePoint, fitAll += eFit * eFit, ++all;
+        bool cutTriangle = false;
+        for (uint32_t v : output.triangles[places[i].triangle].v) cutTriangle = cutTriangle || inside(output.positions[v]);
+        if (!cutTriangle) continue;
+        pointCut += ePoint * ePoint, fitCut += eFit * eFit, ++cut;
+        pointCutBias += ePoint, fitCutBias += eFit;
+    }
     ASSERT_GT(cut, 100u);
     const double rmsPointAll = std::sqrt(pointAll / double(all)), rmsFitAll = std::sqrt(fitAll / double(all));
     const double rmsPointCut = std::sqrt(pointCut / double(cut)), rmsFitCut = std::sqrt(fitCut / double(cut));
@@ -251,23 +323,30 @@ TEST(VertexFit, NegativeValuesAreWrittenAsZeroAndFactorisationsAreKeptWhileTheMa
 // The fit on the data scenes: every frame updated from the last equals a full recomputation and
 // any thread count gives the same bytes, for every estimator — data/cornell (a rigid block moves:
 // its mesh and the floor under it are factorised afresh, the walls keep theirs) and data/walker (a
-// skinned figure walks). One run updates with two threads, the other recomputes every frame with
-// one, so one comparison holds both properties.
+// skinned figure walks), and on data/cornell without a gather too. One run updates with two
+// threads, the other recomputes every frame with one, so one comparison holds both properties.
 TEST(VertexFit, IncrementalFramesEqualFullRecomputationOnTheDataScenes) {
     const fs::path dir = testScratchDir("vertex-fit-incremental");
     const std::string data = (sourceDir() / "data").string();
     struct Case {
-        std::string scene, animation;
+        std::string arguments;  // scene, animation and anything the case adds
+        std::vector<std::string> estimators;
     };
-    const std::vector<Case> cases = {{data + "/cornell/cornell.gltf", data + "/cornell/animation.json"},
-                                     {data + "/walker/walker.gltf", "gltf"}};
-    std::vector<std::string> estimators = {"impact-count", "photon-map", "detp"};
-    if (kSanitized) estimators.resize(1);  // the fit is the same code for every estimator
+    const std::string cornell = data + "/cornell/cornell.gltf --animation " + data + "/cornell/animation.json";
+    std::vector<Case> cases = {
+        {cornell + kCheapSecondPass + " --png", {"impact-count", "photon-map", "detp"}},
+        {data + "/walker/walker.gltf --animation gltf" + kCheapSecondPass, {"impact-count", "photon-map", "detp"}},
+        // Without a gather the covered samples are found by the same rule's own rays.
+        {cornell + " --direct photons", {"impact-count"}},
+        {cornell + " --gather 0", {"impact-count"}},
+    };
+    if (kSanitized)  // the fit is the same code for every estimator
+        for (Case& c : cases) c.estimators.resize(1);
     for (const Case& c : cases)
-        for (const std::string& estimator : estimators) {
-            SCOPED_TRACE(c.scene + " / " + estimator);
-            const std::string common = "render " + c.scene + " --animation " + c.animation + " --frames 0:2 --photons 20000 --quiet --no-exr" +
-                                       kCheapSecondPass + " --vertex-fit least-squares --estimator " + estimator;
+        for (const std::string& estimator : c.estimators) {
+            SCOPED_TRACE(c.arguments + " / " + estimator);
+            const std::string common = "render " + c.arguments + " --frames 0:2 --photons 20000 --quiet --no-exr" +
+                                       " --vertex-fit least-squares --estimator " + estimator;
             const fs::path inc = dir / "inc", full = dir / "full";
             for (const fs::path& p : {inc, full}) fs::remove_all(p);
             CommandResult r = runQsgi(common + " --threads 2 --out " + inc.string());
@@ -287,6 +366,16 @@ TEST(VertexFit, IncrementalFramesEqualFullRecomputationOnTheDataScenes) {
             // A later frame factorises only what the move changed: fewer meshes than the first frame.
             EXPECT_GE(frames[1]["fit_factorisations"].get<uint64_t>(), 1u);
             EXPECT_LT(frames[1]["fit_factorisations"].get<uint64_t>(), frames[0]["fit_factorisations"].get<uint64_t>());
+            if (&c != &cases[0] || estimator != c.estimators[0]) continue;
+            // A run that starts later (a Slurm chunk, --resume) fits frame 0 for the previews'
+            // calibration and then its own frames: the same bytes.
+            const fs::path later = dir / "later";
+            fs::remove_all(later);
+            r = runQsgi("render " + c.arguments + " --frames 1:2 --photons 20000 --quiet --no-exr --vertex-fit least-squares "
+                        "--estimator " + estimator + " --out " + later.string());
+            ASSERT_EQ(r.exitCode, 0) << r.output;
+            for (const char* name : {"frame_0001.ply", "frame_0002.ply", "frame_0002.png"})
+                EXPECT_EQ(readFileBytes(inc / name), readFileBytes(later / name)) << name << " of a run from frame 1";
         }
 }
 
@@ -294,8 +383,8 @@ TEST(VertexFit, IncrementalFramesEqualFullRecomputationOnTheDataScenes) {
 // (tests/reference/cornell_f0000_surface.ply): the fit lowers the error over all visible points and
 // in the contact band. Measured for seeds 1, 2, 3, the fit's figure over point sampling's: 0.897,
 // 0.916, 0.915 over the surface and 0.873, 0.892, 0.893 in the contact band (the band's error is
-// the bias of linear interpolation there, which the seed hardly moves). The bounds, 0.96 and 0.95,
-// sit three times the seeds' spread (0.02) above the worst of them.
+// the bias of linear interpolation there, which the seed hardly moves). The bounds, 0.975 and 0.96,
+// sit three times the seeds' spread (0.019 and 0.020) above the worst of them (0.916 and 0.893).
 TEST(VertexFit, OnDataCornellTheErrorOverTheSurfaceFallsAgainstPointSampling) {
     const fs::path dir = testScratchDir("vertex-fit-accuracy");
     const std::string scene = (sourceDir() / "data" / "cornell" / "cornell.gltf").string();
@@ -314,6 +403,6 @@ TEST(VertexFit, OnDataCornellTheErrorOverTheSurfaceFallsAgainstPointSampling) {
     const double all = score[1]["all"]["relative_rms"].get<double>() / score[0]["all"]["relative_rms"].get<double>();
     const double contact = score[1]["contact"]["relative_rms"].get<double>() / score[0]["contact"]["relative_rms"].get<double>();
     std::printf("least-squares over point sampling: over the surface %.3f, contact band %.3f\n", all, contact);
-    EXPECT_LT(all, 0.96);
-    EXPECT_LT(contact, 0.95);
+    EXPECT_LT(all, 0.975);
+    EXPECT_LT(contact, 0.96);
 }

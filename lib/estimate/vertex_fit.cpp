@@ -1,5 +1,7 @@
 #include "estimate/vertex_fit.h"
 
+#include "estimate/own_surface.h"
+
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -20,12 +22,6 @@ namespace {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 Vec3d at(const Scene& scene, uint32_t v) { return Vec3d(scene.positions[v]); }
-
-double triangleArea(const Vec3d& a, const Vec3d& b, const Vec3d& c) { return 0.5 * length(cross(b - a, c - a)); }
-
-// Two triangles are one smooth surface across their edge when their normals are within 45° (the
-// crease rule of the own surfaces and the surface score's edge band).
-constexpr double kHingeCosine = 0.70710678118654752;
 
 // A sample's place on the output mesh: Σ weight[k] · vertex[k] (count of them used).
 struct SamplePlace {
@@ -73,13 +69,15 @@ struct VertexFit::Mesh {
 
 VertexFit::VertexFit(const Scene& output, const Scene& samples, double smoothing) : smoothing_(smoothing) {
     if (output.instances.size() != samples.instances.size())
-        throw std::logic_error("VertexFit: the sampling mesh is not the output's bisected");
+        throw std::logic_error("VertexFit: the sampling mesh is not the output's refined");
     for (size_t i = 0; i < output.instances.size(); ++i) {
         const MeshInstance& o = output.instances[i];
         const MeshInstance& s = samples.instances[i];
+        // Its own vertices first, as they are; then the added ones, each in refinedFrom.
+        if (s.vertexCount < o.vertexCount || s.refinedFrom.size() != o.refinedFrom.size() + (s.vertexCount - o.vertexCount) ||
+            !std::equal(o.objectPositions.begin(), o.objectPositions.end(), s.objectPositions.begin()))
+            throw std::logic_error("VertexFit: the sampling mesh is not the output's refined");
         const size_t added = s.vertexCount - o.vertexCount;
-        if (s.vertexCount < o.vertexCount || s.refinedFrom.size() != o.refinedFrom.size() + added)
-            throw std::logic_error("VertexFit: the sampling mesh is not the output's bisected");
         auto mesh = std::make_unique<Mesh>();
         mesh->firstOutput = o.firstVertex;
         mesh->outputCount = o.vertexCount;
@@ -94,8 +92,8 @@ VertexFit::VertexFit(const Scene& output, const Scene& samples, double smoothing
         mesh->unknownOf.resize(o.vertexCount);
         for (uint32_t v = 0; v < o.vertexCount; ++v) {
             const Vec3f p = o.objectPositions[v], n = output.normals[o.firstVertex + v];
-            const auto [it, added] = welded.emplace(std::make_tuple(p.x, p.y, p.z, n.x, n.y, n.z), mesh->unknowns);
-            if (added) ++mesh->unknowns;
+            const auto [it, isNew] = welded.emplace(std::make_tuple(p.x, p.y, p.z, n.x, n.y, n.z), mesh->unknowns);
+            if (isNew) ++mesh->unknowns;
             mesh->unknownOf[v] = it->second;
         }
         // An added vertex is the midpoint of two earlier ones: half of each one's place.
@@ -134,7 +132,7 @@ VertexFit::VertexFit(const Scene& output, const Scene& samples, double smoothing
             const auto& [a, b, c] = sides[0];
             const uint32_t d = sides[1][2];
             if (mesh->unknownOf[c] == mesh->unknownOf[d]) continue;  // a fold onto itself
-            if (dot(normalOf(a, b, c), normalOf(sides[1][0], sides[1][1], d)) < kHingeCosine) continue;
+            if (dot(normalOf(a, b, c), normalOf(sides[1][0], sides[1][1], d)) < double(kOwnSurfaceCos)) continue;
             mesh->hinges.push_back({a, b, c, d});
         }
         meshes_.push_back(std::move(mesh));
@@ -147,6 +145,8 @@ VertexFit& VertexFit::operator=(VertexFit&&) noexcept = default;
 
 VertexFit::Report VertexFit::fit(const Scene& output, const Scene& samples, const std::vector<Vec3f>& sampleIrradiance,
                                  const std::vector<uint8_t>& unseen, VertexRadiosity& out) {
+    if (!unseen.empty() && unseen.size() != samples.vertexCount())
+        throw std::logic_error("VertexFit: the unseen flags are not the sampling mesh's");
     out.irradiance.assign(output.vertexCount(), Vec3f(0.0f));
     std::vector<Report> reports(meshes_.size());
     tbb::parallel_for(size_t(0), meshes_.size(), [&](size_t i) {
@@ -154,15 +154,14 @@ VertexFit::Report VertexFit::fit(const Scene& output, const Scene& samples, cons
         Report& report = reports[i];
         // The samples' weights: a third of the area of each sampling triangle round them.
         std::vector<double> weight(mesh.sampleCount, 0.0);
-        for (uint32_t t = 0; t < mesh.sampleTriangleCount; ++t) {
-            const Triangle& tri = samples.triangles[mesh.firstSampleTriangle + t];
-            const double third = triangleArea(at(samples, tri.v[0]), at(samples, tri.v[1]), at(samples, tri.v[2])) / 3;
-            for (uint32_t v : tri.v) weight[v - mesh.firstSample] += third;
+        for (uint32_t t = mesh.firstSampleTriangle; t < mesh.firstSampleTriangle + mesh.sampleTriangleCount; ++t) {
+            const double third = double(samples.triangleArea(t)) / 3;
+            for (uint32_t v : samples.triangles[t].v) weight[v - mesh.firstSample] += third;
         }
         double total = 0;
         for (uint32_t s = 0; s < mesh.sampleCount; ++s) {
             const uint32_t g = mesh.firstSample + s;
-            if (unseen[g] || samples.vertexHidden[g]) weight[s] = 0;
+            if ((!unseen.empty() && unseen[g]) || samples.vertexHidden[g]) weight[s] = 0;
             total += weight[s];
         }
 
@@ -233,10 +232,14 @@ VertexFit::Report VertexFit::fit(const Scene& output, const Scene& samples, cons
                 mesh.factored = mesh.factor.info() == Eigen::Success;
                 ++report.factorisations;
             }
+            // A factorisation that fails or a solve that is not finite (neither is expected of a
+            // positive definite system) leaves the point values, counted.
+            bool solved = false;
             if (mesh.factored) {
-                const Eigen::MatrixX3d solved = mesh.factor.solve(rhs);
-                if (solved.allFinite()) x = solved;
+                const Eigen::MatrixX3d fitted = mesh.factor.solve(rhs);
+                if (fitted.allFinite()) x = fitted, solved = true;
             }
+            if (!solved) ++report.pointFallbacks;
         }
         for (uint32_t v = 0; v < mesh.outputCount; ++v) {
             const uint32_t g = mesh.firstOutput + v;
@@ -247,7 +250,11 @@ VertexFit::Report VertexFit::fit(const Scene& output, const Scene& samples, cons
         }
     });
     Report total;
-    for (const Report& r : reports) total.factorisations += r.factorisations, total.clampedVertices += r.clampedVertices;
+    for (const Report& r : reports) {
+        total.factorisations += r.factorisations;
+        total.clampedVertices += r.clampedVertices;
+        total.pointFallbacks += r.pointFallbacks;
+    }
     computeRadiosity(output, out);
     return total;
 }

@@ -20,15 +20,19 @@
 // has no say and its vertices take whatever values make their visible triangles right.
 // J_e is the jump of g's gradient across a hinge — an edge shared by two triangles of the same
 // unknowns whose normals are within 45° — with the two triangles unfolded into one plane, w_e the
-// hinges' area times their heights squared: the regulariser of Kavan et al., which decides what
-// the samples leave free and is 0 for a field linear across the hinge. δ, 10⁻⁶ of a mesh's mean
-// sample weight, pulls each unknown toward its point value p_u so that every system is positive
+// hinges' area over 3 times their mean height squared (so that λ weighs a gradient's jump as the
+// data weighs a value's error over the same area): the regulariser of Kavan et al., which decides
+// what the samples leave free and is 0 for a field linear across the hinge. δ, 10⁻⁶ of the mesh's
+// sample weight per unknown, pulls each unknown toward its point value p_u so that every system is positive
 // definite (a mesh that is all hidden keeps its point values); for a field linear on the mesh the
 // point values are the fit's, so the fit reproduces it exactly.
 //
 // The unknowns are a mesh's vertices welded by position and normal: copies split for their UVs are
 // one unknown (no false seam), those split for their normals, and separate meshes (materials), are
-// not. Each mesh's sparse system is factorised by Eigen's SimplicialLDLT (single-threaded, fill-
+// not. (A file without normals gets each copy its own area-weighted normal, and those differ: there
+// UV copies stay apart.) For a skinned mesh a sample's place is where the bisection made it, in
+// object space: posed, a midpoint's blended skinning puts it near its output triangle, not on it.
+// Each mesh's sparse system is factorised by Eigen's SimplicialLDLT (single-threaded, fill-
 // reducing AMD order): the same matrix gives the same bits. A mesh keeps its factorisation while
 // its matrix is bitwise the one it was made from (a static mesh whose samples' weights did not
 // change) and solves only the new right-hand side; a mesh whose weights changed (a floor under a
@@ -68,10 +72,11 @@ public:
     struct Report {
         uint64_t factorisations = 0;    // meshes factorised afresh
         uint64_t clampedVertices = 0;   // output vertices with a negative fitted channel, written as 0
+        uint64_t pointFallbacks = 0;    // meshes whose solve failed (not expected) and kept their point values
     };
     // The output's irradiance fitted to the samples' (`sampleIrradiance`, one per sample vertex;
-    // unseen[s] != 0: no weight), both scenes in the current pose; out's radiosity follows
-    // (computeRadiosity). Hidden output vertices are 0, as everywhere.
+    // unseen[s] != 0: no weight; empty: none unseen beyond the hidden ones), both scenes in the
+    // current pose; out's radiosity follows (computeRadiosity). Hidden output vertices are 0, as everywhere.
     Report fit(const Scene& output, const Scene& samples, const std::vector<Vec3f>& sampleIrradiance,
                const std::vector<uint8_t>& unseen, VertexRadiosity& out);
 

@@ -327,4 +327,13 @@ void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_
     lighting_->update(scene_, bvh_, *geometry_.regions(), MovedGeometry{change.bounds, changed}, photons_, result_, stats);
 }
 
+std::vector<uint8_t> FrameSolver::coveredVertices() const {
+    if (lighting_ && !lighting_->covered().empty()) return lighting_->covered();
+    const DiscRegions* regions = geometry_.regions();
+    if (!regions) return {};
+    VertexStarts starts;
+    starts.refreshAll(scene_, *regions);
+    return FinalGather(FinalGather::kCoverRays, settings_.trace.seed).castCovered(scene_, bvh_, starts);
+}
+
 }  // namespace qsgi

@@ -80,12 +80,10 @@ public:
     const TrackedPaths* trackedPaths() const { return tracked_.get(); }
     // The tracer, with the settings the solver gave it (emission aimed at the estimator's reach).
     const PhotonTracer& tracer() const { return tracer_; }
-    // The vertices the last frame found covered — inside or under closed geometry (FinalGather's
-    // rule) — or empty when it casts no gather rays.
-    const std::vector<uint8_t>& coveredVertices() const {
-        static const std::vector<uint8_t> none;
-        return lighting_ ? lighting_->covered() : none;
-    }
+    // The vertices covered in the last frame's pose — inside or under closed geometry, by
+    // FinalGather's rule: the gather's own flags, or without a gather the same 16 rays cast now
+    // from the disc regions' start points. Empty before any frame.
+    std::vector<uint8_t> coveredVertices() const;
 
 private:
     // What the solver holds between frames: one of these, never a mix.

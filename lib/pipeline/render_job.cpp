@@ -14,6 +14,7 @@
 
 #include "estimate/estimator.h"
 #include "estimate/impact_count.h"
+#include "estimate/vertex_fit.h"
 #include "output/asset_sink.h"
 #include "output/image_sink.h"
 #include "output/ply_sink.h"
@@ -26,7 +27,6 @@
 #include "pipeline/frame_solver.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
-#include "estimate/vertex_fit.h"
 #include "scene/contact_refinement.h"
 #include "scene/mesh_refinement.h"
 #include "trace/photon_tracer.h"
@@ -331,8 +331,8 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
                                              settings_.update};
     // Built in the rest pose, before any frame: every run refits the same BVHs (docs/design.md §6.0).
     scene_.applyPose(scene_.restPose());
-    // With the fit, the frames are solved on the sampling mesh, and the output mesh has its own BVH
-    // for the images.
+    // With the fit, the frames are solved on the sampling mesh; the output mesh is posed after it
+    // and has its own BVH, which the images trace.
     Scene& solvedScene = samplingScene_ ? *samplingScene_ : scene_;
     solvedScene.applyPose(solvedScene.restPose());
     FrameSolver solver(solvedScene, device, solverSettings);
@@ -349,12 +349,15 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         const VertexRadiosity& result = solver.solve(pose, timing, updateFollows);
         if (!fit) return SolvedFrame{frame, scene_, solver.bvh(), result};
         Stopwatch clock;
-        scene_.applyPose(pose);
-        outputBvh->updateDynamic(scene_);
+        if (scene_.applyPose(pose)) outputBvh->updateDynamic(scene_);
         const VertexFit::Report report = fit->fit(scene_, solvedScene, result.irradiance, solver.coveredVertices(), fitted);
+        if (report.pointFallbacks > 0)
+            warn("frame " + std::to_string(frame) + ": the vertex fit's solve failed for " +
+                               std::to_string(report.pointFallbacks) + " meshes, which keep their point values");
         timing.fitSeconds = clock.seconds();
         timing.fitFactorisations = report.factorisations;
         timing.fitClampedVertices = report.clampedVertices;
+        timing.estimatorStateBytes += fit->bytes();
         return SolvedFrame{frame, scene_, *outputBvh, fitted};
     };
 

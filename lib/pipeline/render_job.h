@@ -110,8 +110,8 @@ private:
 
     RenderSettings settings_;
     Scene scene_;
-    // --vertex-fit least-squares: scene_ with every edge bisected once, which the frames are
-    // solved on; the bake is then fitted to scene_'s vertices (lib/estimate/vertex_fit.h).
+    // --vertex-fit least-squares: scene_ refined near contacts, which the frames are solved on;
+    // the bake is then fitted to scene_'s vertices (lib/estimate/vertex_fit.h).
     std::optional<Scene> samplingScene_;
     Camera camera_;  // at frame 0
     Camera cameraAt(int frame) const;

@@ -515,7 +515,8 @@ std::vector<RenderOption> declareOptions() {
                  "each vertex's value: point (its own irradiance) or least-squares (the values whose interpolation "
                  "across the triangles is closest to the irradiance sampled over them; the samples are the vertices of "
                  "the mesh refined near contacts as --refine-contacts R would, R 1.5 % of the animation's diagonal, "
-                 "hidden and covered ones left out; the output keeps its vertices; docs/method.md: the least-squares vertex fit)",
+                 "hidden and covered ones (inside or under closed geometry) left out; the output keeps its vertices; "
+                 "docs/method.md: the least-squares vertex fit)",
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.vertexFit = choiceValue(kVertexFitNames, v); },
                  [](const RenderSettings& s) { return json(nameOf(kVertexFitNames, s.vertexFit)); }});
