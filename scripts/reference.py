@@ -36,6 +36,18 @@ irradiance_r/g/b, float stderr_r/g/b, uchar hidden. A point is hidden when no li
 and the ray along its normal meets the back of a face (it lies inside or under closed geometry:
 the floor under a block); a score leaves hidden points out.
 
+--agree-with VERTEX_REFERENCE.ply (with --surface N): the check that the two kinds of reference agree
+where both exist. The N points are then drawn at vertices (a vertex uniformly, one of its triangles
+uniformly, the point at that corner) of the flat interior — every incident face's normal within
+10^-3 of the vertex normal, so that both queries leave from the same plane, and no incident edge on
+a border, where a point on the surface touches the next one — and each point's E is
+compared with the vertex reference's E = B / albedo there (an emitter's vertices, hidden points and
+points dark in both left out), in
+units of their combined standard error (the vertex reference's from this run's spread scaled to its
+path count, read from its comment). It prints the mean and RMS of those z-scores and the share
+beyond 3, and exits 1 when the RMS exceeds 1.5 or the mean 0.5 (the two agree within their noise:
+RMS 1, mean 0, 0.3 % beyond 3). OUT is written as for --surface.
+
 CONFIG: a qsgi config whose "lights" are added (point lights and a uniform sky only here); --sky R,G,B
 adds a uniform sky as qsgi's --sky does (Mitsuba's `constant` emitter). Light that escapes to the sky
 is the sky's emission: it is in E_direct, and subtracted from the gathered rays as a hit's emission is.
@@ -73,6 +85,15 @@ FACE_DTYPE = np.dtype([("n", "u1"), ("v", "<i4", (3,))])
 
 
 def read_ply(path):
+    """A qsgi frame PLY's world positions, normals and triangles."""
+    v, faces = read_ply_records(path)
+    positions = np.stack([v["x"], v["y"], v["z"]], 1).astype(np.float64)
+    normals = np.stack([v["nx"], v["ny"], v["nz"]], 1).astype(np.float64)
+    return positions, normals, faces
+
+
+def read_ply_records(path):
+    """A qsgi frame PLY's vertex records (every property its header lists) and triangles."""
     with open(path, "rb") as f:
         data = f.read()
     end = data.index(b"end_header\n") + len(b"end_header\n")
@@ -94,9 +115,7 @@ def read_ply(path):
     vertex_dtype = np.dtype(fields)
     v = np.frombuffer(data, vertex_dtype, vertices, end)
     fa = np.frombuffer(data, FACE_DTYPE, faces, end + vertices * vertex_dtype.itemsize)
-    positions = np.stack([v["x"], v["y"], v["z"]], 1).astype(np.float64)
-    normals = np.stack([v["nx"], v["ny"], v["nz"]], 1).astype(np.float64)
-    return positions, normals, fa["v"].astype(np.int64)
+    return v, fa["v"].astype(np.int64)
 
 
 def write_ply(path, positions, normals, faces, radiosity, comment, referenced=None):
@@ -333,6 +352,51 @@ def surface_points(positions, normals, faces, count, seed):
     return triangle, b1, b2, p, n
 
 
+def vertex_points(positions, normals, faces, count, seed):
+    """`count` points at vertices of the flat interior (every incident face's normal within 1e-3 of
+    the vertex normal, no incident border edge), each as surface_points records it: the corner of one incident triangle
+    (b1, b2 the corner's weights), and the vertex index it sits on."""
+    a, b, c = positions[faces[:, 0]], positions[faces[:, 1]], positions[faces[:, 2]]
+    face_normal = np.cross(b - a, c - a)
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-300)
+    flat = np.ones(len(positions), bool)
+    for k in range(3):
+        off = np.sum(face_normal * normals[faces[:, k]], 1) < 1 - 1e-3
+        flat[faces[off, k]] = False
+    # Not on a border either (an edge only one triangle uses: a wall's foot on the floor), where a
+    # point on the surface meets the next surface and the vertex reference steps inward.
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    unique, uses = np.unique(edges, axis=0, return_counts=True)
+    flat[unique[uses == 1].ravel()] = False
+    incident = [[] for _ in range(len(positions))]
+    for f, tri in enumerate(faces):
+        for k in range(3):
+            incident[tri[k]].append((f, k))
+    candidates = np.flatnonzero(flat & np.array([len(i) > 0 for i in incident]))
+    rng = np.random.default_rng(seed)
+    vertex = rng.choice(candidates, min(count, len(candidates)), replace=False)
+    triangle, b1, b2 = [], [], []
+    for v in vertex:
+        f, k = incident[v][rng.integers(len(incident[v]))]
+        triangle.append(f)
+        b1.append(1.0 if k == 1 else 0.0)
+        b2.append(1.0 if k == 2 else 0.0)
+    triangle = np.array(triangle)
+    n = face_normal[triangle] * np.where(np.sum(face_normal[triangle] * normals[vertex], 1, keepdims=True) < 0, -1.0, 1.0)
+    return triangle, np.array(b1), np.array(b2), positions[vertex], n, vertex
+
+
+def paths_in_comment(path):
+    """The path count a reference PLY's comment records ("…, 16384 paths …")."""
+    with open(path, "rb") as f:
+        header = f.read(4096).split(b"end_header")[0].decode("ascii", "replace")
+    for line in header.split("\n"):
+        if line.startswith("comment") and " paths" in line:
+            words = line.split()
+            return int(words[words.index("paths") - 1])
+    sys.exit(f"{path}: no path count in its comment")
+
+
 def under_geometry(scene, origins, normals):
     """Whether the ray along each normal first meets the back of a face: the point lies inside or
     under closed geometry."""
@@ -365,6 +429,33 @@ def write_surface_ply(path, triangle, b1, b2, p, n, E, errors, hidden, comment):
     os.replace(tmp, path)
 
 
+def agreement(vertex_reference, vertex, albedo, emission, E, errors, spp, hidden):
+    """Prints how the surface points' E agrees with the vertex reference's at the same vertices
+    (hidden points, which a score leaves out, left out); returns the exit status (0: within their
+    noise)."""
+    records, _ = read_ply_records(vertex_reference)
+    if len(records) != len(albedo):
+        sys.exit(f"{vertex_reference} has {len(records)} vertices, the frame {len(albedo)}")
+    B = np.stack([records["radiosity_r"], records["radiosity_g"], records["radiosity_b"]], 1).astype(np.float64)
+    # The vertex reference's standard error: this run's, scaled from its paths to the reference's.
+    vertex_error = errors * np.sqrt(spp / paths_in_comment(vertex_reference))
+    usable = (albedo[vertex].min(1) > 0) & (emission[vertex].max(1) == 0) & ~hidden
+    E_vertex = B[vertex] / np.where(albedo[vertex] > 0, albedo[vertex], 1)
+    # Points dark in both (below 10^-3 of the median), where a stray path's 10^-7 is many of its
+    # own standard errors, say nothing about agreement.
+    usable &= np.maximum(E, E_vertex).max(1) > 1e-3 * np.median(E.max(1))
+    sigma = np.sqrt(errors ** 2 + vertex_error ** 2)
+    ok = usable[:, None] & (sigma > 0)
+    z = ((E - E_vertex) / np.where(sigma > 0, sigma, 1))[ok]
+    rms, mean, beyond = float(np.sqrt(np.mean(z ** 2))), float(np.mean(z)), float(np.mean(np.abs(z) > 3))
+    worst = np.argsort(-np.abs(np.where(ok, (E - E_vertex) / np.where(sigma > 0, sigma, 1), 0)).max(1))[:5]
+    for i in worst:
+        print(f"  vertex {vertex[i]}: surface E {E[i].round(4)} ± {errors[i].max():.2g}, vertex E {E_vertex[i].round(4)}")
+    print(f"surface points at {int(usable.sum())} flat interior vertices against {vertex_reference}: z-scores "
+          f"(difference / combined standard error, per channel) RMS {rms:.3f}, mean {mean:+.3f}, {100 * beyond:.2f} % beyond 3")
+    return 0 if rms <= 1.5 and abs(mean) <= 0.5 else 1
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("scene")
@@ -378,7 +469,11 @@ def main():
     ap.add_argument("--vertices", type=int, help="only this many vertices, drawn uniformly (dense meshes)")
     ap.add_argument("--surface", type=int, help="instead of the vertices, this many points uniformly by area over the "
                                                 "surface (OUT: a PLY of points; see above)")
+    ap.add_argument("--agree-with", metavar="VERTEX_REFERENCE", help="with --surface: points at flat interior vertices, "
+                                                                     "checked against this vertex reference (see above)")
     args = ap.parse_args()
+    if args.agree_with and args.surface is None:
+        ap.error("--agree-with needs --surface N")
     if args.surface is not None and (args.surface < 1 or args.vertices is not None):
         ap.error("--surface must be at least 1, and not with --vertices")
     if args.vertices is not None and args.vertices < 1:
@@ -397,7 +492,10 @@ def main():
         scene = build_scene(positions, faces, albedo, emission, gltf_point_lights(args.scene, args.config), sky, workdir)
     started = time.time()
     if args.surface is not None:
-        triangle, b1, b2, p, n = surface_points(positions, normals, faces, args.surface, args.seed)
+        if args.agree_with:
+            triangle, b1, b2, p, n, at_vertex = vertex_points(positions, normals, faces, args.surface, args.seed)
+        else:
+            triangle, b1, b2, p, n = surface_points(positions, normals, faces, args.surface, args.seed)
         origins = p + n * (1e-4 * diagonal)
         errors = np.zeros((len(p), 3))
         E = irradiance(scene, origins, n, args.spp, args.seed, args.chunk, errors)
@@ -406,6 +504,8 @@ def main():
                    f"point, seed {args.seed}, {len(p)} points ({int(hidden.sum())} hidden), {time.time() - started:.0f} s")
         write_surface_ply(args.out, triangle, b1, b2, p, n, E, errors, hidden.astype(np.uint8), comment)
         print(comment)
+        if args.agree_with:
+            sys.exit(agreement(args.agree_with, at_vertex, albedo, emission, E, errors, args.spp, hidden))
         return
     origins = query_points(positions, normals, faces, diagonal)
     chosen = np.arange(len(positions))
