@@ -140,6 +140,105 @@ TEST(HostileInput, AFolderAsATransformFileIsRefusedByName) {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
 }
 
+// Every file qsgi reads goes through one opening rule (util/input_file.h): a named pipe or a
+// device given as the scene, the transform file, a config, an environment map or a PLY to compare
+// is refused at once by its kind — exit 2, one line naming the path, nothing written — where it
+// used to wait for a writer or read /dev/zero's endless bytes until killed. Each run is given 30 s
+// by `timeout` (exit 124 when it hangs), far beyond the second a refusal takes.
+TEST(HostileInput, APipeOrADeviceAsAnyInputIsRefusedByItsKindWithoutWaiting) {
+    const fs::path dir = testScratchDir("hostile-not-regular");
+    const fs::path pipe = dir / "pipe.exr", out = dir / "out";
+    fs::remove(pipe);
+    ASSERT_EQ(mkfifo(pipe.c_str(), 0600), 0);
+    const std::string base = (dataDir() / "good" / "base.gltf").string();
+    const std::string good = (sourceDir() / "tests" / "reference" / "cornell_f0000.ply").string();
+    for (const std::string& path : {pipe.string(), std::string("/dev/zero")}) {
+        const std::string kind = path == "/dev/zero" ? "is a device, not a regular file" : "is a named pipe, not a regular file";
+        const std::vector<std::string> runs = {
+            "render " + path + " --out " + out.string(),
+            "render " + base + " --animation " + path + " --out " + out.string(),
+            "render --config " + path + " --out " + out.string(),
+            "render " + base + " --environment " + path + " --photons 1000 --out " + out.string(),
+            "compare " + path + " " + good,
+        };
+        for (const std::string& run : runs) {
+            SCOPED_TRACE(run);
+            fs::remove_all(out);
+            const CommandResult r = runCommand("timeout 30 " + std::string(QSGI_CLI) + " " + run);
+            EXPECT_EQ(r.exitCode, 2) << r.output;
+            EXPECT_NE(r.output.find(path + ": " + kind), std::string::npos) << r.output;
+            EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+            EXPECT_FALSE(fs::exists(out / "frame_0000.ply"));
+        }
+    }
+    fs::remove(pipe);
+}
+
+namespace {
+// A glTF of grey quads facing +y (each four corners, x then z), the last `emissive` of them lit at
+// radiance `strength` (KHR_materials_emissive_strength).
+void writeQuads(const std::string& path, const std::vector<std::vector<float>>& quads, size_t emissive, double strength) {
+    testscenes::GltfWriter w;
+    using nlohmann::json;
+    json primitives = json::array();
+    for (size_t q = 0; q < quads.size(); ++q) {
+        const int positions = w.accessor(quads[q], "VEC3");
+        const int indices = w.indices({0, 1, 2, 0, 2, 3});
+        const bool lit = q + emissive >= quads.size();
+        primitives.push_back({{"attributes", {{"POSITION", positions}}}, {"indices", indices}, {"material", lit ? 1 : 0}});
+    }
+    w.doc["scenes"] = {{{"nodes", {w.node({{"name", "Quads"}, {"mesh", 0}})}}}};
+    w.doc["meshes"] = json::array({{{"primitives", primitives}}});
+    w.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    w.doc["materials"] = json::array(
+        {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}}},
+         {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1}}}}, {"emissiveFactor", {1, 1, 1}},
+          {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", strength}}}}}}});
+    w.write(path);
+}
+std::vector<float> square(float half, float y = 0) { return {-half, y, half, half, y, half, half, y, -half, -half, y, -half}; }
+}  // namespace
+
+// Lights checked by what reaches the output (issue 48): a sky of 3·10³⁸ over a 2 µm floor and a
+// sliver of 10⁻³⁰ m² lit at 2·10³⁸ carry little power (2.4·10²⁸ W, 3·10⁸ W) but their πL
+// overflows float: refused before the render, naming the light. A point light a micrometre over
+// a floor corner passes every check made before the render (its power is 8.8·10²⁹ W) but I/d² is
+// 7·10⁴⁰: the frame's own guard refuses it — exit 2, nothing written, never a file with Inf. And a
+// spot light's direction [0, −10³⁰, 0], whose squares overflow float, is a direction: it renders.
+TEST(HostileInput, LightsWhoseRadianceOrIrradianceOverflowsAreRefusedAndALargeDirectionIsADirection) {
+    const fs::path dir = testScratchDir("hostile-overflow");
+    const std::string tiny = (dir / "tiny.gltf").string(), sliver = (dir / "sliver.gltf").string();
+    writeQuads(tiny, {square(1e-6f)}, 0, 1);
+    // The sliver: 1 m long, 10⁻³⁰ m wide, over a 1 m floor.
+    writeQuads(sliver, {square(0.5f), {-0.5f, 0.1f, 0, 0.5f, 0.1f, 0, 0.5f, 0.1f, -1e-30f, -0.5f, 0.1f, -1e-30f}}, 1, 2e38);
+    const fs::path out = dir / "out";
+    struct Case {
+        std::string arguments, message;
+    };
+    const std::string config = (dir / "close.json").string(), spot = (dir / "spot.json").string();
+    { std::ofstream(config) << R"({"lights": [{"type": "point", "position": [1, 1e-6, 1], "intensity": [7e28, 7e28, 7e28]}]})"; }
+    { std::ofstream(spot) << R"({"lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1e30, 0], "intensity": [10, 10, 10]}]})"; }
+    const std::vector<Case> cases = {
+        {tiny + " --sky 3e38", "the sky or environment map: has a radiance of 3e+38"},
+        {sliver, "materials: "},
+        {(dataDir() / "good" / "base.gltf").string() + " --radius 1 --config " + config, "its light is beyond float's range"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.arguments);
+        fs::remove_all(out);
+        const CommandResult r = runQsgi("render " + c.arguments + " --photons 1000 --no-exr --out " + out.string());
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+        EXPECT_FALSE(fs::exists(out / "frame_0000.ply"));
+    }
+    fs::remove_all(out);
+    const CommandResult lit = runQsgi("render " + (dataDir() / "good" / "base.gltf").string() + " --config " + spot +
+                                      " --photons 1000 --no-exr --quiet --out " + out.string());
+    EXPECT_EQ(lit.exitCode, 0) << lit.output;
+    EXPECT_TRUE(fs::exists(out / "frame_0000.ply"));
+}
+
 // A zero scale in a transform file hides the node for that frame (glTF's visibility, docs/design.md
 // §3; issue 23: it was refused as "not invertible"), on every axis or on one; the frame after it
 // shows the floor lit again, exactly as frame 0 (the same pose, the same photons).
@@ -372,7 +471,7 @@ TEST(HostileInput, ComparedPlysThatAreNoFilesOrClaimMoreThanTheyHoldAreRefusedBy
     const std::vector<std::pair<std::string, std::string>> cases = {
         {good + " " + huge, huge + ": header, element vertex (line 3): declares 200000000 vertices"},
         {dir.string() + " " + good, dir.string() + ": is a directory, not a PLY file"},
-        {good + " " + pipe.string(), pipe.string() + ": is not a regular file (a device, pipe or socket)"},
+        {good + " " + pipe.string(), pipe.string() + ": is a named pipe, not a regular file"},
     };
     for (const auto& [args, message] : cases) {
         // Under 1 GiB of address space: a count believed would fail to allocate, not exit 2.
@@ -400,8 +499,8 @@ TEST(HostileInput, TextureUrisNamingNoReadableFileLeaveTheFactorWithAWarningNami
     for (int up = 0; up < 64; ++up) device = "../" + device;  // past the root stays at the root
     const std::vector<std::pair<std::string, std::string>> images = {
         {"folder.png", "names a directory, not a file"},
-        {"pipe.png", "names a device, pipe or socket, not a regular file"},
-        {device, "names a device, pipe or socket, not a regular file"},
+        {"pipe.png", "names a named pipe, not a regular file"},
+        {device, "names a device, not a regular file"},
         {"huge.png", "names a file of 3221225472 bytes, beyond the 2 GiB qsgi reads for an image"},
         {"missing.png", "names no file (looked beside the glTF file)"},
         {"folder.png", "names a directory, not a file"},  // images[5]: no material decodes it

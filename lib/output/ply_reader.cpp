@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "util/error.h"
+#include "util/input_file.h"
 
 namespace qsgi {
 
@@ -79,16 +80,13 @@ const char* plural(const std::string& element) {
 // The header of a binary PLY whose first element is `first`: every element with its count and
 // properties, checked against the file's size before any data is read. `in` is left at the data.
 std::vector<PlyElement> readHeader(const std::string& path, std::ifstream& in, const std::string& first) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    const fs::file_status status = fs::status(path, ec);
-    if (fs::is_directory(status)) throw InputError(path, "", "is a directory, not a PLY file");
-    if (fs::exists(status) && !fs::is_regular_file(status))
-        throw InputError(path, "", "is not a regular file (a device, pipe or socket), not a PLY file");
+    // The one opening rule (util/input_file.h) first: a directory, device or pipe is refused by its
+    // kind before the stream opens it (a pipe's open would wait for a writer).
+    uint64_t fileSize = 0;
+    const std::string why = InputFile::problem(path, UINT64_MAX, "a PLY file", fileSize);
+    if (!why.empty()) throw InputError(path, "", why);
     in.open(path, std::ios::binary);
     if (!in) throw InputError(path, "", "cannot be opened for reading");
-    const uint64_t fileSize = fs::file_size(path, ec);
-    if (ec) throw InputError(path, "", "cannot be read (its size is unknown)");
 
     std::string line;
     if (!std::getline(in, line) || line != "ply") throw InputError(path, "line 1", "not a PLY file");
@@ -341,8 +339,8 @@ SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
 }
 
 std::string plyFirstElement(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return "";
+    uint64_t size = 0;
+    if (!InputFile::problem(path, UINT64_MAX, "a PLY file", size).empty()) return "";
     std::ifstream in(path, std::ios::binary);
     std::string line;
     if (!std::getline(in, line) || line != "ply") return "";

@@ -30,6 +30,8 @@
 #include "scene/contact_refinement.h"
 #include "scene/mesh_refinement.h"
 #include "trace/photon_tracer.h"
+#include "util/input_file.h"
+#include "util/json_file.h"
 #include "util/memory.h"
 #include "util/stopwatch.h"
 
@@ -229,8 +231,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
             }
         }
     } else if (!settings_.animationPath.empty()) {
-        std::ifstream in(settings_.animationPath, std::ios::binary);
-        animationBytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        animationBytes = readInputFile(settings_.animationPath, kMaxJsonFileBytes, "a transform file");
     }
     fingerprint_ = runFingerprint(settings_, scene_, animationBytes, camera_);
 }
@@ -264,6 +265,20 @@ Camera RenderJob::cameraAt(int frame) const {
     return placeCamera(camera_, scene_.worldTransforms(animation_.localsAt(frame))[size_t(camera_.node)],
                        scene_.worldOrigin);
 }
+
+namespace {
+// The last guard before a frame's files are made (issue 48): lights are checked against float's
+// range before the render, but a point light a hair from a surface (I/d²) is not bounded until the
+// frame is posed. A value that is not finite refuses the frame — no file with Inf, no exit 0.
+void refuseNonFinite(const SolvedFrame& frame, const std::string& scenePath) {
+    const VertexRadiosity& r = frame.result;
+    for (size_t v = 0; v < r.radiosity.size(); ++v)
+        if (!isFinite(r.radiosity[v]) || (v < r.irradiance.size() && !isFinite(r.irradiance[v])))
+            throw InputError(scenePath, "frame " + std::to_string(frame.frame) + ", vertex " + std::to_string(v),
+                             "its light is beyond float's range (a light too strong for the scene's scale, or one almost "
+                             "touching a surface): scale the light's units down");
+}
+}  // namespace
 
 FolderExpectations folderExpectations(const RenderSettings& settings, const RunFingerprint& fingerprint) {
     FolderExpectations expected;
@@ -386,6 +401,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         Stopwatch frameClock;
         FrameTiming timing;
         const SolvedFrame solved = solveFrame(frame, timing, frame < last_);
+        refuseNonFinite(solved, settings_.scenePath);
         timing.frame = frame;
         if (!calibrated) calibrate(solved);
         if (frame == start) {

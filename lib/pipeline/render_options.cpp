@@ -110,6 +110,15 @@ json environmentJson(const EnvironmentSettings& e) {
     return {{"image", pathJson(e.image)}, {"intensity", e.intensity}, {"rotation", e.rotationDegrees}};
 }
 
+// A light's direction made unit in double, scaled by its largest component first: a finite
+// direction such as [0, -1e30, 0], whose squares overflow float, is a direction, not zero.
+Vec3f unitDirection(const Vec3f& given, const std::string& file, const std::string& place) {
+    const double largest = std::max({std::fabs(double(given.x)), std::fabs(double(given.y)), std::fabs(double(given.z))});
+    if (!(largest > 0)) throw InputError(file, place, "must not be zero");
+    const Vec3d scaled = Vec3d(given) / largest;
+    return Vec3f(scaled / length(scaled));
+}
+
 PunctualLight parseLight(const json& j, const std::string& file, const std::string& place) {
     if (!j.is_object() || !j.contains("type") || !j["type"].is_string())
         throw InputError(file, place, "must be an object with a \"type\" (point, spot, directional, sky or environment)");
@@ -132,8 +141,7 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
         l.type = LightType::Directional;
         if (!j.contains("direction") || !j.contains("irradiance"))
             throw InputError(file, place, "a directional light needs \"direction\" and \"irradiance\" (W/m^2)");
-        l.direction = normalize(vec3(j["direction"], file, place + ".direction"));
-        if (dot(l.direction, l.direction) == 0) throw InputError(file, place + ".direction", "must not be zero");
+        l.direction = unitDirection(vec3(j["direction"], file, place + ".direction"), file, place + ".direction");
         l.intensity = nonNegative(vec3(j["irradiance"], file, place + ".irradiance"), "irradiance");
     } else if (type == "spot") {
         // As KHR_lights_punctual's: intensity in W/sr on the axis, cone angles in radians from it.
@@ -141,8 +149,7 @@ PunctualLight parseLight(const json& j, const std::string& file, const std::stri
         if (!j.contains("position") || !j.contains("direction") || !j.contains("intensity"))
             throw InputError(file, place, "a spot light needs \"position\", \"direction\" and \"intensity\" (W/sr)");
         l.position = vec3(j["position"], file, place + ".position");
-        l.direction = normalize(vec3(j["direction"], file, place + ".direction"));
-        if (!(dot(l.direction, l.direction) > 0)) throw InputError(file, place + ".direction", "must not be zero");
+        l.direction = unitDirection(vec3(j["direction"], file, place + ".direction"), file, place + ".direction");
         l.intensity = nonNegative(vec3(j["intensity"], file, place + ".intensity"), "intensity");
         auto angle = [&](const char* key, double fallback) {
             if (!j.contains(key)) return fallback;

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "util/error.h"
+#include "util/input_file.h"
+#include "util/memory.h"
 
 namespace qsgi {
 
@@ -14,6 +16,10 @@ namespace {
 // 16384 × 8192, the largest maps in common use; 32 bytes a pixel while loading (the file's floats,
 // the radiance and the sampling table).
 constexpr uint64_t kMaxEnvironmentPixels = uint64_t(1) << 27;
+// The largest map file read, as for any image (2 GiB).
+constexpr uint64_t kMaxEnvironmentFileBytes = uint64_t(1) << 31;
+// The sampling tables' bytes a pixel (buildTables: a double of the conditional CDF).
+constexpr uint64_t kTableBytesPerPixel = sizeof(double);
 
 // The first index k in [0, n) with cdf[k + 1] > target, for cdf[0..n] increasing: the cell
 // `target` falls in, skipping empty cells.
@@ -41,6 +47,12 @@ EnvironmentLight EnvironmentLight::fromPixels(std::vector<Vec3f> pixels, uint32_
 }
 
 EnvironmentLight EnvironmentLight::fromImage(const std::string& path, float intensity, float rotationDegrees) {
+    // The one opening rule first: a pipe, a device (/dev/zero) or a directory is refused by its
+    // kind before OpenImageIO opens the path (a pipe's open would wait for a writer, a device's
+    // bytes never end).
+    uint64_t fileBytes = 0;
+    const std::string why = InputFile::problem(path, kMaxEnvironmentFileBytes, "an environment map", fileBytes);
+    if (!why.empty()) throw InputError(path, "", why);
     auto input = OIIO::ImageInput::open(path);
     if (!input) throw InputError(path, "", "cannot be read as an image: " + oneLine(OIIO::geterror()));
     const OIIO::ImageSpec& spec = input->spec();
@@ -53,6 +65,11 @@ EnvironmentLight EnvironmentLight::fromImage(const std::string& path, float inte
     // Grey maps are read as one channel and spread to three; colour maps as their first three (R,
     // G, B; alpha ignored).
     const int channels = spec.nchannels >= 3 ? 3 : 1;
+    // What loading holds at once, before any of it is allocated: the file's floats, OpenImageIO's
+    // own copy of them while it converts, the radiance and the sampling tables.
+    const uint64_t pixelCount = uint64_t(width) * height;
+    refuseBeyondMemory(saturatingMultiply(pixelCount, 2 * 4 * uint64_t(channels) + sizeof(Vec3f) + kTableBytesPerPixel), path, "",
+                       "an environment map of " + std::to_string(width) + " x " + std::to_string(height) + " pixels");
     std::vector<float> raw(size_t(width) * height * size_t(channels));
     if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, raw.data()))
         throw InputError(path, "", "is truncated or corrupt: " + oneLine(input->geterror()));

@@ -12,6 +12,7 @@
 #include <map>
 #include <set>
 
+#include "util/input_file.h"
 #include "util/json_file.h"
 
 // Part of libtinygltf's exported API, though its header declares it only for the translation
@@ -284,14 +285,8 @@ void refuseBeyondGltfSize(const std::string& path, uint64_t size) {
 }
 
 std::string readBytes(const std::string& path) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw InputError(path, "", "no such file");
-    if (fs::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a glTF file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", "cannot be opened for reading");
-    const auto size = fs::file_size(path, ec);
-    if (!ec) refuseBeyondGltfSize(path, size);  // before reading it
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    // glTF lengths are 32-bit: a file of 2^32 bytes or more is refused before it is read.
+    return readInputFile(path, (uint64_t(1) << 32) - 1, "a glTF file");
 }
 
 // tinygltf's image callback: nothing is decoded here (see texture_colour.h). The encoded bytes of a
@@ -351,13 +346,11 @@ std::vector<std::string> uriFilePaths(const std::string& baseDir, const std::str
 // "" if `path` is a regular file of 1 to `limit` - 1 bytes (its size in `size`); else why not, as
 // what the uri names.
 std::string uriFileProblem(const std::string& path, uint64_t limit, uint64_t& size) {
-    std::error_code ec;
-    const fs::file_status status = fs::status(path, ec);
-    if (!fs::exists(status)) return "names no file";
-    if (fs::is_directory(status)) return "names a directory, not a file";
-    if (!fs::is_regular_file(status)) return "names a device, pipe or socket, not a regular file";
-    size = fs::file_size(path, ec);
-    if (ec) return "names a file that cannot be read (" + ec.message() + ")";
+    // The kind by the one opening rule (InputFile), in the words of a uri: "names a directory, …".
+    const std::string why = InputFile::problem(path, UINT64_MAX, "a file", size);
+    if (why == "no such file") return "names no file";
+    if (why.rfind("is ", 0) == 0) return "names " + why.substr(3);
+    if (!why.empty()) return "names a file that " + why;
     if (size == 0) return "names an empty file";
     if (size >= limit)
         return "names a file of " + std::to_string(size) + " bytes, beyond the " +
@@ -377,10 +370,13 @@ bool uriFileRead(std::vector<unsigned char>* out, std::string* err, const std::s
     uint64_t size = 0;
     std::string problem = uriFileProblem(path, files.imagePaths.count(path) ? kMaxImageFileBytes : kMaxBufferFileBytes, size);
     if (problem.empty()) {
-        std::ifstream in(path, std::ios::binary);
-        out->resize(size_t(size));
-        if (!in || !in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size)))
-            problem = "names a file that cannot be read";
+        try {
+            InputFile file(path, size, "a file");
+            const std::string bytes = file.readAll();
+            out->assign(bytes.begin(), bytes.end());
+        } catch (const InputError& e) {
+            problem = "names a file that " + e.problem();
+        }
     }
     if (problem.empty()) return true;
     files.problems[path] = problem;

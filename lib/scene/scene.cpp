@@ -81,6 +81,14 @@ void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, c
         }
     }
     file = sceneFile;
+    auto refuseRadiance = [&](const std::string& place, double radiance) {
+        throw InputError(file, place, "has a radiance of " + threeDigits(radiance) + " W m^-2 sr^-1, whose pi L (" +
+                                          threeDigits(kPi * radiance) + " W/m^2) is beyond the " + threeDigits(kMaxIrradiance) +
+                                          " W/m^2 qsgi carries in float irradiance (scale the light's units down)");
+    };
+    for (const Material& m : scene.materials)
+        if (m.isEmissive() && !(kPi * double(maxComponent(m.emission)) <= kMaxIrradiance))
+            refuseRadiance("materials: " + m.name, double(maxComponent(m.emission)));
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
         const Material& m = scene.materials[scene.triangleMaterial[t]];
         if (!m.isEmissive()) continue;
@@ -94,6 +102,9 @@ void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, c
         const double watts = std::max({in.x, in.y, in.z});
         file = configFile.empty() ? "command line" : configFile;
         if (!(watts <= kMaxLightPower)) refuse("the sky or environment map", watts);
+        float brightest = 0;
+        for (const Vec3f& L : scene.environment->pixels()) brightest = std::max(brightest, maxComponent(L));
+        if (!(kPi * double(brightest) <= kMaxIrradiance)) refuseRadiance("the sky or environment map", double(brightest));
         total += watts;
         file = sceneFile;
     }

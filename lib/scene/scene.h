@@ -231,7 +231,16 @@ struct Scene {
 // The most power qsgi carries, in watts: photon powers are floats, and a light's power times the
 // scene's emitters and scatterings must stay far below float's 3.4e38.
 constexpr double kMaxLightPower = 1e30;
-// Throws InputError when a light or emitter carries more than kMaxLightPower (the total too), or a
+// The most irradiance one emitter may put on a surface, in W/m² (issue 48): what reaches the output
+// is radiance and irradiance, not power — a sliver of 10⁻³⁰ m² can carry little power yet have a
+// radiance whose πL overflows float. An emissive material's πL_e and a sky's or map's π·(largest
+// radiance) (the irradiance it gives a surface open to all of it, at most) must stay below this;
+// 10⁸ below float's 3.4·10³⁸, so sums over emitters, bounces and a vertex's neighbours stay finite.
+// A point or spot light's I/d² has no such bound before the geometry is posed: the frame's own
+// check (RenderJob) refuses a non-finite value before any file is written.
+constexpr double kMaxIrradiance = 1e30;
+// Throws InputError when a light or emitter carries more than kMaxLightPower (the total too), an
+// emissive material or the sky or map has a radiance whose πL exceeds kMaxIrradiance, or a
 // point or spot light lies farther from the animation's bounds than kMaxSceneExtent. Messages name
 // sceneFile, or configFile for a light the config added (node -1). Needs animationBounds.
 void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, const std::string& configFile);

@@ -1,3 +1,4 @@
+#include "util/input_file.h"
 #include "util/json_file.h"
 
 #include <algorithm>
@@ -72,12 +73,7 @@ private:
 }  // namespace
 
 nlohmann::json readJsonFile(const std::string& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a directory, not a JSON file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", "cannot be opened for reading");
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw InputError(path, "", "cannot be read");
+    const std::string text = readInputFile(path, kMaxJsonFileBytes, "a JSON file");
     refuseDeepNesting(text, path);
     try {
         DuplicateKeyFinder duplicates(path);

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -11,12 +12,16 @@ namespace qsgi {
 
 // A JSON file of qsgi's own (a config, a transform file). Besides syntax it refuses a key given
 // twice in one object (JSON readers silently keep one of them) and nesting deeper than
-// kMaxJsonDepth; a directory or an unreadable file is refused by name.
+// kMaxJsonDepth; it is read under the one opening rule (util/input_file.h): a directory, a
+// device or a pipe is refused by its kind.
 nlohmann::json readJsonFile(const std::string& path);
 
 // Nesting deeper than this is refused before any parser sees it: recursive readers (tinygltf's
 // copy of extras) overflow the stack around 10^4–10^5 levels, and no scene needs more than a few.
 constexpr size_t kMaxJsonDepth = 256;
+// The largest JSON file read (a config, a transform file of 10^5 frames is a few MiB): its parsed
+// form takes several times its bytes.
+constexpr uint64_t kMaxJsonFileBytes = uint64_t(256) << 20;
 // Throws InputError(path, "byte N", …) at the first bracket nested deeper than kMaxJsonDepth;
 // `byteOffset` is added to N (the JSON chunk's place in a GLB).
 void refuseDeepNesting(const std::string& text, const std::string& path, size_t byteOffset = 0);
