@@ -239,6 +239,47 @@ TEST(HostileInput, LightsWhoseRadianceOrIrradianceOverflowsAreRefusedAndALargeDi
     EXPECT_TRUE(fs::exists(out / "frame_0000.ply"));
 }
 
+// One memory budget, read from the address-space limit (issue 48), consulted before what grows
+// with the input is allocated: an environment map whose header claims 12288 x 6144 pixels (its
+// loading would hold 3.1 GiB), --subdivide making more triangles than 1.5 GiB holds at 256 bytes
+// each (counted as bisection makes them: the estimate passes), and an asset whose buffers declare
+// 3.3 GiB. Each is refused naming the input, what it would need and the limit; exit 2; nothing
+// written. A buffer of 5·10⁹ bytes is beyond a GLB's 4 GiB whatever the memory.
+TEST(HostileInput, InputsBeyondTheMemoryBudgetAreRefusedBeforeTheyAreAllocated) {
+    if (kSanitized) GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space, so ulimit -v cannot apply";
+    const fs::path dir = testScratchDir("hostile-budget"), out = dir / "out";
+    const std::string base = (dataDir() / "good" / "base.gltf").string();
+    // A Radiance header and no pixels: refused before they are read.
+    { std::ofstream(dir / "big.hdr", std::ios::binary) << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 6144 +X 12288\n"; }
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(base));
+    doc["buffers"].push_back({{"byteLength", 3500000000ull}});
+    { std::ofstream(dir / "declared.gltf") << doc.dump(); }
+    doc["buffers"].back()["byteLength"] = 5000000000ull;
+    { std::ofstream(dir / "beyond.gltf") << doc.dump(); }
+    struct Case {
+        std::string limit, arguments, message;
+    };
+    const std::vector<Case> cases = {
+        {"3145728", base + " --environment " + (dir / "big.hdr").string(),
+         "big.hdr: an environment map of 12288 x 6144 pixels would need 3.1 GiB, more than the 3.0 GiB of memory ulimit -v allows"},
+        {"1572864", base + " --subdivide 0.0005", "subdivide (--subdivide): 0.0005 would make more than 6291456 triangles"},
+        {"3145728", (dir / "declared.gltf").string() + " --gltf-out",
+         "declared.gltf: buffers: asset.glb (--gltf-out: the scene's buffers, 3.3 GiB, and the bake) would need 3.3 GiB, more than "
+         "the 3.0 GiB of memory ulimit -v allows"},
+        {"", (dir / "beyond.gltf").string() + " --gltf-out", "beyond the 4 GiB a GLB file holds"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.arguments);
+        fs::remove_all(out);
+        const CommandResult r = runCommand((c.limit.empty() ? std::string() : "ulimit -v " + c.limit + " && ") + QSGI_CLI +
+                                           " render " + c.arguments + " --radius 1 --photons 1000 --no-exr --out " + out.string());
+        EXPECT_EQ(r.exitCode, 2) << r.output;
+        EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+        EXPECT_FALSE(fs::exists(out));
+    }
+}
+
 // A zero scale in a transform file hides the node for that frame (glTF's visibility, docs/design.md
 // §3; issue 23: it was refused as "not invertible"), on every axis or on one; the frame after it
 // shows the floor lit again, exactly as frame 0 (the same pose, the same photons).

@@ -6,6 +6,8 @@
 // skinned animation refined gives incremental frames byte-identical to full ones.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -241,4 +243,33 @@ TEST(MeshRefinement, IncrementalFramesOfARefinedSkinnedMeshEqualFullOnes) {
         EXPECT_TRUE(a == b) << name << ": the incremental frame differs from the full one";
         EXPECT_GT(readVertexRadiosityPly((dir / "inc" / name).string()).positions.size(), before) << name;
     }
+}
+
+// The triangle count a refinement is held to is the exact one, counted as bisection makes them
+// (issue 48): estimatedRefinedTriangles' (longest edge / LENGTH)² a triangle can fall below the
+// real count — here by 40 % — so it cannot bound memory. Limited to the real
+// count the refinement is made, and equals inspect's; one below, nothing changes.
+TEST(MeshRefinement, TheLimitHoldsTheExactTriangleCountWhichTheEstimateCanFallBelow) {
+    Scene scene = testscenes::plane(1.0f, 1, Vec3f(0.5f));  // two right triangles of a 2 m square
+    const double length = 0.01;  // 262,144 triangles; the estimate says 160,178
+    Scene full = scene;
+    const size_t real = refineMesh(full, length).trianglesAfter;
+    EXPECT_LT(estimatedRefinedTriangles(scene, length), real) << "the estimate is below the real count here";
+    Scene under = scene;
+    EXPECT_FALSE(refineMesh(under, length, real - 1).has_value());
+    EXPECT_EQ(under.triangleCount(), scene.triangleCount()) << "a refused refinement changes nothing";
+    Scene exact = scene;
+    const std::optional<RefinementReport> made = refineMesh(exact, length, real);
+    ASSERT_TRUE(made.has_value());
+    EXPECT_EQ(made->trianglesAfter, real);
+    EXPECT_EQ(exact.triangleCount(), real);
+    // The command's count (inspect) is the same refinement's.
+    const fs::path dir = testScratchDir("refinement-count");
+    testscenes::writeQuadGltf((dir / "quad.gltf").string(), true);  // 1 m: its edges 1 m and 1.41 m
+    const CommandResult inspect = runQsgi("inspect " + (dir / "quad.gltf").string() + " --subdivide 0.005 --json");
+    ASSERT_EQ(inspect.exitCode, 0) << inspect.output;
+    Warnings warnings;
+    Scene quad = loadGltfScene((dir / "quad.gltf").string(), warnings);
+    const size_t quadReal = refineMesh(quad, 0.005).trianglesAfter;
+    EXPECT_EQ(nlohmann::json::parse(inspect.output)["scene"]["triangles"].get<size_t>(), quadReal);
 }

@@ -9,6 +9,7 @@
 #include "output/baked_asset_parts.h"
 #include "output/glb_builder.h"
 #include "output/gltf_repack.h"
+#include "util/memory.h"
 
 namespace qsgi {
 
@@ -49,6 +50,19 @@ void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const
                     throw InputError(sceneFile, "meshes[" + std::to_string(mesh) + "].primitives[" + std::to_string(p) + "].attributes." + name,
                                      "is already there (a baked asset?): --gltf-out adds it, so bake the original asset");
     }
+    // What the asset will hold at least, known before the render (issue 48): every buffer as its
+    // byteLength declares it (a buffer without data is written as zeros) and one frame's bake
+    // (E and B/π, 24 bytes a vertex). It is made in memory, and a GLB's length is 32 bits.
+    uint64_t declared = 0;
+    if (doc.contains("buffers") && doc["buffers"].is_array())
+        for (const json& buffer : doc["buffers"])
+            if (buffer.is_object() && buffer.contains("byteLength") && buffer["byteLength"].is_number_unsigned())
+                declared = saturatingAdd(declared, buffer["byteLength"].get<uint64_t>());
+    const uint64_t atLeast = saturatingAdd(declared, saturatingMultiply(scene.vertexCount(), 2 * sizeof(Vec3f)));
+    const std::string what = "asset.glb (--gltf-out: the scene's buffers, " + formatBytes(declared) + ", and the bake)";
+    if (atLeast + 65536 > kMaxGlbBytes)
+        throw InputError(sceneFile, "buffers", what + " would be " + formatBytes(atLeast) + " or more, beyond the 4 GiB a GLB file holds");
+    refuseBeyondMemory(atLeast, sceneFile, "buffers", what);
 }
 
 std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, size_t frameCount,

@@ -69,6 +69,30 @@ Camera resolveCamera(const RenderSettings& s, const Scene& scene, Warnings& warn
 
 }  // namespace
 
+namespace {
+// The memory a rendered triangle takes at least (issue 48): the scene's arrays (16 bytes a
+// triangle, about 60 a vertex, half a vertex a triangle), the BVH (about 64) and the second pass's
+// per-vertex state (the gather's 16 kept probes, 256 bytes a vertex). A refinement that would make
+// more triangles than the usable memory holds at this rate is refused while it counts, before it
+// fills the memory.
+constexpr uint64_t kBytesPerRenderedTriangle = 256;
+
+size_t refinedTriangleLimit() {
+    return size_t(std::min<uint64_t>(uint64_t(kMaxRefinedTriangles), usableMemory().bytes / kBytesPerRenderedTriangle));
+}
+
+[[noreturn]] void refuseRefinement(const std::string& option, double length) {
+    const MemoryLimit memory = usableMemory();
+    const size_t limit = refinedTriangleLimit();
+    char text[400];
+    std::snprintf(text, sizeof text, "%g would make more than %zu triangles, the most %s (at %llu bytes a triangle, at least, "
+                  "in the %s of memory %s): choose a longer length",
+                  length, limit, double(limit) >= kMaxRefinedTriangles ? "a run holds" : "the memory holds",
+                  static_cast<unsigned long long>(kBytesPerRenderedTriangle), formatBytes(memory.bytes).c_str(), memory.source.c_str());
+    throw InputError(option, "", text);
+}
+}  // namespace
+
 RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     : settings_(std::move(settings)), scene_(), animation_() {
     validateSettings(settings_);
@@ -121,7 +145,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                           double(settings_.subdivide), scene_.triangleCount(), double(estimate), kMaxRefinedTriangles);
             throw InputError("subdivide (--subdivide)", "", text);
         }
-        refineMesh(scene_, settings_.subdivide);
+        if (!refineMesh(scene_, settings_.subdivide, refinedTriangleLimit()))
+            refuseRefinement("subdivide (--subdivide)", settings_.subdivide);
     }
     if (settings_.refineContacts > 0) {
         const double size = double(scene_.bounds().extent());
@@ -133,13 +158,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         }
         const std::optional<ContactRefinementReport> refined =
             refineContacts(scene_, settings_.refineContacts, animation_.lastFrame(), [&](int frame) { return animation_.poseAt(frame); },
-                           size_t(kMaxRefinedTriangles));
-        if (!refined) {
-            char text[200];
-            std::snprintf(text, sizeof text, "%g would refine %zu triangles into more than %.0e: choose a longer distance",
-                          double(settings_.refineContacts), scene_.triangleCount(), kMaxRefinedTriangles);
-            throw InputError("refine_contacts (--refine-contacts)", "", text);
-        }
+                           refinedTriangleLimit());
+        if (!refined) refuseRefinement("refine_contacts (--refine-contacts)", settings_.refineContacts);
         contactRefinement_ = {{"vertices_added", refined->mesh.verticesAfter - refined->mesh.verticesBefore},
                               {"poses_judged", refined->posesJudged}};
     }
@@ -158,13 +178,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         samplingScene_ = scene_;
         const std::optional<ContactRefinementReport> sampled =
             refineContacts(*samplingScene_, defaultRadius(scene_), animation_.lastFrame(),
-                           [&](int frame) { return animation_.poseAt(frame); }, size_t(kMaxRefinedTriangles));
-        if (!sampled) {
-            char text[200];
-            std::snprintf(text, sizeof text, "its samples near contacts would refine %zu triangles into more than %.0e",
-                          scene_.triangleCount(), kMaxRefinedTriangles);
-            throw InputError("vertex_fit (--vertex-fit)", "", text);
-        }
+                           [&](int frame) { return animation_.poseAt(frame); }, refinedTriangleLimit());
+        if (!sampled) refuseRefinement("vertex_fit (--vertex-fit): its samples near contacts", defaultRadius(scene_));
         samplingScene_->markDynamic(animation_.movedNodes(), animation_.morphedNodes());
         sweepAnimationBounds(*samplingScene_, animation_);
     }

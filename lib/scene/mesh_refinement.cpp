@@ -220,14 +220,20 @@ namespace {
 RefinementReport storeRefined(Scene& scene, std::vector<InstanceRefiner>& refiners, RefinementReport report);
 }  // namespace
 
-RefinementReport refineMesh(Scene& scene, double maxEdge) {
+RefinementReport refineMesh(Scene& scene, double maxEdge) { return *refineMesh(scene, maxEdge, SIZE_MAX); }
+
+std::optional<RefinementReport> refineMesh(Scene& scene, double maxEdge, size_t triangleLimit) {
     RefinementReport report;
     report.trianglesBefore = scene.triangleCount();
     report.verticesBefore = scene.vertexCount();
     std::vector<InstanceRefiner> refiners;
+    size_t made = 0;
     for (const MeshInstance& inst : scene.instances) {
         refiners.emplace_back(scene, inst);
-        refiners.back().refine([&](double len, uint32_t, uint32_t, uint32_t) { return len > maxEdge; }, SIZE_MAX);
+        if (!refiners.back().refine([&](double len, uint32_t, uint32_t, uint32_t) { return len > maxEdge; },
+                                    triangleLimit - std::min(triangleLimit, made)))
+            return std::nullopt;
+        made += refiners.back().triangleCount();
     }
     return storeRefined(scene, refiners, report);
 }

@@ -54,6 +54,10 @@ struct RefinementReport {
 // Refines `scene` in place (its instances, vertex and triangle arrays) and re-places every
 // instance with what it was last placed with. maxEdge > 0.
 RefinementReport refineMesh(Scene& scene, double maxEdge);
+// The same, counting the triangles as it makes them: nothing is changed, and nullopt returned, as
+// soon as more than `triangleLimit` would be made (the exact count, where estimatedRefinedTriangles
+// only guesses: longest-edge bisection makes up to four times its estimate).
+std::optional<RefinementReport> refineMesh(Scene& scene, double maxEdge, size_t triangleLimit);
 
 // Splits every edge of every mesh once, at its midpoint (a triangle becomes four, by the same
 // bisection): a sampling mesh with samples on every triangle for the least-squares vertex fit
@@ -91,8 +95,9 @@ std::optional<RefinementReport> refineMeshWhere(Scene& scene, const RefinementTr
                                                 size_t triangleLimit);
 
 // About how many triangles refineMesh(scene, maxEdge) makes (each triangle as (longest edge /
-// maxEdge)² pieces): what a run checks before refining, so that a LENGTH far too small is refused
-// instead of filling the memory.
+// maxEdge)² pieces; bisection makes up to four times that): what a run checks first, so that a
+// LENGTH far too small is refused at once; the limited refineMesh then holds the exact count to
+// the limit.
 size_t estimatedRefinedTriangles(const Scene& scene, double maxEdge);
 
 }  // namespace qsgi
