@@ -243,8 +243,9 @@ TEST(HostileInput, LightsWhoseRadianceOrIrradianceOverflowsAreRefusedAndALargeDi
 // with the input is allocated: an environment map whose header claims 12288 x 6144 pixels (its
 // loading would hold 3.1 GiB), --subdivide making more triangles than 1.5 GiB holds at 256 bytes
 // each (counted as bisection makes them: the estimate passes), and an asset whose buffers declare
-// 3.3 GiB. Each is refused naming the input, what it would need and the limit; exit 2; nothing
-// written. A buffer of 5·10⁹ bytes is beyond a GLB's 4 GiB whatever the memory.
+// 3.3 GiB, and a gather keeping 65536 hits a vertex between frames. Each is refused naming the
+// input, what it would need and the limit; exit 2; nothing written. A buffer of 5·10⁹ bytes is
+// beyond a GLB's 4 GiB whatever the memory.
 TEST(HostileInput, InputsBeyondTheMemoryBudgetAreRefusedBeforeTheyAreAllocated) {
     if (kSanitized) GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space, so ulimit -v cannot apply";
     const fs::path dir = testScratchDir("hostile-budget"), out = dir / "out";
@@ -267,6 +268,10 @@ TEST(HostileInput, InputsBeyondTheMemoryBudgetAreRefusedBeforeTheyAreAllocated) 
          "declared.gltf: buffers: asset.glb (--gltf-out: the scene's buffers, 3.3 GiB, and the bake) would need 3.3 GiB, more than "
          "the 3.0 GiB of memory ulimit -v allows"},
         {"", (dir / "beyond.gltf").string() + " --gltf-out", "beyond the 4 GiB a GLB file holds"},
+        // 21,636 vertices keeping 65536 hits of 16 bytes each between frames: 21 GiB.
+        {"3145728", (sourceDir() / "data" / "cornell" / "cornell.gltf").string() + " --animation " +
+                        (sourceDir() / "data" / "cornell" / "animation.json").string() + " --frames 0:1 --gather 65536 --gather-cache off",
+         "gather (--gather): the gather's kept hits (65536 a vertex, at 16 bytes, for 21636 vertices) would need 21.1 GiB"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.arguments);

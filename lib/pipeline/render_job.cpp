@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "estimate/estimator.h"
+#include "estimate/final_gather.h"
 #include "estimate/impact_count.h"
 #include "estimate/vertex_fit.h"
 #include "output/asset_sink.h"
@@ -249,6 +250,18 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         animationBytes = readInputFile(settings_.animationPath, kMaxJsonFileBytes, "a transform file");
     }
     fingerprint_ = runFingerprint(settings_, scene_, animationBytes, camera_);
+
+    // The gather's kept hits (16 bytes each), checked before the render (issue 48): every vertex
+    // keeps its probes under the cache, all M rays without it when a frame will update from this
+    // one (a run of one frame streams them).
+    const Scene& solved = samplingScene_ ? *samplingScene_ : scene_;
+    const LightingSettings lighting = settings_.lighting.resolvedFor(solved.vertexCount());
+    if (lighting.gathers()) {
+        const uint64_t kept = lighting.cachesGather() ? LightingSettings::kGatherProbeRays : last_ > first_ ? lighting.gatherRays : 0;
+        refuseBeyondMemory(saturatingMultiply(solved.vertexCount(), kept * sizeof(GatherHit)), "gather (--gather)", "",
+                           "the gather's kept hits (" + std::to_string(kept) + " a vertex, at " + std::to_string(sizeof(GatherHit)) +
+                               " bytes, for " + std::to_string(solved.vertexCount()) + " vertices)");
+    }
 }
 
 void RenderJob::refuseIfUnlit() const {
