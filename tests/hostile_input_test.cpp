@@ -20,6 +20,7 @@
 #include "scene/animation.h"
 #include "scene/gltf_loader.h"
 #include "test_support.h"
+#include "util/memory.h"
 
 using namespace qsgi;
 namespace fs = std::filesystem;
@@ -220,7 +221,7 @@ TEST(HostileInput, LightsWhoseRadianceOrIrradianceOverflowsAreRefusedAndALargeDi
     { std::ofstream(spot) << R"({"lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1e30, 0], "intensity": [10, 10, 10]}]})"; }
     const std::vector<Case> cases = {
         {tiny + " --sky 3e38", "the sky or environment map: has a radiance of 3e+38"},
-        {sliver, "materials: "},
+        {sliver, "has a radiance of 2e+38"},
         {(dataDir() / "good" / "base.gltf").string() + " --radius 1 --config " + config, "its light is beyond float's range"},
     };
     for (const Case& c : cases) {
@@ -231,6 +232,11 @@ TEST(HostileInput, LightsWhoseRadianceOrIrradianceOverflowsAreRefusedAndALargeDi
         EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
         EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
         EXPECT_FALSE(fs::exists(out / "frame_0000.ply"));
+        // A frame refused by the last guard leaves the folder as an interrupted run does: its log
+        // lists no frame.
+        if (fs::exists(out / "timing.json")) {
+            EXPECT_TRUE(nlohmann::json::parse(readFileBytes(out / "timing.json"))["frames"].empty());
+        }
     }
     fs::remove_all(out);
     const CommandResult lit = runQsgi("render " + (dataDir() / "good" / "base.gltf").string() + " --config " + spot +
@@ -275,6 +281,11 @@ TEST(HostileInput, InputsBeyondTheMemoryBudgetAreRefusedBeforeTheyAreAllocated) 
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.arguments);
+        // The messages name ulimit -v as the limit that binds: not so where another is lower already.
+        if (!c.limit.empty() && usableMemory().bytes < uint64_t(std::stoull(c.limit)) * 1024) {
+            std::printf("skipped: this process may use only %s\n", formatBytes(usableMemory().bytes).c_str());
+            continue;
+        }
         fs::remove_all(out);
         const CommandResult r = runCommand((c.limit.empty() ? std::string() : "ulimit -v " + c.limit + " && ") + QSGI_CLI +
                                            " render " + c.arguments + " --radius 1 --photons 1000 --no-exr --out " + out.string());

@@ -60,7 +60,7 @@ void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const
                 declared = saturatingAdd(declared, buffer["byteLength"].get<uint64_t>());
     const uint64_t atLeast = saturatingAdd(declared, saturatingMultiply(scene.vertexCount(), 2 * sizeof(Vec3f)));
     const std::string what = "asset.glb (--gltf-out: the scene's buffers, " + formatBytes(declared) + ", and the bake)";
-    if (atLeast + 65536 > kMaxGlbBytes)
+    if (atLeast > kMaxGlbBytes - 65536)
         throw InputError(sceneFile, "buffers", what + " would be " + formatBytes(atLeast) + " or more, beyond the 4 GiB a GLB file holds");
     refuseBeyondMemory(atLeast, sceneFile, "buffers", what);
 }

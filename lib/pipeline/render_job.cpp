@@ -82,14 +82,15 @@ size_t refinedTriangleLimit() {
     return size_t(std::min<uint64_t>(uint64_t(kMaxRefinedTriangles), usableMemory().bytes / kBytesPerRenderedTriangle));
 }
 
-[[noreturn]] void refuseRefinement(const std::string& option, double length) {
+[[noreturn]] void refuseRefinement(const std::string& option, double length, const char* advice = "choose a longer length") {
     const MemoryLimit memory = usableMemory();
     const size_t limit = refinedTriangleLimit();
     char text[400];
     std::snprintf(text, sizeof text, "%g would make more than %zu triangles, the most %s (at %llu bytes a triangle, at least, "
-                  "in the %s of memory %s): choose a longer length",
+                  "in the %s of memory %s): %s",
                   length, limit, double(limit) >= kMaxRefinedTriangles ? "a run holds" : "the memory holds",
-                  static_cast<unsigned long long>(kBytesPerRenderedTriangle), formatBytes(memory.bytes).c_str(), memory.source.c_str());
+                  static_cast<unsigned long long>(kBytesPerRenderedTriangle), formatBytes(memory.bytes).c_str(), memory.source.c_str(),
+                  advice);
     throw InputError(option, "", text);
 }
 }  // namespace
@@ -180,7 +181,9 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         const std::optional<ContactRefinementReport> sampled =
             refineContacts(*samplingScene_, defaultRadius(scene_), animation_.lastFrame(),
                            [&](int frame) { return animation_.poseAt(frame); }, refinedTriangleLimit());
-        if (!sampled) refuseRefinement("vertex_fit (--vertex-fit): its samples near contacts", defaultRadius(scene_));
+        if (!sampled)
+            refuseRefinement("vertex_fit (--vertex-fit): its samples, edges within R of a contact split to R/2 with R", defaultRadius(scene_),
+                             "use --vertex-fit point");
         samplingScene_->markDynamic(animation_.movedNodes(), animation_.morphedNodes());
         sweepAnimationBounds(*samplingScene_, animation_);
     }
@@ -257,7 +260,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     const Scene& solved = samplingScene_ ? *samplingScene_ : scene_;
     const LightingSettings lighting = settings_.lighting.resolvedFor(solved.vertexCount());
     if (lighting.gathers()) {
-        const uint64_t kept = lighting.cachesGather() ? LightingSettings::kGatherProbeRays : last_ > first_ ? lighting.gatherRays : 0;
+        const bool updates = last_ > first_ && !settings_.update.fullRecompute;  // else every frame streams its rays
+        const uint64_t kept = lighting.cachesGather() ? LightingSettings::kGatherProbeRays : updates ? lighting.gatherRays : 0;
         refuseBeyondMemory(saturatingMultiply(solved.vertexCount(), kept * sizeof(GatherHit)), "gather (--gather)", "",
                            "the gather's kept hits (" + std::to_string(kept) + " a vertex, at " + std::to_string(sizeof(GatherHit)) +
                                " bytes, for " + std::to_string(solved.vertexCount()) + " vertices)");
@@ -414,7 +418,9 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     };
     if (start > 0) {
         FrameTiming ignored;
-        calibrate(solveFrame(0, ignored, false));
+        const SolvedFrame frame0 = solveFrame(0, ignored, false);
+        refuseNonFinite(frame0, settings_.scenePath);
+        calibrate(frame0);
         solver.reset();
     }
 

@@ -5,6 +5,7 @@
 
 #include "scene/mesh_topology.h"
 #include "scene/triangle_grid.h"
+#include "util/memory.h"
 
 namespace qsgi {
 
@@ -94,6 +95,10 @@ std::optional<ContactRefinementReport> refineContacts(Scene& scene, double dista
         }
         return false;
     };
+    // The refiner follows each new vertex through every judged pose (12 bytes a pose, about half a
+    // vertex a triangle): those tracks must fit the memory too, whatever the caller's limit.
+    const uint64_t trackBytesPerTriangle = sizeof(Vec3f) * tracks.poses.size() / 2 + 1;
+    triangleLimit = size_t(std::min<uint64_t>(triangleLimit, usableMemory().bytes / trackBytesPerTriangle));
     const std::optional<RefinementReport> mesh = refineMeshWhere(scene, tracks, needs, triangleLimit);
     if (!mesh) return std::nullopt;
     return ContactRefinementReport{*mesh, int(frames.size())};

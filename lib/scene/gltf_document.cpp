@@ -285,8 +285,9 @@ void refuseBeyondGltfSize(const std::string& path, uint64_t size) {
 }
 
 std::string readBytes(const std::string& path) {
-    // glTF lengths are 32-bit: a file of 2^32 bytes or more is refused before it is read.
-    return readInputFile(path, (uint64_t(1) << 32) - 1, "a glTF file");
+    InputFile file(path, UINT64_MAX, "a glTF file");
+    refuseBeyondGltfSize(path, file.size());  // before it is read
+    return file.readAll();
 }
 
 // tinygltf's image callback: nothing is decoded here (see texture_colour.h). The encoded bytes of a
@@ -349,7 +350,7 @@ std::string uriFileProblem(const std::string& path, uint64_t limit, uint64_t& si
     // The kind by the one opening rule (InputFile), in the words of a uri: "names a directory, …".
     const std::string why = InputFile::problem(path, UINT64_MAX, "a file", size);
     if (why == "no such file") return "names no file";
-    if (why.rfind("is ", 0) == 0) return "names " + why.substr(3);
+    if (why.rfind("is a", 0) == 0) return "names " + why.substr(3);  // its kind: "names a named pipe, …"
     if (!why.empty()) return "names a file that " + why;
     if (size == 0) return "names an empty file";
     if (size >= limit)

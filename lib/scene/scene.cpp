@@ -86,9 +86,14 @@ void checkLightPowerAndPlace(const Scene& scene, const std::string& sceneFile, c
                                           threeDigits(kPi * radiance) + " W/m^2) is beyond the " + threeDigits(kMaxIrradiance) +
                                           " W/m^2 qsgi carries in float irradiance (scale the light's units down)");
     };
-    for (const Material& m : scene.materials)
-        if (m.isEmissive() && !(kPi * double(maxComponent(m.emission)) <= kMaxIrradiance))
+    // The materials triangles use (a variant no triangle uses lights nothing).
+    std::vector<uint8_t> used(scene.materials.size(), 0);
+    for (const uint32_t m : scene.triangleMaterial) used[m] = 1;
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        if (used[i] && m.isEmissive() && !(kPi * double(maxComponent(m.emission)) <= kMaxIrradiance))
             refuseRadiance("materials: " + m.name, double(maxComponent(m.emission)));
+    }
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
         const Material& m = scene.materials[scene.triangleMaterial[t]];
         if (!m.isEmissive()) continue;

@@ -31,7 +31,9 @@ std::string InputFile::open(const std::string& path, uint64_t limit, const std::
     if (fd_ < 0) {
         const int error = errno;
         if (error == ENOENT) return "no such file";
-        if (error == ENXIO) return kindOf(S_IFSOCK, what);  // a socket cannot be opened as a file
+        struct stat status {};
+        // A socket, or a device node with no device behind it, cannot be opened: named by its kind.
+        if (error == ENXIO && ::stat(path.c_str(), &status) == 0) return kindOf(status.st_mode, what);
         return std::string("cannot be opened for reading (") + std::strerror(error) + ")";
     }
     struct stat status {};
