@@ -16,8 +16,6 @@ namespace {
 // 16384 × 8192, the largest maps in common use; 32 bytes a pixel while loading (the file's floats,
 // the radiance and the sampling table).
 constexpr uint64_t kMaxEnvironmentPixels = uint64_t(1) << 27;
-// The largest map file read, as for any image (2 GiB).
-constexpr uint64_t kMaxEnvironmentFileBytes = uint64_t(1) << 31;
 // The sampling tables' bytes a pixel (buildTables: a double of the conditional CDF).
 constexpr uint64_t kTableBytesPerPixel = sizeof(double);
 
@@ -51,7 +49,7 @@ EnvironmentLight EnvironmentLight::fromImage(const std::string& path, float inte
     // kind before OpenImageIO opens the path (a pipe's open would wait for a writer, a device's
     // bytes never end).
     uint64_t fileBytes = 0;
-    const std::string why = InputFile::problem(path, kMaxEnvironmentFileBytes, "an environment map", fileBytes);
+    const std::string why = InputFile::problem(path, kMaxImageFileBytes, "an environment map", fileBytes);
     if (!why.empty()) throw InputError(path, "", why);
     auto input = OIIO::ImageInput::open(path);
     if (!input) throw InputError(path, "", "cannot be read as an image: " + oneLine(OIIO::geterror()));

@@ -304,10 +304,7 @@ bool keepEncodedImage(tinygltf::Image* image, int, std::string*, std::string*, i
 // tinygltf's own reader opens whatever a path names: a pipe blocks it for ever, and a directory
 // opens, seeks to an "end" of 2^63 - 1 and has that many bytes allocated. Its file callbacks are
 // replaced by these, which read a file only if it is a regular file of sane size and keep why
-// any other was not read, for the messages.
-
-constexpr uint64_t kMaxBufferFileBytes = uint64_t(1) << 32;  // glTF's limit for a binary glTF
-constexpr uint64_t kMaxImageFileBytes = uint64_t(1) << 31;   // tinygltf hands image bytes on with an int size
+// any other was not read, for the messages. Their size limits are util/input_file.h's.
 
 struct UriFiles {
     std::string baseDir;

@@ -11,6 +11,11 @@
 
 namespace qsgi {
 
+// The most bytes qsgi reads of an image, a texture or an environment map (tinygltf hands image
+// bytes on with an int size), and of a glTF buffer (glTF's limit for a binary glTF).
+constexpr uint64_t kMaxImageFileBytes = uint64_t(1) << 31;
+constexpr uint64_t kMaxBufferFileBytes = uint64_t(1) << 32;
+
 class InputFile {
 public:
     // Opens `path` under the rule; throws InputError(path, "", why not) — "no such file", "is a
