@@ -37,7 +37,7 @@ Vec3d world(const Scene& scene, const Vec3f& p) { return Vec3d(p) + scene.worldO
 
 // The floor's first pass is a constant c wherever light reaches it (0 under the block, and on the
 // block). A vertex of the block's lowest row, on a vertical face at the foot, starts its gather
-// rays a scene epsilon off the floor: each ray that leaves downward lands on the floor within a
+// rays a float error (δ_v, a few µm) off the floor: each ray that leaves downward lands on the floor within a
 // hair of the foot, on the visible side, and each upward one escapes. The exact gathered value is
 // therefore c × (the share of its rays pointing down) — whatever fraction of a floor triangle the
 // foot cuts off. (A ray from a start 10⁻⁵ m up could miss the 4 m floor only below 10⁻⁵ rad; the
@@ -55,7 +55,7 @@ TEST(CoveredVertices, TheBlocksFootSeesTheFloorsOwnValueWhereverTheFootCutsItsTr
         const SecondPassRig rig(scene);
         FinalGather gather(M, 11);
         gather.castAll(scene, rig.bvh, rig.starts);
-        const std::vector<uint8_t> covered = gather.coveredFromKept(scene);
+        const std::vector<uint8_t> covered = gather.coveredFromKept(scene, rig.starts);
 
         // Covered: exactly the floor vertices strictly inside the footprint. Floor vertices on the
         // foot line (fraction 0) start outside the block (their side step goes outward) and are

@@ -172,7 +172,7 @@ TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
         SCOPED_TRACE(c.name);
         EmbreeDevice device;
         const SceneBvh bvh(device, c.scene);
-        DiscRegions quick = DiscRegions::startsOnly(c.radius), reference = DiscRegions::startsOnly(c.radius);
+        DiscRegions quick(c.radius, false), reference(c.radius, false);
         quick.setTreeUse(DiscRegions::TreeUse::Always);  // coarse scenes too: the tree's answers against the walk's
         reference.useOwnSurfaceShortcut(false);
         quick.computeAll(c.scene, bvh);
@@ -181,8 +181,6 @@ TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
             ASSERT_TRUE(quick[v] == reference[v]) << "vertex " << v << ": eps+ " << quick[v].epsAbove << " against "
                                                   << reference[v].epsAbove << ", area " << quick[v].reachableArea << " against "
                                                   << reference[v].reachableArea;
-            const Vec3f a = vertexRayStart(c.scene, quick[v], v), b = vertexRayStart(c.scene, reference[v], v);
-            ASSERT_EQ(std::memcmp(&a, &b, sizeof(Vec3f)), 0) << "vertex " << v;
         }
         EXPECT_EQ(reference.lastWork().ownSurfacesProved, 0u);
         const uint64_t proved = quick.lastWork().ownSurfacesProved;

@@ -220,6 +220,24 @@ TEST(Incremental, WithExactDirectAndGatherEveryFrameEqualsFull) {
         }
 }
 
+// Overlapping parts (issue 56): a sheet sliding 0.5 mm over a plate, its front toward the plate, so
+// the plate's vertices it covers change every frame (by the covered-vertex rule's front-face
+// branch) and their rays start under it. Every estimator kind, with exact direct light and a gather.
+TEST(Incremental, ASheetSlidingAHairOverAPlateEqualsFull) {
+    const AnimatedScene a{"sheet sliding a hair over a plate",
+                          [] {
+                              Scene s = testscenes::plateUnderSheet(0.6f, 16, 0.2f, 6, 0.0005f, false, Vec3f(0.7f));
+                              testscenes::addPointLight(s, Vec3f(0.1f, 1.5f, 0.2f), Vec3f(20.0f));
+                              return s;
+                          },
+                          "Sheet", [](int f) { return slide(f, 0.07, 0.03); }, 4};
+    for (const EstimatorCase& e : kEstimators) {
+        if (!e.index || e.rule != DetpBoundary::Clip) continue;  // impact count, photon map, DETP
+        expectIncrementalEqualsFull(a, e, 2, true, 6000, 0.12f, TrackedPaths::kGenerations, exactDirect(16));
+        if (HasFatalFailure()) return;
+    }
+}
+
 TEST(Incremental, WithExactDirectEqualsFullWithOneThreadAndWithoutGather) {
     const AnimatedScene a = scenes()[0];
     for (const EstimatorCase& e : kEstimators) {

@@ -327,7 +327,7 @@ Scene partition(int cells, Vec3f albedo) {
     return s;
 }
 
-Scene creasedSheet(int cells, bool welded, Vec3f albedo) {
+Scene creasedSheet(int cells, bool welded, Vec3f albedo, float farQuad) {
     // Rows j = 0..cells run along the floor from z = 1 to the crease (z = 0); rows cells..2·cells
     // climb the wall. Columns i = 0..cells span x.
     std::vector<Vec3f> p, n;
@@ -362,6 +362,8 @@ Scene creasedSheet(int cells, bool welded, Vec3f albedo) {
     Scene s;
     const uint32_t m = addMaterial(s, albedo);
     s.addInstance(s.addNode("Sheet", Transform()), std::move(p), std::move(n), idx, m);
+    if (farQuad > 0)
+        addGrid(s, s.addNode("Far quad", Transform()), {farQuad, 0, 0.5f}, {1, 0, 0}, {0, 0, -1}, 1, addMaterial(s, Vec3f(0.0f)));
     s.finalize();
     return s;
 }

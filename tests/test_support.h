@@ -109,8 +109,9 @@ qsgi::Scene partition(int cells, qsgi::Vec3f albedo);
 // An L-shaped sheet: floor y = 0 (z in [0, 1]) and wall z = 0 (y in [0, 1]), x in [-1, 1]. welded:
 // one mesh whose crease row is shared and whose normals are area-weighted (the crease vertices'
 // normals are 45° from both faces); otherwise the crease row is duplicated, each side with its
-// face normal. Both have the same triangles in the same order.
-qsgi::Scene creasedSheet(int cells, bool welded, qsgi::Vec3f albedo);
+// face normal. Both have the same triangles in the same order. farQuad > 0 adds, after the sheet,
+// a black 1 m quad facing +y that far off along +x (issue 56: it only enlarges the scene).
+qsgi::Scene creasedSheet(int cells, bool welded, qsgi::Vec3f albedo, float farQuad = 0);
 // A square plate y = 0 (half size `half`, `cells` per side, facing up) and, `offset` along x
 // from its centre, a sliver y = 0 (`width` along x, 1 along z, 10 cells, facing up).
 qsgi::Scene plateAndSliver(float half, int cells, float width, float offset, qsgi::Vec3f albedo);
@@ -155,14 +156,10 @@ qsgi::Scene plateUnderSheet(float plateHalf, int plateCells, float sheetHalf, in
 }  // namespace testscenes
 
 // What the second pass's tests read (tests/direct_light_test.cpp, tests/final_gather_test.cpp): the
-// scene's BVH, its disc regions (the rays' start points) and the starts as the second pass reads them.
+// scene's BVH and the rays' start points as the second pass reads them.
 struct SecondPassRig {
     qsgi::EmbreeDevice device;
     qsgi::SceneBvh bvh;
-    qsgi::DiscRegions regions;
     qsgi::VertexStarts starts;
-    SecondPassRig(const qsgi::Scene& scene, float radius = 0.05f) : bvh(device, scene), regions(radius, false) {
-        regions.computeAll(scene, bvh);
-        starts.refreshAll(scene, regions);
-    }
+    explicit SecondPassRig(const qsgi::Scene& scene) : bvh(device, scene) { starts.computeAll(scene, bvh); }
 };

@@ -41,9 +41,7 @@ void DirectLight::readEmitters(const Scene& scene) {
 template <class Visit>
 void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& starts, uint32_t v, Visit&& visit) const {
     // The irradiance is v's own: distance and cosines from v itself. Only the shadow ray leaves
-    // from s_v, lifted clear of v's own surface; measured from s_v, a concave surface's direct
-    // light would come out too high by about twice the lift over the distance (4 % inside a
-    // sphere of radius 5r).
+    // from s_v, a float error off v (VertexStarts).
     const Vec3d p(scene.positions[v]);
     const Vec3d start(starts.point(v));
     const Vec3d n(starts.normal(v));
@@ -138,8 +136,8 @@ Vec3f DirectLight::vertexIrradiance(const Scene& scene, const SceneBvh& bvh, con
     const Vec3f origin = starts.point(v);
     Vec3d sum(0.0);
     forEachShadowRay(scene, starts, v, [&](const Vec3f& w, float tfar, const Vec3d& irradiance) {
-        // From t = 0, as the disc regions' rays (s_v is lifted clear of v's own surface; a surface
-        // beside v lies nearer than a ray epsilon). Stop short of the light's own surface: an
+        // From t = 0 (s_v lies a float error off v's own surface; a surface beside v lies as
+        // near, nearer than a ray epsilon). Stop short of the light's own surface: an
         // emissive triangle does not shadow itself.
         const float end = std::isinf(tfar) ? tfar : tfar * (1 - 1e-5f) - bvh.rayEpsilon();
         if (end > 0) {

@@ -1,6 +1,6 @@
 // Direct light, exact (docs/design.md §5.1): the irradiance D_v that reaches vertex v straight from
 // the emitters, with v's normal n_v, distances and cosines measured from v itself and visibility
-// by shadow rays from v's start point s_v (VertexStarts), lifted clear of v's own surface:
+// by shadow rays from v's start point s_v (VertexStarts: v itself, a float error up):
 //   point light   I · cosθ_v / d²   when the segment s_v → light is clear (spot lights only inside
 //                 their cone, as their photons are);
 //   directional   E · cosθ_v        when the ray from s_v against the light's direction is clear;

@@ -198,24 +198,10 @@ double meanOwnSurfaceTriangles(const Scene& scene, const MeshTopology& topology,
     return walked ? double(triangles) / double(walked) : 0;
 }
 
-// Whether some cell centre of v's disc is reachable from `start`: then the full regions keep that
-// start (they look further only when nothing is reachable from it).
-bool someCentreReachable(const Vec3f& start, const VertexDisc& disc, uint32_t v, const Scene& scene, const SceneBvh& bvh,
-                         float radius, DiscRegions::Work& tally) {
-    const DiscPatternPoints& points = discPatternPoints();
-    for (int c = 0; c < kDiscCells; ++c) {
-        ++tally.rays;
-        const Vec3d target = liftedDiscPoint(disc, scene.positions[v], scene.normals[v], radius, points.centres[size_t(c)].x,
-                                             points.centres[size_t(c)].y);
-        if (segmentClear(Vec3d(start), target, bvh)) return true;
-    }
-    return false;
-}
-
 VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                              const std::vector<Vec3f>& frontNormals, float radius, bool withCoverage,
                              OwnSurfaceScratch& scratch, const OwnSurfaceTree* tree, bool treeForOwnSurface, DiscRegions::Work& tally,
-                             DiscRegions::StaticAnswers* answers, bool staticShortcut, bool startOnly = false) {
+                             DiscRegions::StaticAnswers* answers, bool staticShortcut) {
     VertexDisc disc;
     const Vec3f& normal = scene.normals[v];
     discFrame(normal, disc.tangent, disc.bitangent);
@@ -235,21 +221,6 @@ VertexDisc computeVertexDisc(uint32_t v, const Scene& scene, const SceneBvh& bvh
     const double sideStep = std::min(1e-3 * double(radius), double(scene.sceneEpsilon()));
     const Vec3d lifted = Vec3d(scene.positions[v]) + Vec3d(normal) * double(own.epsAbove);
     const Vec3f start(lifted + Vec3d(own.towardSurface) * sideStep);
-    if (startOnly) {
-        disc.start = start;
-        if (someCentreReachable(start, disc, v, scene, bvh, radius, tally)) {
-            disc.reachableArea = 1.0f / kDiscCells;  // at least that cell: not buried
-            return disc;
-        }
-        // Nothing reachable from any centre: decide exactly as the full regions do, keep the start.
-        const uint64_t proved = tally.ownSurfacesProved;
-        VertexDisc full = computeVertexDisc(v, scene, bvh, topology, frontNormals, radius, false, scratch, tree, treeForOwnSurface, tally,
-                                            nullptr, staticShortcut);
-        tally.ownSurfacesProved = proved;  // the same own surface again: counted once
-        disc.start = full.start;
-        disc.reachableArea = full.reachableArea;
-        return disc;
-    }
     // The starts tried below: s_v, and if nothing is reachable from it, a step to each side.
     const Vec3d sides[4] = {Vec3d(disc.tangent), -Vec3d(disc.tangent), Vec3d(disc.bitangent), -Vec3d(disc.bitangent)};
     Vec3f sideStarts[4];
@@ -350,7 +321,7 @@ void DiscRegions::computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounte
 
 std::vector<uint32_t> DiscRegions::recompute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
                                              WorkCounter* progress) {
-    return compute(scene, bvh, vertices, !startsOnly_, progress);
+    return compute(scene, bvh, vertices, true, progress);
 }
 
 std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& bvh, const std::vector<uint32_t>& vertices,
@@ -392,8 +363,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
             StaticAnswers* answers = keepAnswers ? &answers_[size_t(answerSlot_[vertices[i]])] : nullptr;
             if (answers && scene.vertexDynamic[vertices[i]]) answers = nullptr;
             VertexDisc disc = computeVertexDisc(vertices[i], scene, bvh, topology, frontNormals, radius_, withCoverage_, local,
-                                                tree ? &*tree : nullptr, ownSurfaceShortcut_, tally, startsOnly_ ? nullptr : answers, staticShortcut_,
-                                                startsOnly_);
+                                                tree ? &*tree : nullptr, ownSurfaceShortcut_, tally, answers, staticShortcut_);
             changed[i] = !(disc == discs_[vertices[i]]) || disc.mixed.count() > 0;
             discs_[vertices[i]] = std::move(disc);
         }
@@ -423,11 +393,6 @@ std::vector<uint32_t> DiscRegions::touchedBy(const Scene& scene, const std::vect
         if (hit) touched.push_back(v);
     }
     return touched;
-}
-
-Vec3f vertexRayStart(const Scene& scene, const VertexDisc& disc, uint32_t v) {
-    if (!disc.fallback) return disc.start;
-    return Vec3f(Vec3d(scene.positions[v]) + Vec3d(scene.normals[v]) * double(scene.sceneEpsilon()));
 }
 
 uint64_t DiscRegions::fallbackVertices() const {

@@ -64,27 +64,10 @@ bool discPointReachable(const VertexDisc& disc, const Vec3f& centre, const Vec3f
 bool pointReachable(Reach reach, const VertexDisc& disc, const Vec3f& centre, const Vec3f& normal, float radius,
                     double x, double y, const SceneBvh* bvh);
 
-// Where v's shadow and gather rays start (docs/design.md §5.1): s_v, the point its disc's
-// reachability is decided from — side-stepped where the first choice sees nothing (a floor vertex
-// at the foot of a wall) — or, for a vertex with an empty own surface, v lifted by the scene
-// epsilon.
-Vec3f vertexRayStart(const Scene& scene, const VertexDisc& disc, uint32_t v);
-
 class DiscRegions {
 public:
     // radius: the disc radius r. withCoverage: also find the photon map's covered cells.
     DiscRegions(float radius, bool withCoverage) : radius_(radius), withCoverage_(withCoverage) {}
-    // Only each vertex's start point (and own-surface heights), for a second pass under an
-    // estimator that reads no regions (impact count, DETP's paper rule): the same start the full
-    // regions choose, found by asking the disc's cell centres only until one is clear — the first
-    // usually is — and computing the whole disc only where none is. The masks stay empty.
-    static DiscRegions startsOnly(float radius) {
-        DiscRegions regions(radius, false);
-        regions.startsOnly_ = true;
-        return regions;
-    }
-    bool hasStartsOnly() const { return startsOnly_; }
-
     // Every vertex, for the scene's current pose (bvh must hold that pose).
     // progress, if given, counts the vertices done.
     void computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounter* progress = nullptr);
@@ -154,7 +137,6 @@ private:
 
     float radius_;
     bool withCoverage_;
-    bool startsOnly_ = false;
     std::vector<VertexDisc> discs_;
     std::vector<int32_t> answerSlot_;  // per vertex, into answers_ (−1: none kept)
     std::vector<StaticAnswers> answers_;

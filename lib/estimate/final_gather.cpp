@@ -71,8 +71,8 @@ Vec3f FinalGather::rayDirection(const GatherHit& hit) { return decodeOctahedral(
 GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                                const Vec3f& direction) const {
     GatherHit out;
-    // From t = 0, as the disc regions' rays: s_v is lifted clear of v's own surface, and a surface
-    // beside v (the floor at the foot of a wall) lies a hair from s_v, nearer than a ray epsilon.
+    // From t = 0: s_v lies a float error off v's own surface (VertexStarts), and a surface
+    // beside v (the wall at a floor vertex's foot) lies as near, far nearer than a ray epsilon.
     const auto hit = bvh.intersect(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
     if (!hit) {
         out.t = std::numeric_limits<float>::infinity();
@@ -180,18 +180,25 @@ void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const Vert
 }
 
 namespace {
-bool allBackFaces(const GatherHit* hits, uint32_t count) {
+// The covered-vertex rule on v's cover rays: each meets a back face, or a front face lower above
+// v's tangent plane than the start's cover height (VertexStart::coverHeight).
+bool coveredBy(const GatherHit* hits, uint32_t count, const Vec3f& normal, float coverHeight) {
     if (count == 0) return false;
-    for (uint32_t j = 0; j < count; ++j)
-        if (hits[j].triangle != GatherHit::kBackFace) return false;
+    for (uint32_t j = 0; j < count; ++j) {
+        if (hits[j].triangle == GatherHit::kBackFace) continue;
+        if (hits[j].triangle == GatherHit::kMiss) return false;
+        const float height = hits[j].t * dot(FinalGather::rayDirection(hits[j]), normal);
+        if (!(height < coverHeight)) return false;
+    }
     return true;
 }
 }  // namespace
 
-std::vector<uint8_t> FinalGather::coveredFromKept(const Scene& scene) const {
+std::vector<uint8_t> FinalGather::coveredFromKept(const Scene& scene, const VertexStarts& starts) const {
     std::vector<uint8_t> covered(scene.vertexCount(), 0);
     if (rays_ == 0 || probeHits_.empty()) return covered;
-    for (uint32_t v = 0; v < covered.size(); ++v) covered[v] = allBackFaces(&probeHits_[size_t(v) * probes_], coverRays());
+    for (uint32_t v = 0; v < covered.size(); ++v)
+        covered[v] = coveredBy(&probeHits_[size_t(v) * probes_], coverRays(), starts.normal(v), starts.coverHeight(v));
     return covered;
 }
 
@@ -203,7 +210,7 @@ std::vector<uint8_t> FinalGather::castCovered(const Scene& scene, const SceneBvh
         GatherHit hits[kCoverRays];
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             castVertexInto(scene, bvh, starts, frontNormals, v, 0, coverRays(), hits);
-            covered[v] = allBackFaces(hits, coverRays());
+            covered[v] = coveredBy(hits, coverRays(), starts.normal(v), starts.coverHeight(v));
         }
     });
     return covered;

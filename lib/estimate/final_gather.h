@@ -1,5 +1,5 @@
 // The final gather (docs/design.md §5.1; Jensen's two-pass method with the first pass stored at the
-// vertices): from each vertex's start point s_v, M cosine-distributed rays about n_v (v's own
+// vertices): from each vertex's start point s_v (VertexStarts: v itself, a float error up), M cosine-distributed rays about n_v (v's own
 // scrambled Sobol points), each returning the first pass F interpolated over the triangle it hits
 // — F_u = ρ_u (D_u + I_u), the light a vertex reflects, emission excluded (exact direct light
 // already holds what comes straight from the emitters). A ray that escapes returns 0, and so does
@@ -76,15 +76,17 @@ public:
     // Drops every kept hit.
     void clear();
 
-    // Covered vertices (docs/design.md §5.1): every one of v's first coverRays() gather rays meets
-    // a back face — its start point lies inside closed geometry (the floor under a block standing
-    // on it). Not a vertex under a single-sided sheet (a table top facing up): its grazing rays
-    // escape or meet front faces. Read from the kept hits (every vertex keeps its probes, which
-    // hold those rays) or, for castAndGather, which keeps none, cast afresh: the same rays, the
-    // same answer.
+    // Covered vertices (docs/design.md §5.1, issues 47 and 56): every one of v's first coverRays()
+    // gather rays is blocked — by a back face (its start lies inside closed geometry: the floor
+    // under a block standing on it), or by a front face lower above v's tangent plane than
+    // starts.coverHeight(v), a quarter of v's longest edge (a part lying a hair over v: a strap
+    // on a shell, a plate on a floor, whichever mesh it belongs to). Not a vertex under a table
+    // top: its grazing rays escape or meet surfaces higher than that. Read from the kept hits
+    // (every vertex keeps its probes, which hold those rays) or, for castAndGather, which keeps
+    // none, cast afresh: the same rays, the same answer.
     static constexpr uint32_t kCoverRays = 16;
     uint32_t coverRays() const { return std::min({rays_, probes_, kCoverRays}); }
-    std::vector<uint8_t> coveredFromKept(const Scene& scene) const;
+    std::vector<uint8_t> coveredFromKept(const Scene& scene, const VertexStarts& starts) const;
     std::vector<uint8_t> castCovered(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts) const;
 
     uint32_t raysPerVertex() const { return rays_; }

@@ -15,7 +15,7 @@ TwoPassLighting::TwoPassLighting(const LightingSettings& settings, uint64_t seed
 }
 
 size_t TwoPassLighting::stateBytes() const {
-    return starts_.size() * 2 * sizeof(Vec3f) + direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes() + (cache_ ? cache_->bytes() : 0);
+    return starts_.bytes() + direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes() + (cache_ ? cache_->bytes() : 0);
 }
 
 void TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats, WorkCounter* progress) {
@@ -25,10 +25,10 @@ void TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, Fram
     stats.gatherRecords = cache_->recordCount();
 }
 
-void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const VertexRadiosity& photons,
+void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons,
                             VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress, bool keepForUpdates) {
     Stopwatch clock;
-    starts_.refreshAll(scene, regions);
+    starts_.computeAll(scene, bvh);
     if (progress) progress->start("direct", scene.vertexCount());
     direct_.computeAll(scene, bvh, starts_, progress);
     stats.directSeconds = clock.seconds();
@@ -58,16 +58,16 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const DiscR
     if (!solved_) gather_.clear();
 }
 
-void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const MovedGeometry& moved,
+void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const MovedGeometry& moved,
                              const VertexRadiosity& photons, VertexRadiosity& out, FrameTiming& stats) {
     Stopwatch clock;
     // A segment that grazes a mover's bounds is re-cast: the margin covers Embree's hits on the
-    // bounds' faces and the start points' lift.
+    // bounds' faces.
     const float margin = 4 * scene.sceneEpsilon() + bvh.rayEpsilon();
     std::vector<Bounds3f> boxes;
     for (const Bounds3f& b : moved.bounds)
         if (!b.empty()) boxes.push_back(b.expanded(margin));
-    const std::vector<uint32_t> newStarts = starts_.refresh(scene, regions, moved.touched);
+    const std::vector<uint32_t> newStarts = starts_.update(scene, bvh, moved.bounds, moved.vertexMoved);
     // Lights are static (an emissive mover is refused, docs/design.md §2): the emitters read at the
     // first solve stand.
     std::vector<uint32_t> vertices = direct_.raysMeeting(scene, starts_, boxes);
@@ -114,7 +114,7 @@ void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons
     const size_t n = scene.vertexCount();
     out.irradiance.resize(n);
     if (settings_.gathers()) {
-        covered_ = gather_.coveredFromKept(scene);
+        covered_ = gather_.coveredFromKept(scene, starts_);
         gather_.gather(scene, firstPass(scene, photons, covered_), out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);
         addDirect(scene, out);

@@ -6,8 +6,8 @@
 // visible neighbours' (covered_vertices.h).
 // It owns what that takes — the direct light and the gather's kept hits — and keeps each up to date
 // across a move, touching only what the move can change, so that every update gives the bits a
-// from-scratch solve of the same pose gives. The rays leave from the disc regions' start points
-// (DiscRegions, whose owner keeps them current; every estimator's, impact count's too).
+// from-scratch solve of the same pose gives. The rays leave from the vertices themselves
+// (VertexStarts, which it owns and keeps current: its rule depends on no estimator setting).
 #pragma once
 
 #include <memory>
@@ -30,23 +30,21 @@ namespace qsgi {
 // What a pose changed, as the second pass reads it. The scene and BVH already hold the new pose.
 struct MovedGeometry {
     const std::vector<Bounds3f>& bounds;  // old and new bounds of each moved part
-    // Vertices whose disc regions were recomputed or that moved: every vertex whose start point
-    // or normal may have changed is among them.
-    const std::vector<uint32_t>& touched;
+    const std::vector<uint8_t>& vertexMoved;
 };
 
 class TwoPassLighting {
 public:
     TwoPassLighting(const LightingSettings& settings, uint64_t seed);
 
-    // From scratch for the current pose (bvh and regions hold it). photons: the estimator's answer
+    // From scratch for the current pose (bvh holds it). photons: the estimator's answer
     // (after the first bounce). keepForUpdates false: no frame will update from this one (the
     // last frame, --full-recompute), so the gather keeps no hits — the same bits, without M hits
     // a vertex of memory — and the next frame solves from scratch.
-    void solve(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const VertexRadiosity& photons,
+    void solve(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons,
                VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress = nullptr, bool keepForUpdates = true);
     // The last solve's or update's state brought to the current pose.
-    void update(const Scene& scene, const SceneBvh& bvh, const DiscRegions& regions, const MovedGeometry& moved,
+    void update(const Scene& scene, const SceneBvh& bvh, const MovedGeometry& moved,
                 const VertexRadiosity& photons, VertexRadiosity& out, FrameTiming& stats);
     bool solved() const { return solved_; }
     void reset() { solved_ = false; }
@@ -57,6 +55,8 @@ public:
     const GatherCache* gatherCache() const { return cache_ ? &*cache_ : nullptr; }
     // The covered vertices of the last solve or update (FinalGather's rule; empty without a gather).
     const std::vector<uint8_t>& covered() const { return covered_; }
+    // Where the rays of the last solve or update started.
+    const VertexStarts& starts() const { return starts_; }
 
 private:
     void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out);

@@ -6,10 +6,8 @@
 
 namespace qsgi {
 
-VertexGeometry::VertexGeometry(const EstimatorSettings& estimator, bool secondPassReadsStarts)
-    : estimatorReadsRegions_(needsDiscRegions(estimator)) {
-    if (estimatorReadsRegions_) regions_.emplace(makeDiscRegions(estimator));
-    else if (secondPassReadsStarts) regions_.emplace(DiscRegions::startsOnly(estimator.radius));
+VertexGeometry::VertexGeometry(const EstimatorSettings& estimator) {
+    if (needsDiscRegions(estimator)) regions_.emplace(makeDiscRegions(estimator));
 }
 
 void VertexGeometry::computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounter* progress, FrameTiming& stats) {

@@ -4,9 +4,8 @@
 // and says which vertices the pose change left different. Estimators and the second pass only
 // read it; what each estimator keeps besides (DETP's sums, the photon map's lists) is its own.
 //
-// What it holds follows from who reads it: full disc regions when the estimator reads them (the
-// photon map with coverage), start points only when only the second pass does (impact count and
-// DETP's paper rule under exact direct light), nothing when nobody does.
+// It holds disc regions when the estimator reads them (DETP's boundary rules, the photon map),
+// nothing otherwise: the second pass's rays start from the vertices themselves (VertexStarts).
 #pragma once
 
 #include <optional>
@@ -23,22 +22,19 @@ namespace qsgi {
 
 class VertexGeometry {
 public:
-    // secondPassReadsStarts: exact direct light will cast rays from each vertex's s_v.
-    VertexGeometry(const EstimatorSettings& estimator, bool secondPassReadsStarts);
+    explicit VertexGeometry(const EstimatorSettings& estimator);
 
     // Every vertex, for the scene's current pose (bvh holds it).
     void computeAll(const Scene& scene, const SceneBvh& bvh, WorkCounter* progress, FrameTiming& stats);
     // After a pose change: recomputes the vertices whose test region the moved objects' old or
     // new bounds (`movedBounds`) touch, and the moved vertices. Returns, sorted, the moved
     // vertices and those whose regions may now decide differently: what estimators recompute
-    // (Estimator::verticesToRecompute) and where the second pass's rays may now start elsewhere.
+    // (Estimator::verticesToRecompute).
     std::vector<uint32_t> update(const Scene& scene, const SceneBvh& bvh, const std::vector<Bounds3f>& movedBounds,
                                  const std::vector<uint8_t>& vertexMoved, WorkCounter* progress, FrameTiming& stats);
 
-    // The regions for whoever reads them (null when nobody does), and for the estimator (null
-    // when it reads none: the regions, if any, are then the second pass's start points only).
+    // The regions (null when the estimator reads none).
     const DiscRegions* regions() const { return regions_ ? &*regions_ : nullptr; }
-    const DiscRegions* estimatorRegions() const { return estimatorReadsRegions_ ? regions() : nullptr; }
 
     // Bytes of incremental state (the static answers kept for recomputed vertices), and the
     // counts timing.json reports.
@@ -49,7 +45,6 @@ private:
     // The regions' time, vertices and work of this frame, into timing.json's fields.
     void recordWork(uint64_t vertices, double seconds, FrameTiming& stats) const;
 
-    bool estimatorReadsRegions_;
     std::optional<DiscRegions> regions_;
 };
 

@@ -1,29 +1,177 @@
 #include "estimate/vertex_starts.h"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+
+#include "estimate/own_surface.h"
+#include "scene/mesh_topology.h"
 
 namespace qsgi {
 
-void VertexStarts::refreshAll(const Scene& scene, const DiscRegions& regions) {
-    points_.resize(scene.vertexCount());
-    normals_.resize(scene.vertexCount());
-    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
-        points_[v] = vertexRayStart(scene, regions[v], v);
-        normals_[v] = scene.normals[v];
+namespace {
+
+// δ_v is 2⁻¹⁸ of the larger of v's largest coordinate and its longest incident edge, over the
+// least cosine between n_v and an incident face's normal (at least 1/8). Embree decides a hit on
+// one of v's own triangles from the start's height above its plane, computed with an error of a
+// few float ulps (2⁻²⁴) of those lengths, and the start itself is rounded to float by half an ulp
+// of v's coordinates: the height δ_v·cosθ is 64 times that, so a ray leaving above v's surface
+// never hits it by rounding, and one entering it always does. It is 4 µm on a 1 m asset.
+constexpr double kOffsetScale = 1.0 / 262144.0;
+constexpr double kLeastCosine = 0.125;
+// The inside test's probes reach 4 δ_v from a start; a start whose probes meet a surface nearer
+// than δ_v / 4 lies on it (rounding decides its side).
+constexpr double kProbeOffsets = 4, kOnSurfaceOffsets = 0.25;
+
+// What short probes from a start find: whether it lies inside closed geometry (a probe first
+// meets a back face) and how far the nearest surface around it is.
+struct StartProbe {
+    bool inside = false;
+    double clearance = 0;
+};
+
+StartProbe probeAround(const Vec3f& start, const Vec3f directions[5], double offset, const SceneBvh& bvh,
+                       const std::vector<Vec3f>& frontNormals) {
+    StartProbe probe;
+    const float reach = float(kProbeOffsets * offset);
+    probe.clearance = reach;
+    for (int k = 0; k < 5; ++k) {
+        const auto hit = bvh.intersect(start, directions[k], 0.0f, reach);
+        if (!hit) continue;
+        probe.clearance = std::min(probe.clearance, double(hit->t));
+        if (dot(frontNormals[hit->triangle], directions[k]) > 0) probe.inside = true;
     }
+    return probe;
 }
 
-std::vector<uint32_t> VertexStarts::refresh(const Scene& scene, const DiscRegions& regions, const std::vector<uint32_t>& vertices) {
-    std::vector<uint32_t> changed;
-    for (uint32_t v : vertices) {
-        const Vec3f point = vertexRayStart(scene, regions[v], v);
-        const Vec3f& normal = scene.normals[v];
-        // Bitwise: the rays are the same only if they start from the very same floats.
-        if (std::memcmp(&point, &points_[v], sizeof(Vec3f)) != 0 || std::memcmp(&normal, &normals_[v], sizeof(Vec3f)) != 0)
-            changed.push_back(v);
-        points_[v] = point;
-        normals_[v] = normal;
+bool acceptable(const StartProbe& probe, double offset) { return !probe.inside && probe.clearance >= kOnSurfaceOffsets * offset; }
+
+}  // namespace
+
+VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
+                           const std::vector<Vec3f>& frontNormals, uint32_t v) {
+    VertexStart out;
+    const Vec3d p(scene.positions[v]);
+    const Vec3d n(scene.normals[v]);
+    // v's incident triangles (welded: a UV seam does not cut them): their size, their tilt from
+    // n_v, and where v's own surface lies (those facing within 45° of n_v, as the own surface's rule).
+    double longest = 0, leastCosine = 1, areaSum = 0;
+    Vec3d centroidSum(0.0);
+    for (const uint32_t* it = topology.trianglesBegin(v); it != topology.trianglesEnd(v); ++it) {
+        const Triangle& tri = scene.triangles[*it];
+        Vec3d centroid(0.0);
+        for (uint32_t c : tri.v) {
+            longest = std::max(longest, length(Vec3d(scene.positions[c]) - p));
+            centroid += Vec3d(scene.positions[c]) / 3.0;
+        }
+        const double area = scene.triangleArea(*it);
+        if (!(area > 0)) continue;
+        const double cosine = dot(Vec3d(frontNormals[*it]), n);
+        leastCosine = std::min(leastCosine, cosine);
+        if (cosine > double(kOwnSurfaceCos)) {
+            centroidSum += centroid * area;
+            areaSum += area;
+        }
     }
+    const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z), longest});
+    double offset = magnitude * kOffsetScale / std::max(leastCosine, kLeastCosine);
+    if (!(offset > 0)) offset = double(scene.sceneEpsilon());  // a lone vertex at the origin
+    out.offset = float(offset);
+    out.coverHeight = float(0.25 * longest);
+    const Vec3d lifted = p + n * offset;
+    out.point = Vec3f(lifted);
+    if (scene.vertexHidden[v]) return out;  // casts nothing
+    // The step over v's own surface: a floor vertex at the foot of a wall of its own mesh then
+    // starts on the floor's side of the wall's plane, not on it.
+    if (areaSum > 0) {
+        const Vec3d toCentroid = centroidSum / areaSum - p;
+        const Vec3d tangential = toCentroid - n * dot(toCentroid, n);
+        if (length(tangential) > 1e-9 * longest) out.point = Vec3f(lifted + normalize(tangential) * offset);
+    }
+    // Inside other geometry, or on a surface through v that is not v's (a block's wall on v's foot
+    // line, which rounding puts the start on either side of): step sideways by 2 δ_v. A side
+    // point is inside something when the ray from it back to v's lifted point leaves through a
+    // back face — robust, as the side point lies off any plane through v — and then the point
+    // opposite it is where the open side is.
+    Vec3f tangent, bitangent;
+    orthonormalBasis(scene.normals[v], tangent, bitangent);
+    const Vec3f probes[5] = {tangent, -tangent, bitangent, -bitangent, scene.normals[v]};
+    Vec3f side[4];
+    bool sideInside[4];
+    for (int k = 0; k < 4; ++k) {
+        side[k] = Vec3f(lifted + Vec3d(probes[k]) * (2 * offset));
+        const Vec3f back = -probes[k];
+        const auto hit = bvh.intersect(side[k], back, 0.0f, float(2 * offset));
+        sideInside[k] = hit && dot(frontNormals[hit->triangle], back) > 0;
+    }
+    StartProbe best = probeAround(out.point, probes, offset, bvh, frontNormals);
+    if (acceptable(best, offset) && std::none_of(sideInside, sideInside + 4, [](bool b) { return b; })) return out;
+    for (int k = 0; k < 4; ++k)
+        if (!sideInside[k] && sideInside[k ^ 1]) {
+            out.point = side[k];
+            return out;
+        }
+    // Inside something larger than the step, or hemmed in all round: the clearest start, outside first.
+    for (int k = 0; k < 4; ++k) {
+        const StartProbe probe = probeAround(side[k], probes, offset, bvh, frontNormals);
+        const bool better = probe.inside != best.inside ? !probe.inside : probe.clearance > best.clearance;
+        if (!better) continue;
+        best = probe;
+        out.point = side[k];
+    }
+    return out;
+}
+
+void VertexStarts::computeAll(const Scene& scene, const SceneBvh& bvh) {
+    starts_.assign(scene.vertexCount(), VertexStart{});
+    normals_.assign(scene.normals.begin(), scene.normals.end());
+    const MeshTopology topology(scene.positions, scene.triangles);
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 256), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t v = r.begin(); v != r.end(); ++v) starts_[v] = vertexRayStart(scene, bvh, topology, frontNormals, v);
+    });
+}
+
+std::vector<uint32_t> VertexStarts::update(const Scene& scene, const SceneBvh& bvh, const std::vector<Bounds3f>& movedBounds,
+                                           const std::vector<uint8_t>& vertexMoved) {
+    // A vertex that did not move keeps its offset unless one of its triangles moved, and then it
+    // lies in that triangle's bounds: the boxes widened by its reach find every vertex whose
+    // start may differ. The ray epsilon covers the widening's rounding, with room to spare.
+    std::vector<uint8_t> touched(scene.vertexCount(), 0);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 1024), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t v = r.begin(); v != r.end(); ++v) {
+            if (vertexMoved[v]) {
+                touched[v] = 1;
+                continue;
+            }
+            const float reach = kReachOffsets * starts_[v].offset + bvh.rayEpsilon();
+            for (const Bounds3f& box : movedBounds)
+                if (box.expanded(reach).contains(scene.positions[v])) {
+                    touched[v] = 1;
+                    break;
+                }
+        }
+    });
+    std::vector<uint32_t> changed;
+    if (std::find(touched.begin(), touched.end(), uint8_t(1)) == touched.end()) return changed;
+    const MeshTopology topology(scene.positions, scene.triangles);
+    const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
+    std::vector<uint8_t> differs(scene.vertexCount(), 0);
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 1024), [&](const tbb::blocked_range<uint32_t>& r) {
+        for (uint32_t v = r.begin(); v != r.end(); ++v) {
+            if (!touched[v]) continue;
+            const VertexStart start = vertexRayStart(scene, bvh, topology, frontNormals, v);
+            // Bitwise: the rays are the same only if they start from the very same floats.
+            differs[v] = std::memcmp(&start.point, &starts_[v].point, sizeof(Vec3f)) != 0 ||
+                         std::memcmp(&scene.normals[v], &normals_[v], sizeof(Vec3f)) != 0;
+            starts_[v] = start;
+            normals_[v] = scene.normals[v];
+        }
+    });
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v)
+        if (differs[v]) changed.push_back(v);
     return changed;
 }
 

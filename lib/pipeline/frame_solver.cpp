@@ -61,11 +61,9 @@ FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSo
     : scene_(scene), settings_(settings),
       work_([this](const char* name, uint64_t done, uint64_t total) { stage(name, done, total); }),
       bvh_(device, scene),
-      // The second pass's rays start where the disc regions say, whatever the estimator
-      // (docs/design.md §5.1).
-      geometry_(settings.estimator, settings.lighting.exactDirect()),
+      geometry_(settings.estimator),
       estimator_(Estimator::create(settings.estimator,
-                                   EstimatorContext{scene_, bvh_, device, geometry_.estimatorRegions(), !settings.update.fullRecompute,
+                                   EstimatorContext{scene_, bvh_, device, geometry_.regions(), !settings.update.fullRecompute,
                                                     &work_, settings.lighting.exactDirect()})),
       tracer_(scene, bvh_, aimedAt(settings.trace, estimator_->reach())) {
     // An auto gather cache is settled once, for the scene the run renders (its vertices do not
@@ -216,7 +214,7 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
         }
     }
     stats.estimationSeconds += regionSeconds;
-    if (lighting_) secondPass(change, changed, updateFollows, stats);
+    if (lighting_) secondPass(change, updateFollows, stats);
     if (mode_ == Mode::Tracking) {
         stats.trackedPaths = tracked_->trackedPaths();
         stats.trackedSegments = tracked_->trackedSegments();
@@ -315,24 +313,21 @@ void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector
 
 namespace qsgi {
 
-void FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, bool updateFollows,
-                             FrameTiming& stats) {
+void FrameSolver::secondPass(const PoseChange& change, bool updateFollows, FrameTiming& stats) {
     if (!lighting_->solved() || settings_.update.fullRecompute) {
         // Keep what an update reads only if one may come.
         const bool keep = updateFollows && !settings_.update.fullRecompute;
-        lighting_->solve(scene_, bvh_, *geometry_.regions(), photons_, result_, stats, &work_, keep);
+        lighting_->solve(scene_, bvh_, photons_, result_, stats, &work_, keep);
         return;
     }
     stage("gathering");
-    lighting_->update(scene_, bvh_, *geometry_.regions(), MovedGeometry{change.bounds, changed}, photons_, result_, stats);
+    lighting_->update(scene_, bvh_, MovedGeometry{change.bounds, change.vertexMoved}, photons_, result_, stats);
 }
 
 std::vector<uint8_t> FrameSolver::coveredVertices() const {
     if (lighting_ && !lighting_->covered().empty()) return lighting_->covered();
-    const DiscRegions* regions = geometry_.regions();
-    if (!regions) return {};
     VertexStarts starts;
-    starts.refreshAll(scene_, *regions);
+    starts.computeAll(scene_, bvh_);
     return FinalGather(FinalGather::kCoverRays, settings_.trace.seed).castCovered(scene_, bvh_, starts);
 }
 

@@ -82,7 +82,7 @@ public:
     const PhotonTracer& tracer() const { return tracer_; }
     // The vertices covered in the last frame's pose — inside or under closed geometry, by
     // FinalGather's rule: the gather's own flags, or without a gather the same 16 rays cast now
-    // from the disc regions' start points. Empty before any frame.
+    // from the vertices' start points (VertexStarts).
     std::vector<uint8_t> coveredVertices() const;
 
 private:
@@ -136,8 +136,8 @@ private:
     // Where the estimator's answer goes: result_ itself, or photons_ under a second pass.
     VertexRadiosity& estimate() { return lighting_ ? photons_ : result_; }
     // The second pass for this frame: from scratch the first time and under --full-recompute,
-    // else brought from the last frame's. `changed`: the vertices whose rays may start elsewhere.
-    void secondPass(const PoseChange& change, const std::vector<uint32_t>& changed, bool updateFollows, FrameTiming& stats);
+    // else brought from the last frame's.
+    void secondPass(const PoseChange& change, bool updateFollows, FrameTiming& stats);
 
     Scene& scene_;
     FrameSolverSettings settings_;
