@@ -12,6 +12,7 @@
 #include "estimate/final_gather.h"
 #include "pipeline/frame_solver.h"
 #include "pipeline/render_settings.h"
+#include "scene/gltf_loader.h"
 #include "scene/mesh_topology.h"
 #include "test_support.h"
 
@@ -83,16 +84,17 @@ Vec3d worldOf(const Scene& scene, const Vec3f& p) { return Vec3d(p) + scene.worl
 // The first test: two quads at 90° (testscenes::creasedSheet, 2 cells a side: coarse),
 // black, under a sky of radiance 1. At every vertex — on the crease with its 45° normal (welded) or
 // its face's (split), on the borders, at the corners — D equals π × the sky share seen from the
-// vertex, found here by an independent ray cast against the two rectangles from a point 10⁻⁷ m
-// toward the inside of the L. The sky's S cosine-distributed rays estimate the share with a
+// vertex, found here by an independent ray cast against the two rectangles from the vertex (10⁻⁹ m
+// along its normal; and out of the wall where it stands at the foot of one). The sky's S cosine-distributed rays estimate the share with a
 // standard error of at most √(s(1−s)/S) (Sobol points do better); the quadrature's own error is at
 // most 2/grid. And D is the same to the bit for any photon radius: the rays no longer start from a
 // point lifted with r.
 TEST(VertexStarts, ACreaseUnderASkyReceivesPiTimesItsExactSkyShareWhateverTheRadius) {
     constexpr uint32_t S = 65536;
     constexpr int kGrid = 1024;
-    const std::vector<Rectangle> sheet = {{{-1, 0, 0}, {2, 0, 0}, {0, 0, 1}},   // floor y = 0
-                                          {{-1, 0, 0}, {2, 0, 0}, {0, 1, 0}}};  // wall z = 0
+    const std::vector<Rectangle> sheet = {{{-1, 0, 0}, {2, 0, 0}, {0, 0, 1}},   // floor y = 0, front +y
+                                          {{-1, 0, 0}, {2, 0, 0}, {0, 1, 0}}};  // wall z = 0, front +z
+    const Vec3d fronts[2] = {{0, 1, 0}, {0, 0, 1}};
     for (const bool welded : {true, false}) {
         SCOPED_TRACE(welded ? "welded (45° normals on the crease)" : "split (face normals)");
         Scene scene = testscenes::creasedSheet(2, welded, Vec3f(0.0f));
@@ -104,9 +106,13 @@ TEST(VertexStarts, ACreaseUnderASkyReceivesPiTimesItsExactSkyShareWhateverTheRad
                 first = D;
                 double worst = 0;
                 for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
-                    const Vec3d p = worldOf(scene, scene.positions[v]);
-                    const Vec3d inward = normalize(Vec3d(0, 0.5, 0.5) - p);
-                    const double share = skyShare(p + inward * 1e-7, Vec3d(scene.normals[v]), sheet, kGrid);
+                    // From the vertex itself, 10⁻⁹ m along its normal, and 10⁻⁸ m out of the front
+                    // of a wall standing on it (a split crease's other side, 90° from the normal).
+                    const Vec3d p = worldOf(scene, scene.positions[v]), n = normalize(Vec3d(scene.normals[v]));
+                    Vec3d from = p + n * 1e-9;
+                    for (int k = 0; k < 2; ++k)
+                        if (dot(p - sheet[k].corner, fronts[k]) == 0 && dot(fronts[k], n) < 0.125) from += fronts[k] * 1e-8;
+                    const double share = skyShare(from, n, sheet, kGrid);
                     const double tolerance = M_PI * (4 * std::sqrt(share * (1 - share) / S) + 2.0 / kGrid);
                     EXPECT_NEAR(D[v].x, M_PI * share, tolerance) << "vertex " << v << " at " << p.x << ", " << p.y << ", " << p.z;
                     worst = std::max(worst, std::abs(D[v].x - M_PI * share) / (M_PI * share));
@@ -215,7 +221,7 @@ TEST(VertexStarts, StartsLieWithinAFewFloatErrorsOfTheirVertex) {
         ASSERT_EQ(one.point, starts.point(v)) << "vertex " << v;
         const double away = length(Vec3d(starts.point(v)) - Vec3d(cornell.positions[v]));
         ASSERT_GT(one.offset, 0.0f);
-        ASSERT_LE(away, 3.0 * one.offset) << "vertex " << v;
+        ASSERT_LE(away, 5.0 * one.offset) << "vertex " << v;
         ASSERT_LE(one.offset, 1e-4 * cornell.animationBounds.extent()) << "vertex " << v;
     }
 }

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstring>
 
-#include "estimate/own_surface.h"
 #include "scene/mesh_topology.h"
 
 namespace qsgi {
@@ -25,21 +24,29 @@ constexpr double kLeastCosine = 0.125;
 // than δ_v / 4 lies on it (rounding decides its side).
 constexpr double kProbeOffsets = 4, kOnSurfaceOffsets = 0.25;
 
+// v's own triangles (those at its welded position), which the probes below look past: stepping a
+// hair sideways in a concave crease crosses v's own surface, which is not other geometry.
+struct OwnTriangles {
+    const uint32_t *begin, *end;
+    bool contain(uint32_t tri) const { return std::binary_search(begin, end, tri); }
+};
+
 // What short probes from a start find: whether it lies inside closed geometry (a probe first
-// meets a back face) and how far the nearest surface around it is.
+// meets a back face) and how far the nearest surface around it is. A probe that first meets one
+// of v's own triangles tells nothing.
 struct StartProbe {
     bool inside = false;
     double clearance = 0;
 };
 
 StartProbe probeAround(const Vec3f& start, const Vec3f directions[5], double offset, const SceneBvh& bvh,
-                       const std::vector<Vec3f>& frontNormals) {
+                       const std::vector<Vec3f>& frontNormals, const OwnTriangles& own) {
     StartProbe probe;
     const float reach = float(kProbeOffsets * offset);
     probe.clearance = reach;
     for (int k = 0; k < 5; ++k) {
         const auto hit = bvh.intersect(start, directions[k], 0.0f, reach);
-        if (!hit) continue;
+        if (!hit || own.contain(hit->triangle)) continue;
         probe.clearance = std::min(probe.clearance, double(hit->t));
         if (dot(frontNormals[hit->triangle], directions[k]) > 0) probe.inside = true;
     }
@@ -56,40 +63,37 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
     const Vec3d p(scene.positions[v]);
     const Vec3d n(scene.normals[v]);
     // v's incident triangles (welded: a UV seam does not cut them): their size, their tilt from
-    // n_v, and where v's own surface lies (those facing within 45° of n_v, as the own surface's rule).
-    double longest = 0, leastCosine = 1, areaSum = 0;
-    Vec3d centroidSum(0.0);
+    // n_v, and those that stand up from v's tangent plane (cosine below kLeastCosine: the wall at
+    // a floor vertex's foot, where the floor and the wall meet with split normals), which the lift
+    // along n_v alone would not clear.
+    double longest = 0, leastCosine = 1;
+    Vec3d awayFromWalls(0.0);
+    const Vec3d unit = normalize(n);
     for (const uint32_t* it = topology.trianglesBegin(v); it != topology.trianglesEnd(v); ++it) {
-        const Triangle& tri = scene.triangles[*it];
-        Vec3d centroid(0.0);
-        for (uint32_t c : tri.v) {
-            longest = std::max(longest, length(Vec3d(scene.positions[c]) - p));
-            centroid += Vec3d(scene.positions[c]) / 3.0;
-        }
-        const double area = scene.triangleArea(*it);
-        if (!(area > 0)) continue;
-        const double cosine = dot(Vec3d(frontNormals[*it]), n);
+        for (uint32_t c : scene.triangles[*it].v) longest = std::max(longest, length(Vec3d(scene.positions[c]) - p));
+        if (!(scene.triangleArea(*it) > 0)) continue;
+        const Vec3d face(frontNormals[*it]);
+        const double cosine = dot(face, n);
         leastCosine = std::min(leastCosine, cosine);
-        if (cosine > double(kOwnSurfaceCos)) {
-            centroidSum += centroid * area;
-            areaSum += area;
-        }
+        if (cosine < kLeastCosine) awayFromWalls += face - unit * dot(face, unit);
     }
     const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z), longest});
     double offset = magnitude * kOffsetScale / std::max(leastCosine, kLeastCosine);
     if (!(offset > 0)) offset = double(scene.sceneEpsilon());  // a lone vertex at the origin
     out.offset = float(offset);
     out.coverHeight = float(0.25 * longest);
-    const Vec3d lifted = p + n * offset;
-    out.point = Vec3f(lifted);
-    if (scene.vertexHidden[v]) return out;  // casts nothing
-    // The step over v's own surface: a floor vertex at the foot of a wall of its own mesh then
-    // starts on the floor's side of the wall's plane, not on it.
-    if (areaSum > 0) {
-        const Vec3d toCentroid = centroidSum / areaSum - p;
-        const Vec3d tangential = toCentroid - n * dot(toCentroid, n);
-        if (length(tangential) > 1e-9 * longest) out.point = Vec3f(lifted + normalize(tangential) * offset);
+    Vec3d lifted = p + n * offset;
+    if (scene.vertexHidden[v]) {
+        out.point = Vec3f(lifted);
+        return out;  // casts nothing
     }
+    // Off the walls of v's own mesh that stand on v, by 2 δ_v out of their front: the floor's side
+    // of the wall's plane, not on it. Nowhere else does the start leave v's normal: a step along
+    // a face would put the faces round a smooth-shaded vertex in the way of its own hemisphere
+    // (π on a smooth icosahedron under a sky, not a per-corner bake's 0.894 π).
+    if (length(awayFromWalls) > 0) lifted += normalize(awayFromWalls) * (2 * offset);
+    out.point = Vec3f(lifted);
+    const OwnTriangles own{topology.trianglesBegin(v), topology.trianglesEnd(v)};
     // Inside other geometry, or on a surface through v that is not v's (a block's wall on v's foot
     // line, which rounding puts the start on either side of): step sideways by 2 δ_v. A side
     // point is inside something when the ray from it back to v's lifted point leaves through a
@@ -104,9 +108,9 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
         side[k] = Vec3f(lifted + Vec3d(probes[k]) * (2 * offset));
         const Vec3f back = -probes[k];
         const auto hit = bvh.intersect(side[k], back, 0.0f, float(2 * offset));
-        sideInside[k] = hit && dot(frontNormals[hit->triangle], back) > 0;
+        sideInside[k] = hit && !own.contain(hit->triangle) && dot(frontNormals[hit->triangle], back) > 0;
     }
-    StartProbe best = probeAround(out.point, probes, offset, bvh, frontNormals);
+    StartProbe best = probeAround(out.point, probes, offset, bvh, frontNormals, own);
     if (acceptable(best, offset) && std::none_of(sideInside, sideInside + 4, [](bool b) { return b; })) return out;
     for (int k = 0; k < 4; ++k)
         if (!sideInside[k] && sideInside[k ^ 1]) {
@@ -115,7 +119,7 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
         }
     // Inside something larger than the step, or hemmed in all round: the clearest start, outside first.
     for (int k = 0; k < 4; ++k) {
-        const StartProbe probe = probeAround(side[k], probes, offset, bvh, frontNormals);
+        const StartProbe probe = probeAround(side[k], probes, offset, bvh, frontNormals, own);
         const bool better = probe.inside != best.inside ? !probe.inside : probe.clearance > best.clearance;
         if (!better) continue;
         best = probe;

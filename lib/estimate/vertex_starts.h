@@ -1,6 +1,6 @@
 // Where each vertex's shadow and gather rays leave from, and along which normal (docs/design.md
 // §5.1, issue 56): the vertex itself, as close as floating point allows. The start is
-//   s_v = v + δ_v n_v (+ δ_v u_v, a step over v's own surface),
+//   s_v = v + δ_v n_v (+ 2 δ_v out of the front of a wall of v's own mesh standing on v),
 // where δ_v is set by the float error of v's coordinates and its incident triangles' size —
 // the geometry's own scale, never the photon radius nor the scene's diagonal — so s_v sees what
 // the point v sees: a direction into the back of v's own surface meets one of v's triangles at
@@ -10,8 +10,8 @@
 // inside it) does the start step sideways, by 2δ_v, to the open side.
 //
 // It owns the rule and keeps it current across moves: a vertex's start depends on the geometry
-// within kReachOffsets δ_v of v (its incident triangles, and the short probes of the inside
-// test), so after a pose only the moved vertices and those that near to a moved part's old or new
+// within kReachOffsets δ_v of v (its incident triangles, the step and the short probes of the
+// inside test), so after a pose only the moved vertices and those that near to a moved part's old or new
 // bounds are looked at again, with the same function: an update gives what a from-scratch
 // computation of the pose gives, to the bit.
 #pragma once
@@ -43,8 +43,9 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
 class VertexStarts {
 public:
     // How far from v, in units of its offset δ_v, the geometry its start depends on may lie:
-    // the lift and side step (at most 3 δ_v) and the inside test's probes (4 δ_v from there).
-    static constexpr float kReachOffsets = 8;
+    // the lift and the steps (at most 5 δ_v together) and the inside test's probes (4 δ_v from
+    // there).
+    static constexpr float kReachOffsets = 10;
 
     // Every vertex, for the scene's current pose (bvh holds it).
     void computeAll(const Scene& scene, const SceneBvh& bvh);
