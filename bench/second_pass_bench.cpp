@@ -135,7 +135,8 @@ void BM_GatherRays(benchmark::State& state) {
         switch (form) {
             case kStreamed: {
                 FinalGather streamed(kRaysPerVertex, 1);
-                streamed.castAndGather(g->scene, *g->bvh, g->starts, firstPass, gathered);
+                const std::vector<uint8_t> none;
+                streamed.castAndGather(g->scene, *g->bvh, g->starts, FinalGather::FirstPass{firstPass, firstPass, none}, gathered);
                 hits = rays;
                 break;
             }

@@ -326,20 +326,25 @@ Vec3f FinalGather::meanOverHits(const Scene& scene, const std::vector<Vec3f>& fi
     return Vec3f(sum / double(rays_));
 }
 
-void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const {
+void FinalGather::gather(const Scene& scene, const FirstPass& firstPass, std::vector<Vec3f>& out) const {
     out.assign(scene.vertexCount(), Vec3f(0.0f));
     if (rays_ == 0) return;
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             if (!hasAllRays(v)) continue;
             const GatherHit* rest = cached() ? restOf(v) : nullptr;
-            out[v] = meanOverHits(scene, firstPass, &probeHits_[size_t(v) * probes_], rest);
+            out[v] = meanOverHits(scene, firstPass.readBy(v), &probeHits_[size_t(v) * probes_], rest);
         }
     });
 }
 
-void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
-                                const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out, WorkCounter* progress) {
+void FinalGather::gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const {
+    const std::vector<uint8_t> none;
+    gather(scene, FirstPass{firstPass, firstPass, none}, out);
+}
+
+void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const FirstPass& firstPass,
+                                std::vector<Vec3f>& out, WorkCounter* progress) {
     clear();
     out.assign(scene.vertexCount(), Vec3f(0.0f));
     raysCast_ = 0;
@@ -354,7 +359,7 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             if (scene.vertexHidden[v]) continue;  // all misses: 0
             castVertexInto(scene, bvh, starts, frontNormals, v, 0, rays_, hits.data());
-            out[v] = meanOverHits(scene, firstPass, hits.data(), hits.data() + probes_);
+            out[v] = meanOverHits(scene, firstPass.readBy(v), hits.data(), hits.data() + probes_);
         }
         if (progress) progress->add(r.size() * uint64_t(rays_));
     });

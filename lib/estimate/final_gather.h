@@ -63,16 +63,29 @@ public:
     void setRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint8_t>& record,
                     WorkCounter* progress = nullptr);
 
-    // Each vertex's gathered irradiance from the first pass F (per vertex, the current pose's);
-    // 0 at a vertex that does not have all M rays (a cache interpolates those).
+    // The first pass F as the rays read it (per vertex, the current pose's): `filled`, with the
+    // covered vertices' stand-ins (fillCoveredFirstPass), for every vertex's rays but a covered
+    // vertex's own, which read `solved`, F as it is. What lies a hair over a covered vertex (a
+    // plate over a floor, a light panel under a ceiling: each covers the other) is covered too,
+    // and its stand-in is the light outside the gap, not in it.
+    struct FirstPass {
+        const std::vector<Vec3f>& filled;
+        const std::vector<Vec3f>& solved;
+        const std::vector<uint8_t>& covered;  // empty: every vertex reads `filled`
+        const std::vector<Vec3f>& readBy(uint32_t v) const { return v < covered.size() && covered[v] ? solved : filled; }
+    };
+    // Each vertex's gathered irradiance from the first pass; 0 at a vertex that does not have all
+    // M rays (a cache interpolates those).
+    void gather(const Scene& scene, const FirstPass& firstPass, std::vector<Vec3f>& out) const;
+    // The same, every vertex's rays reading `firstPass`.
     void gather(const Scene& scene, const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out) const;
     // castAll and gather at once, keeping no hit: each vertex's hits are cast into a buffer of M
     // and summed at once, in ray order — the same bits as castAll then gather — when no frame will
     // update from this one (the last frame, --full-recompute), so that a frame needs no M hits a
     // vertex of memory. Leaves nothing to update: hit() and the re-casts need a castAll first.
     // Without a cache only.
-    void castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
-                       const std::vector<Vec3f>& firstPass, std::vector<Vec3f>& out, WorkCounter* progress = nullptr);
+    void castAndGather(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const FirstPass& firstPass,
+                       std::vector<Vec3f>& out, WorkCounter* progress = nullptr);
     // Drops every kept hit.
     void clear();
 

@@ -38,7 +38,8 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const Verte
         if (progress) progress->start("gathering", scene.vertexCount());
         // castAndGather keeps no hit: the rays that tell covered vertices are cast first.
         covered_ = gather_.castCovered(scene, bvh, starts_);
-        gather_.castAndGather(scene, bvh, starts_, firstPass(scene, photons, covered_), out.irradiance, progress);
+        const std::vector<Vec3f> solved = firstPass(scene, photons), filled = withStandIns(scene, solved);
+        gather_.castAndGather(scene, bvh, starts_, FinalGather::FirstPass{filled, solved, covered_}, out.irradiance, progress);
         stats.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
         addDirect(scene, out);
         stats.gatherSeconds = clock.seconds();
@@ -91,16 +92,19 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Move
     stats.gatherSeconds = clock.seconds();
 }
 
-std::vector<Vec3f> TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons,
-                                              const std::vector<uint8_t>& covered) const {
+std::vector<Vec3f> TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons) const {
     const std::vector<Vec3f>& direct = direct_.irradiance();
     std::vector<Vec3f> first(scene.vertexCount());
     for (size_t v = 0; v < first.size(); ++v) {
         const Material& m = scene.materials[scene.vertexMaterial[v]];
         first[v] = scene.vertexHidden[v] ? Vec3f(0.0f) : m.albedo * (direct[v] + photons.irradiance[v]);
     }
-    fillCoveredFirstPass(scene, covered, first);
     return first;
+}
+
+std::vector<Vec3f> TwoPassLighting::withStandIns(const Scene& scene, std::vector<Vec3f> firstPass) const {
+    fillCoveredFirstPass(scene, covered_, firstPass);
+    return firstPass;
 }
 
 void TwoPassLighting::addDirect(const Scene& scene, VertexRadiosity& out) const {
@@ -115,7 +119,8 @@ void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons
     out.irradiance.resize(n);
     if (settings_.gathers()) {
         covered_ = gather_.coveredFromKept(scene, starts_);
-        gather_.gather(scene, firstPass(scene, photons, covered_), out.irradiance);
+        const std::vector<Vec3f> solved = firstPass(scene, photons), filled = withStandIns(scene, solved);
+        gather_.gather(scene, FinalGather::FirstPass{filled, solved, covered_}, out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);
         addDirect(scene, out);
         return;

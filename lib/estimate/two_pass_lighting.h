@@ -3,7 +3,7 @@
 // after its first bounce; F_u = ρ_u (D_u + I_u) the first pass; then
 //   E_v = D_v + (M > 0 ? mean of F over v's gather rays (FinalGather) : I_v),  B_v = ρ_v E_v + π L_e,v,
 // where the gather reads F at covered vertices (under a block standing on the floor) as their
-// visible neighbours' (covered_vertices.h).
+// visible neighbours' (covered_vertices.h), except from the covered vertices themselves.
 // It owns what that takes — the direct light and the gather's kept hits — and keeps each up to date
 // across a move, touching only what the move can change, so that every update gives the bits a
 // from-scratch solve of the same pose gives. The rays leave from the vertices themselves
@@ -60,9 +60,11 @@ public:
 
 private:
     void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out);
-    // F_u = ρ_u (D_u + I_u) as the gather reads it: 0 at hidden vertices, and at covered ones
-    // (FinalGather's rule) their visible neighbours' stand-in (fillCoveredFirstPass).
-    std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons, const std::vector<uint8_t>& covered) const;
+    // F_u = ρ_u (D_u + I_u), 0 at hidden vertices.
+    std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons) const;
+    // The same with the covered vertices' (covered_) stand-ins (fillCoveredFirstPass): what the
+    // rays of every other vertex read (FinalGather::FirstPass).
+    std::vector<Vec3f> withStandIns(const Scene& scene, std::vector<Vec3f> firstPass) const;
     // E = D + the gathered mean, and B.
     void addDirect(const Scene& scene, VertexRadiosity& out) const;
     // With the cache: the records for the current pose, and the rest of their rays.

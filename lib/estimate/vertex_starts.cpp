@@ -23,6 +23,7 @@ constexpr double kLeastCosine = 0.125;
 // The inside test's probes reach 4 δ_v from a start; a start whose probes meet a surface nearer
 // than δ_v / 4 lies on it (rounding decides its side).
 constexpr double kProbeOffsets = 4, kOnSurfaceOffsets = 0.25;
+constexpr double kBorderStepOffsets = 16;
 
 // v's own triangles (those at its welded position), which the probes below look past: stepping a
 // hair sideways in a concave crease crosses v's own surface, which is not other geometry.
@@ -53,6 +54,39 @@ StartProbe probeAround(const Vec3f& start, const Vec3f directions[5], double off
     return probe;
 }
 
+// The edges at a vertex, by the welded id of their other end, each with the count of triangles
+// using it: one that a single triangle uses is a border. A fan of more edges than it holds (a
+// pole) is taken as no border.
+class EdgeCounts {
+public:
+    void add(uint32_t other) {
+        for (int i = 0; i < size_; ++i)
+            if (other_[i] == other) {
+                ++count_[i];
+                return;
+            }
+        if (size_ == kMost) {
+            overflow_ = true;
+            return;
+        }
+        other_[size_] = other;
+        count_[size_++] = 1;
+    }
+    bool border() const {
+        if (overflow_) return false;
+        for (int i = 0; i < size_; ++i)
+            if (count_[i] == 1) return true;
+        return false;
+    }
+
+private:
+    static constexpr int kMost = 64;
+    uint32_t other_[kMost];
+    int count_[kMost];
+    int size_ = 0;
+    bool overflow_ = false;
+};
+
 bool acceptable(const StartProbe& probe, double offset) { return !probe.inside && probe.clearance >= kOnSurfaceOffsets * offset; }
 
 }  // namespace
@@ -66,16 +100,30 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
     // n_v, and those that stand up from v's tangent plane (cosine below kLeastCosine: the wall at
     // a floor vertex's foot, where the floor and the wall meet with split normals), which the lift
     // along n_v alone would not clear.
-    double longest = 0, leastCosine = 1;
-    Vec3d awayFromWalls(0.0);
+    double longest = 0, leastCosine = 1, facingArea = 0;
+    Vec3d awayFromWalls(0.0), facingCentroid(0.0);
     const Vec3d unit = normalize(n);
+    const uint32_t self = topology.weldedId(v);
+    EdgeCounts edges;
     for (const uint32_t* it = topology.trianglesBegin(v); it != topology.trianglesEnd(v); ++it) {
-        for (uint32_t c : scene.triangles[*it].v) longest = std::max(longest, length(Vec3d(scene.positions[c]) - p));
-        if (!(scene.triangleArea(*it) > 0)) continue;
+        Vec3d centroid(0.0);
+        for (uint32_t c : scene.triangles[*it].v) {
+            longest = std::max(longest, length(Vec3d(scene.positions[c]) - p));
+            centroid += Vec3d(scene.positions[c]) / 3.0;
+            if (topology.weldedId(c) != self) edges.add(topology.weldedId(c));
+        }
+        const double area = scene.triangleArea(*it);
+        if (!(area > 0)) continue;
         const Vec3d face(frontNormals[*it]);
         const double cosine = dot(face, n);
         leastCosine = std::min(leastCosine, cosine);
-        if (cosine < kLeastCosine) awayFromWalls += face - unit * dot(face, unit);
+        // A wall rises on n_v's side of v (a room's wall at its floor's vertex); a face that drops
+        // behind it (a box's bottom at a vertex of its side) is no wall to step off.
+        if (cosine < kLeastCosine && dot(centroid - p, n) > 0) awayFromWalls += face - unit * dot(face, unit);
+        if (cosine > 0) {
+            facingCentroid += centroid * area;
+            facingArea += area;
+        }
     }
     const double magnitude = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z), longest});
     double offset = magnitude * kOffsetScale / std::max(leastCosine, kLeastCosine);
@@ -88,17 +136,35 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
         return out;  // casts nothing
     }
     // Off the walls of v's own mesh that stand on v, by 2 δ_v out of their front: the floor's side
-    // of the wall's plane, not on it. Nowhere else does the start leave v's normal: a step along
-    // a face would put the faces round a smooth-shaded vertex in the way of its own hemisphere
-    // (π on a smooth icosahedron under a sky, not a per-corner bake's 0.894 π).
+    // of the wall's plane, not on it. Inside a surface the start leaves v's normal for nothing else:
+    // a step along a face would put the faces round a smooth-shaded vertex in the way of its own
+    // hemisphere (π on a smooth icosahedron under a sky, not a per-corner bake's 0.894 π).
     if (length(awayFromWalls) > 0) lifted += normalize(awayFromWalls) * (2 * offset);
+    // At a border (an edge at v that one triangle alone uses: a sheet's edge, an open box's rim, a
+    // crease's open end) v is the end of its surface, and the rays past the edge below the
+    // surface's plane would escape that every point of the triangles beside v sees blocked. The
+    // vertex stands for those triangles: its start steps 16 δ_v over them, toward their centroid
+    // in v's tangent plane (at most a quarter of the way), lifted far less than it stepped, and
+    // stops at half the distance to anything in the way.
+    if (edges.border() && facingArea > 0) {
+        const Vec3d toCentroid = facingCentroid / facingArea - p;
+        const Vec3d tangential = toCentroid - unit * dot(toCentroid, unit);
+        const double distance = length(tangential);
+        if (distance > 1e-3 * length(toCentroid)) {
+            const Vec3d u = tangential / distance;
+            double step = std::min(kBorderStepOffsets * offset, 0.25 * distance);
+            const auto hit = bvh.intersect(Vec3f(lifted), Vec3f(u), 0.0f, float(step));
+            if (hit) step = 0.5 * double(hit->t);
+            lifted += u * step;
+        }
+    }
     out.point = Vec3f(lifted);
     const OwnTriangles own{topology.trianglesBegin(v), topology.trianglesEnd(v)};
     // Inside other geometry, or on a surface through v that is not v's (a block's wall on v's foot
-    // line, which rounding puts the start on either side of): step sideways by 2 δ_v. A side
-    // point is inside something when the ray from it back to v's lifted point leaves through a
-    // back face — robust, as the side point lies off any plane through v — and then the point
-    // opposite it is where the open side is.
+    // line, which rounding puts the start on either side of; the floor under a block's lowest row):
+    // step sideways by 2 δ_v. A side point is inside something when the ray from it back to v's
+    // lifted point and a little past leaves through a back face — robust, as the side point lies
+    // off any plane through v — and then the point opposite it is where the open side is.
     Vec3f tangent, bitangent;
     orthonormalBasis(scene.normals[v], tangent, bitangent);
     const Vec3f probes[5] = {tangent, -tangent, bitangent, -bitangent, scene.normals[v]};
@@ -107,7 +173,9 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
     for (int k = 0; k < 4; ++k) {
         side[k] = Vec3f(lifted + Vec3d(probes[k]) * (2 * offset));
         const Vec3f back = -probes[k];
-        const auto hit = bvh.intersect(side[k], back, 0.0f, float(2 * offset));
+        // On past the lifted point by δ_v: a surface through it (the floor under a block's lowest
+        // vertex) is crossed well inside the ray, not at its end, where rounding would decide.
+        const auto hit = bvh.intersect(side[k], back, 0.0f, float(3 * offset));
         sideInside[k] = hit && !own.contain(hit->triangle) && dot(frontNormals[hit->triangle], back) > 0;
     }
     StartProbe best = probeAround(out.point, probes, offset, bvh, frontNormals, own);

@@ -1,6 +1,7 @@
 // Where each vertex's shadow and gather rays leave from, and along which normal (docs/design.md
 // §5.1, issue 56): the vertex itself, as close as floating point allows. The start is
-//   s_v = v + δ_v n_v (+ 2 δ_v out of the front of a wall of v's own mesh standing on v),
+//   s_v = v + δ_v n_v (+ 2 δ_v out of the front of a wall of v's own mesh standing on v;
+//         + 16 δ_v over v's triangles at a border),
 // where δ_v is set by the float error of v's coordinates and its incident triangles' size —
 // the geometry's own scale, never the photon radius nor the scene's diagonal — so s_v sees what
 // the point v sees: a direction into the back of v's own surface meets one of v's triangles at
@@ -43,9 +44,9 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
 class VertexStarts {
 public:
     // How far from v, in units of its offset δ_v, the geometry its start depends on may lie:
-    // the lift and the steps (at most 5 δ_v together) and the inside test's probes (4 δ_v from
+    // the lift and the steps (at most 21 δ_v together) and the inside test's probes (4 δ_v from
     // there).
-    static constexpr float kReachOffsets = 10;
+    static constexpr float kReachOffsets = 26;
 
     // Every vertex, for the scene's current pose (bvh holds it).
     void computeAll(const Scene& scene, const SceneBvh& bvh);
