@@ -43,6 +43,29 @@ def uri_to(target, folder):
     return urllib.parse.quote(relative.replace(os.sep, "/"), safe="/")
 
 
+def embed_helmet(doc, helmet, helmet_dir, folder, textures=True):
+    """Copies the helmet's glTF into `doc` (GltfBuilder's) ahead of the scene's own arrays, unchanged,
+    so that its indices stay valid (GltfBuilder appends the rest); its views read buffer 1, its own
+    .bin, and its images and .bin are named by URIs relative to `folder`. textures=False leaves its
+    textures, images and samplers out. Returns the .bin's URI, the helmet's buffer and the indices
+    of its nodes in `doc`, for the caller to hang under a node of its own."""
+    keys = ["meshes", "materials", "accessors", "bufferViews"] + (["textures", "images", "samplers"] if textures else [])
+    for key in keys:
+        doc[key] = [dict(item) for item in helmet.get(key, [])]
+    for view in doc["bufferViews"]:
+        view["buffer"] = 1
+    for image in doc.get("images", []) if textures else []:
+        if "uri" in image:
+            image["uri"] = uri_to(os.path.join(helmet_dir, urllib.parse.unquote(image["uri"])), folder)
+    (helmet_buffer,) = helmet["buffers"]
+    helmet_bin = uri_to(os.path.join(helmet_dir, urllib.parse.unquote(helmet_buffer["uri"])), folder)
+    children = []
+    for node in helmet["nodes"]:
+        doc["nodes"].append(dict(node))
+        children.append(len(doc["nodes"]) - 1)
+    return helmet_bin, helmet_buffer, children
+
+
 def build(folder, helmet_path):
     with open(helmet_path, encoding="utf-8") as f:
         helmet = json.load(f)
@@ -52,23 +75,8 @@ def build(folder, helmet_path):
     doc["asset"]["generator"] = "qsgi scripts/make_helmet_room.py"
     doc["scenes"][0]["name"] = "HelmetRoom"
     doc["extensionsUsed"] = ["KHR_lights_punctual"]
-    # The helmet's arrays come first, unchanged, so its indices stay valid; the room's are appended
-    # by GltfBuilder. Its views read buffer 1 (its own .bin); buffer 0 is the room's.
-    for key in ("meshes", "materials", "accessors", "bufferViews", "textures", "images", "samplers"):
-        doc[key] = [dict(item) for item in helmet.get(key, [])]
-    for view in doc["bufferViews"]:
-        view["buffer"] = 1
-    for image in doc["images"]:
-        if "uri" in image:
-            image["uri"] = uri_to(os.path.join(helmet_dir, urllib.parse.unquote(image["uri"])), folder)
-    (helmet_buffer,) = helmet["buffers"]
-    helmet_bin = uri_to(os.path.join(helmet_dir, urllib.parse.unquote(helmet_buffer["uri"])), folder)
-
+    helmet_bin, helmet_buffer, children = embed_helmet(doc, helmet, helmet_dir, folder)
     # The helmet's nodes under one "Helmet" node, standing on the floor (its base is at y = 0).
-    children = []
-    for node in helmet["nodes"]:
-        doc["nodes"].append(dict(node))
-        children.append(len(doc["nodes"]) - 1)
     g.node({"name": "Helmet", "children": children, "translation": [0, 0, -0.2]})
 
     white, red, green, block = (g.material("White", WHITE), g.material("Red", RED), g.material("Green", GREEN),
