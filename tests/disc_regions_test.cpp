@@ -134,8 +134,8 @@ TEST(OwnSurface, RisesCountInWholeSceneEpsilons) {
 // The own-surface shortcut (OwnSurfaceTree) spares the walk, never changes an answer: every start
 // point, ε⁺ and disc equals the one found by walking every own surface whole — on dense meshes
 // (data/cornell refined to 2.5 cm at frame 30, its block turned; a tiled floor, flat and tilted)
-// and on curved ones (data/walker, data/tree, inside and outside a sphere); start points only
-// (the second pass under the defaults) and DETP's full regions.
+// and on curved ones (data/walker, data/tree, inside and outside a sphere); DETP's regions (no
+// coverage) on every case, and on data/cornell unrefined at r = 0.05.
 TEST(OwnSurface, TheTreeShortcutChangesNoStartPointOrDisc) {
     struct Case {
         std::string name;
