@@ -59,7 +59,7 @@ import urllib.parse
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from reference import FACE_DTYPE, gltf_document, gltf_vertex_materials, read_ply  # noqa: E402  (sets DRJIT_LIBLLVM_PATH)
+from reference import FACE_DTYPE, gltf_document, gltf_vertex_materials, per_vertex_samples, read_ply  # noqa: E402  (sets DRJIT_LIBLLVM_PATH)
 
 import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
@@ -258,26 +258,15 @@ def irradiance_indirect(scene, origins, normals, spp, seed, chunk):
     """pi x the mean radiance from the first surface hit along cosine rays (escaping rays: 0), and
     the standard error of that mean from the samples' spread (RGB)."""
     integrator = scene.integrator()
-    mean = np.zeros((len(origins), 3))
-    err = np.zeros((len(origins), 3))
-    for start in range(0, len(origins), chunk):
-        end = min(len(origins), start + chunk)
-        n = end - start
-        size = n * spp
-        sampler = mi.load_dict({"type": "independent"})
-        sampler.seed(seed * 1000003 + 7919 + start, size)
-        idx = dr.arange(mi.UInt32, size) // spp
-        o = mi.Point3f(*vec(origins[start:end], idx))
-        nn = mi.Normal3f(*vec(normals[start:end], idx))
+
+    def sample(o, nn, sampler):
         d = mi.Frame3f(nn).to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d()))
         ray = mi.Ray3f(o, d)
         hit = scene.ray_intersect(ray).is_valid()
         L, _, _ = integrator.sample(scene, sampler, mi.RayDifferential3f(ray))
-        value = dr.select(hit, L, 0.0) * dr.pi
-        values = np.array(mi.TensorXf(dr.ravel(value), (size, 3))).reshape(n, spp, 3).astype(np.float64)
-        mean[start:end] = values.mean(1)
-        err[start:end] = values.std(1, ddof=1) / np.sqrt(spp)
-    return mean, err
+        return dr.select(hit, L, 0.0) * dr.pi
+
+    return per_vertex_samples(origins, normals, spp, seed * 1000003 + 7919, chunk, sample)
 
 
 def main():

@@ -35,7 +35,7 @@ import urllib.parse
 
 sys.path.insert(0, os.path.dirname(__file__))
 from make_cornell import GltfBuilder, grid  # noqa: E402
-from make_helmet_room import HELMET, default_shared, embed_helmet  # noqa: E402
+from make_helmet_room import HELMET, default_shared, embed_helmet, write_with_helmet  # noqa: E402
 
 GROUND_SIZE = 1.0
 GROUND_CELLS = 10
@@ -103,13 +103,7 @@ def build(folder, helmet_path, black, far_plane):
     g.node({"name": "Camera", "camera": 0, "translation": [0, 0.9, 1.7],
             "rotation": [-math.sin(tilt / 2), 0.0, 0.0, math.cos(tilt / 2)]})
 
-    doc["buffers"] = [{"uri": "scene.bin", "byteLength": len(g.bin)},
-                      {"uri": helmet_bin, "byteLength": helmet_buffer["byteLength"]}]
-    with open(os.path.join(folder, "scene.bin"), "wb") as f:
-        f.write(g.bin)
-    with open(os.path.join(folder, "scene.gltf"), "w", encoding="utf-8") as f:
-        json.dump(doc, f, indent=1)
-        f.write("\n")
+    write_with_helmet(folder, "scene", g, helmet_bin, helmet_buffer)
 
 
 def main():

@@ -66,6 +66,18 @@ def embed_helmet(doc, helmet, helmet_dir, folder, textures=True):
     return helmet_bin, helmet_buffer, children
 
 
+def write_with_helmet(folder, name, g, helmet_bin, helmet_buffer):
+    """Writes NAME.gltf and NAME.bin (the builder's own buffer, 0) into `folder`, buffer 1 being
+    the helmet's .bin that embed_helmet named."""
+    g.doc["buffers"] = [{"uri": name + ".bin", "byteLength": len(g.bin)},
+                        {"uri": helmet_bin, "byteLength": helmet_buffer["byteLength"]}]
+    with open(os.path.join(folder, name + ".bin"), "wb") as f:
+        f.write(g.bin)
+    with open(os.path.join(folder, name + ".gltf"), "w", encoding="utf-8") as f:
+        json.dump(g.doc, f, indent=1)
+        f.write("\n")
+
+
 def build(folder, helmet_path):
     with open(helmet_path, encoding="utf-8") as f:
         helmet = json.load(f)
@@ -93,13 +105,7 @@ def build(folder, helmet_path):
                            "perspective": {"yfov": 0.7, "aspectRatio": 4 / 3, "znear": 0.05}})
     g.node({"name": "Camera", "camera": 0, "translation": [0, 1, 4.0]})
 
-    doc["buffers"] = [{"uri": "helmet_room.bin", "byteLength": len(g.bin)},
-                      {"uri": helmet_bin, "byteLength": helmet_buffer["byteLength"]}]
-    with open(os.path.join(folder, "helmet_room.bin"), "wb") as f:
-        f.write(g.bin)
-    with open(os.path.join(folder, "helmet_room.gltf"), "w", encoding="utf-8") as f:
-        json.dump(doc, f, indent=1)
-        f.write("\n")
+    write_with_helmet(folder, "helmet_room", g, helmet_bin, helmet_buffer)
 
     # The block slides along the floor in front of the helmet, 5 cm from its front at the closest.
     frames = []

@@ -296,11 +296,13 @@ def query_points(positions, normals, faces, diagonal):
     return positions + normals * (1e-4 * diagonal) + towards * (5e-4 * diagonal)
 
 
-def irradiance(scene, origins, normals, spp, seed, chunk, errors=None):
-    """E at each origin about its normal; with `errors` (an array like the result), the standard
-    error of each mean from the spread of its spp samples."""
-    integrator = scene.integrator()
-    out = np.zeros((len(origins), 3))
+def per_vertex_samples(origins, normals, spp, seed, chunk, sample):
+    """Each vertex's mean of spp RGB samples and its standard error (inf with one sample):
+    `sample(o, n, sampler)` gets Dr.Jit arrays holding each vertex's origin and normal spp times
+    over, for `chunk` vertices at a time, and an independent sampler seeded `seed` + the chunk's
+    first vertex; it returns one RGB value per entry."""
+    mean = np.zeros((len(origins), 3))
+    err = np.zeros((len(origins), 3))
     for start in range(0, len(origins), chunk):
         end = min(len(origins), start + chunk)
         n = end - start
@@ -310,7 +312,18 @@ def irradiance(scene, origins, normals, spp, seed, chunk, errors=None):
         idx = dr.arange(mi.UInt32, size) // spp
         o = mi.Point3f(*[dr.gather(mi.Float, mi.Float(origins[start:end, k].astype(np.float32)), idx) for k in range(3)])
         nn = mi.Normal3f(*[dr.gather(mi.Float, mi.Float(normals[start:end, k].astype(np.float32)), idx) for k in range(3)])
-        frame = mi.Frame3f(nn)
+        values = np.array(mi.TensorXf(dr.ravel(sample(o, nn, sampler)), (size, 3))).reshape(n, spp, 3).astype(np.float64)
+        mean[start:end] = values.mean(1)
+        err[start:end] = values.std(1, ddof=1) / np.sqrt(spp) if spp > 1 else np.inf
+    return mean, err
+
+
+def irradiance(scene, origins, normals, spp, seed, chunk, errors=None):
+    """E at each origin about its normal; with `errors` (an array like the result), the standard
+    error of each mean from the spread of its spp samples."""
+    integrator = scene.integrator()
+
+    def sample(o, nn, sampler):
         # Direct light: one emitter sample per path.
         it = dr.zeros(mi.Interaction3f)
         it.p = o
@@ -319,17 +332,17 @@ def irradiance(scene, origins, normals, spp, seed, chunk, errors=None):
         ds, weight = scene.sample_emitter_direction(it, sampler.next_2d(), True)
         direct = weight * dr.maximum(0, dr.dot(ds.d, nn))
         # Indirect light: cosine-weighted rays, minus the first hit's own emission.
-        d = frame.to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d()))
+        d = mi.Frame3f(nn).to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d()))
         ray = mi.Ray3f(o, d)
         L, _, _ = integrator.sample(scene, sampler, ray)
         si = scene.ray_intersect(ray)
         # A ray that escapes meets the environment: si.emitter() is then the scene's sky (none: 0).
         emitted = si.emitter(scene).eval(si)
-        total = direct + dr.pi * (L - emitted)
-        values = np.array(mi.TensorXf(dr.ravel(total), (size, 3))).reshape(n, spp, 3).astype(np.float64)
-        out[start:end] = values.mean(1)
-        if errors is not None:
-            errors[start:end] = values.std(1, ddof=1) / np.sqrt(spp) if spp > 1 else np.inf
+        return direct + dr.pi * (L - emitted)
+
+    out, err = per_vertex_samples(origins, normals, spp, seed, chunk, sample)
+    if errors is not None:
+        errors[:] = err
     return out
 
 

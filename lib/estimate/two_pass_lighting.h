@@ -55,8 +55,6 @@ public:
     const GatherCache* gatherCache() const { return cache_ ? &*cache_ : nullptr; }
     // The covered vertices of the last solve or update (FinalGather's rule; empty without a gather).
     const std::vector<uint8_t>& covered() const { return covered_; }
-    // Where the rays of the last solve or update started.
-    const VertexStarts& starts() const { return starts_; }
 
 private:
     void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out);
