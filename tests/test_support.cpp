@@ -167,6 +167,35 @@ void addBoxOnFloor(Scene& s, int node, float half, float height, int cells, uint
 }
 }  // namespace
 
+uint32_t addTexturedMaterial(Scene& s, Material material, int width, int height, std::vector<uint8_t> rgba, bool nearest) {
+    auto image = std::make_shared<TextureImage>();
+    image->width = uint32_t(width);
+    image->height = uint32_t(height);
+    image->rgba = std::move(rgba);
+    auto textures = std::make_shared<TextureSet>(s.textures ? *s.textures : TextureSet());
+    Texture texture;
+    texture.image = std::move(image);
+    texture.nearest = nearest;
+    textures->push_back(texture);
+    material.baseColour.texture = int(textures->size() - 1);
+    material.baseColour.texCoord = 0;
+    s.textures = std::move(textures);
+    s.materials.push_back(std::move(material));
+    return uint32_t(s.materials.size() - 1);
+}
+
+void paintInstance(Scene& s, size_t instance, uint32_t material, int axisS, int axisT, Vec3f origin, float size) {
+    const MeshInstance& inst = s.instances[instance];
+    if (s.vertexTexCoords.empty()) s.vertexTexCoords.resize(1);
+    s.vertexTexCoords[0].resize(s.vertexCount());
+    for (uint32_t v = inst.firstVertex; v < inst.firstVertex + inst.vertexCount; ++v) {
+        s.vertexMaterial[v] = material;
+        const Vec3f& p = s.positions[v];
+        s.vertexTexCoords[0][v] = {(p[axisS] - origin[axisS]) / size, (p[axisT] - origin[axisT]) / size};
+    }
+    for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t) s.triangleMaterial[t] = material;
+}
+
 Scene closedSphere(float radius, int subdivisions, Vec3f albedo, bool inwardNormals) {
     // Icosphere: near-uniform triangles, so impact-count noise is alike everywhere.
     const float t = (1 + std::sqrt(5.0f)) / 2;

@@ -121,6 +121,14 @@ qsgi::Scene plateAndSliver(float half, int cells, float width, float offset, qsg
 // 8 cells a face standing on it off-centre.
 qsgi::Scene tiledFloor(int tiles, int cells, const qsgi::Transform& placement, qsgi::Vec3f albedo);
 void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
+// Materials as an asset gives them (issue 57), for scenes built in code: `material` reading a
+// texture of `width` x `height` RGBA8 pixels (`rgba`, top row first) through TEXCOORD_0, added
+// to the scene; returns its index.
+uint32_t addTexturedMaterial(qsgi::Scene& s, qsgi::Material material, int width, int height, std::vector<uint8_t> rgba,
+                             bool nearest = true);
+// Gives instance `instance` material `material`, and TEXCOORD_0 projected from its rest-pose world
+// positions: s = (p[axisS] − origin[axisS]) / size, t = (p[axisT] − origin[axisT]) / size.
+void paintInstance(qsgi::Scene& s, size_t instance, uint32_t material, int axisS, int axisT, qsgi::Vec3f origin, float size);
 // Writes a small glTF (a quad; emissive if lit) with an embedded buffer.
 void writeQuadGltf(const std::string& path, bool lit);
 

@@ -1,6 +1,7 @@
-// Base colour textures count through their mean linear colour (texture_colour.h): decoded with
-// OpenImageIO, only when a material uses them, and never read outside their bytes. The expected
-// means are worked out here from the pixels with the sRGB curve of the glTF specification.
+// Textures are decoded whole (texture_colour.h: PNG by libpng, JPEG by OpenImageIO), only when a
+// material uses them, and never read outside their bytes. The checks compare the decoded pixels'
+// mean linear colour with the one worked out here from the pixels written, with the sRGB curve of
+// the glTF specification.
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -50,8 +52,31 @@ std::string base64(const std::string& bytes) {
     return out;
 }
 
+struct TextureColour {
+    std::optional<Vec3f> mean;  // mean linear (sRGB-decoded) RGB of the decoded pixels
+    std::string problem;
+};
+
+TextureColour meanOfImage(const TextureImage& image) {
+    double sum[3] = {0, 0, 0};
+    const size_t pixels = size_t(image.width) * image.height;
+    for (size_t p = 0; p < pixels; ++p)
+        for (size_t c = 0; c < 3; ++c) sum[c] += srgbToLinear(image.rgba[4 * p + c] / 255.0);
+    return {Vec3f(float(sum[0] / double(pixels)), float(sum[1] / double(pixels)), float(sum[2] / double(pixels))), ""};
+}
+
 TextureColour meanOf(const std::string& bytes) {
-    return meanTextureColour(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+    const DecodedTexture decoded = decodeTextureImage(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+    if (!decoded.image) return {std::nullopt, decoded.problem};
+    return meanOfImage(*decoded.image);
+}
+
+// The mean colour of the base colour texture material m of a loaded scene reads.
+Vec3f meanOfMaterialTexture(const Scene& scene, size_t m) {
+    const TextureSlot& slot = scene.materials[m].baseColour;
+    EXPECT_TRUE(slot.used()) << "material " << m << " reads no texture";
+    if (!slot.used()) return Vec3f(0.0f);
+    return *meanOfImage(*(*scene.textures)[size_t(slot.texture)].image).mean;
 }
 
 // The 2 x 2 texture of tests/data/good/texture_*.gltf (make_inputs.py, TEXTURE_PIXELS).
@@ -72,9 +97,10 @@ TEST(TextureColour, EmbeddedAndDataUriTexturesGiveTheirMeanLinearColourAndUnused
         Warnings warnings;
         const Scene scene = loadGltfScene((sourceDir() / "tests/data/good" / name).string(), warnings);
         ASSERT_GE(scene.materials.size(), 1u);
-        EXPECT_FLOAT_EQ(scene.materials[0].albedo.x, expected.x);
-        EXPECT_FLOAT_EQ(scene.materials[0].albedo.y, expected.y);
-        EXPECT_FLOAT_EQ(scene.materials[0].albedo.z, expected.z);
+        const Vec3f mean = meanOfMaterialTexture(scene, 0);
+        EXPECT_FLOAT_EQ(mean.x, expected.x);
+        EXPECT_FLOAT_EQ(mean.y, expected.y);
+        EXPECT_FLOAT_EQ(mean.z, expected.z);
         // images[1] is garbage that no material uses: not decoded, so not warned about.
         for (const auto& w : warnings.messages) EXPECT_EQ(w.find("images[1]"), std::string::npos) << w;
     }
@@ -101,13 +127,14 @@ TEST(TextureColour, UnreadableTexturesLeaveTheFactorAndSayWhy) {
 }
 
 TEST(TextureColour, SixteenBitsAndAlphaAreReadAsStored) {
-    // 16-bit RGBA: the colour is not multiplied by alpha (glTF's alpha is coverage, not premultiplied).
+    // 16-bit RGBA, rounded to 8 bits a channel; the colour is not multiplied by alpha (glTF's
+    // alpha is coverage, not premultiplied), and alpha is kept.
     const std::vector<uint16_t> pixels = {65535, 0, 30000, 0, 1000, 65535, 2, 65535};
-    const TextureColour colour = meanOf(encoded("rgba16.png", 2, 1, 4, pixels));
-    ASSERT_TRUE(colour.mean) << colour.problem;
-    EXPECT_FLOAT_EQ(colour.mean->x, float((srgbToLinear(1.0) + srgbToLinear(1000 / 65535.0)) / 2));
-    EXPECT_FLOAT_EQ(colour.mean->y, float((srgbToLinear(0.0) + srgbToLinear(1.0)) / 2));
-    EXPECT_FLOAT_EQ(colour.mean->z, float((srgbToLinear(30000 / 65535.0) + srgbToLinear(2 / 65535.0)) / 2));
+    const std::string bytes = encoded("rgba16.png", 2, 1, 4, pixels);
+    const DecodedTexture decoded = decodeTextureImage(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+    ASSERT_TRUE(decoded.image) << decoded.problem;
+    for (size_t i = 0; i < pixels.size(); ++i)
+        EXPECT_EQ(decoded.image->rgba[i], uint8_t((uint32_t(pixels[i]) * 255 + 32767) / 65535)) << "value " << i;
 }
 
 TEST(TextureColour, GreyImagesGiveGrey) {
@@ -143,19 +170,27 @@ TEST(TextureColour, AFlatJpegGivesItsColourWithinOneQuantisationStep) {
 // interlaced one, read pass by pass, every pixel once; and a row of 1,100,000 pixels, wider than
 // libpng's default limit of 10^6 (OpenImageIO refused it, printing "libpng error").
 TEST(TextureColour, InterlacedAndVeryWidePngsGiveTheirMean) {
+    // The file's floor uses material 0; a copy whose floor uses material 1 reads the wide one (a
+    // scene keeps the textures of the materials it renders).
+    const fs::path file = sourceDir() / "tests/data/good/texture_png_variants.gltf";
+    nlohmann::json doc = nlohmann::json::parse(readFileBytes(file));
+    doc["meshes"][0]["primitives"][0]["material"] = 1;
+    const fs::path wideFile = fs::path(testScratchDir("texture_colour_wide")) / "wide.gltf";
+    std::ofstream(wideFile) << doc.dump();
     Warnings warnings;
-    const Scene scene = loadGltfScene((sourceDir() / "tests/data/good/texture_png_variants.gltf").string(), warnings);
+    const Scene scene = loadGltfScene(file.string(), warnings), wideScene = loadGltfScene(wideFile.string(), warnings);
     for (const auto& w : warnings.messages) EXPECT_EQ(w.find("materials["), std::string::npos) << w;
     double sum[3] = {0, 0, 0};
     for (int y = 0; y < 3; ++y)
         for (int x = 0; x < 5; ++x)
             for (int c = 0; c < 3; ++c) sum[c] += srgbToLinear(((x * 37 + y * 11 + c * 50) % 256) / 255.0);
     ASSERT_GE(scene.materials.size(), 2u);
-    EXPECT_FLOAT_EQ(scene.materials[0].albedo.x, float(sum[0] / 15));
-    EXPECT_FLOAT_EQ(scene.materials[0].albedo.y, float(sum[1] / 15));
-    EXPECT_FLOAT_EQ(scene.materials[0].albedo.z, float(sum[2] / 15));
-    EXPECT_FLOAT_EQ(scene.materials[1].albedo.x, float(srgbToLinear(128 / 255.0)));
-    EXPECT_FLOAT_EQ(scene.materials[1].albedo.z, float(srgbToLinear(128 / 255.0)));
+    const Vec3f interlaced = meanOfMaterialTexture(scene, 0), wide = meanOfMaterialTexture(wideScene, 1);
+    EXPECT_FLOAT_EQ(interlaced.x, float(sum[0] / 15));
+    EXPECT_FLOAT_EQ(interlaced.y, float(sum[1] / 15));
+    EXPECT_FLOAT_EQ(interlaced.z, float(sum[2] / 15));
+    EXPECT_FLOAT_EQ(wide.x, float(srgbToLinear(128 / 255.0)));
+    EXPECT_FLOAT_EQ(wide.z, float(srgbToLinear(128 / 255.0)));
 }
 
 // Broken JPEGs go through OpenImageIO, which takes over libjpeg's error and message routines: a

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "estimate/vertex_samples.h"
+#include "scene/emission_pieces.h"
 #include "trace/sampling.h"
 
 namespace qsgi {
@@ -20,14 +21,25 @@ void DirectLight::readEmitters(const Scene& scene) {
         const Material& m = scene.materials[scene.triangleMaterial[t]];
         const float area = scene.triangleArea(t);
         if (!m.isEmissive() || !(area > 0)) continue;
-        // Chosen by power, as photons are (LightSampler): luminance of π L_e A.
-        const double power = double(luminance(m.emission)) * double(area);
-        if (!(power > 0)) continue;
         const Triangle& tri = scene.triangles[t];
-        emitters_.push_back({t, m.emission, area, power,
-                             {Vec3d(scene.positions[tri.v[0]]), Vec3d(scene.positions[tri.v[1]]), Vec3d(scene.positions[tri.v[2]])},
-                             Vec3d(scene.geometricNormal(t))});
-        total += power;
+        const std::array<Vec3d, 3> corners = {Vec3d(scene.positions[tri.v[0]]), Vec3d(scene.positions[tri.v[1]]),
+                                              Vec3d(scene.positions[tri.v[2]])};
+        // A textured emitter piece by piece (emission_pieces.h), each chosen by its own power.
+        for (const EmissionPiece& piece : emissionPieces(scene, t)) {
+            const float pieceArea = area * piece.areaShare;
+            // Chosen by power, as photons are (LightSampler): luminance of π L_e A.
+            const double power = double(luminance(piece.radiance)) * double(pieceArea);
+            if (!(power > 0)) continue;
+            std::array<Vec3d, 3> at = corners;
+            const bool whole = piece.areaShare == 1 && piece.corner[1][0] == 1 && piece.corner[2][1] == 1;
+            if (!whole)
+                for (size_t k = 0; k < 3; ++k) {
+                    const double b1 = piece.corner[k][0], b2 = piece.corner[k][1];
+                    at[k] = corners[0] * (1 - b1 - b2) + corners[1] * b1 + corners[2] * b2;
+                }
+            emitters_.push_back({t, piece.radiance, pieceArea, power, at, Vec3d(scene.geometricNormal(t))});
+            total += power;
+        }
     }
     double running = 0;
     for (Emitter& e : emitters_) {

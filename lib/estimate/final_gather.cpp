@@ -310,10 +310,12 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
     return recast;
 }
 
-Vec3f FinalGather::meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* probes,
+Vec3f FinalGather::meanOverHits(const Scene& scene, const FirstPass& firstPass, uint32_t v, const GatherHit* probes,
                                 const GatherHit* rest) const {
     // In ray order, in one thread: the same bits for any schedule, and with or without a cache.
     // Misses and back faces add nothing (not even +0).
+    const std::vector<Vec3f>& reflected = firstPass.readBy(v);
+    const std::vector<Vec3f>* irradiance = firstPass.irradianceReadBy(v);
     Vec3d sum(0.0);
     for (uint32_t j = 0; j < rays_; ++j) {
         const GatherHit& h = j < probes_ ? probes[j] : rest[j - probes_];
@@ -321,7 +323,13 @@ Vec3f FinalGather::meanOverHits(const Scene& scene, const std::vector<Vec3f>& fi
         const Triangle& tri = scene.triangles[h.triangle];
         const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
         const double w0 = std::max(0.0, 1.0 - w1 - w2);
-        sum += Vec3d(firstPass[tri.v[0]]) * w0 + Vec3d(firstPass[tri.v[1]]) * w1 + Vec3d(firstPass[tri.v[2]]) * w2;
+        if (irradiance && firstPass.surfaces->varies(h.triangle)) {
+            const std::vector<Vec3f>& e = *irradiance;
+            const Vec3d arriving = Vec3d(e[tri.v[0]]) * w0 + Vec3d(e[tri.v[1]]) * w1 + Vec3d(e[tri.v[2]]) * w2;
+            sum += arriving * Vec3d(firstPass.surfaces->albedo(h.triangle, float(w1), float(w2)));
+            continue;
+        }
+        sum += Vec3d(reflected[tri.v[0]]) * w0 + Vec3d(reflected[tri.v[1]]) * w1 + Vec3d(reflected[tri.v[2]]) * w2;
     }
     return Vec3f(sum / double(rays_));
 }
@@ -333,7 +341,7 @@ void FinalGather::gather(const Scene& scene, const FirstPass& firstPass, std::ve
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             if (!hasAllRays(v)) continue;
             const GatherHit* rest = cached() ? restOf(v) : nullptr;
-            out[v] = meanOverHits(scene, firstPass.readBy(v), &probeHits_[size_t(v) * probes_], rest);
+            out[v] = meanOverHits(scene, firstPass, v, &probeHits_[size_t(v) * probes_], rest);
         }
     });
 }
@@ -359,7 +367,7 @@ void FinalGather::castAndGather(const Scene& scene, const SceneBvh& bvh, const V
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             if (scene.vertexHidden[v]) continue;  // all misses: 0
             castVertexInto(scene, bvh, starts, frontNormals, v, 0, rays_, hits.data());
-            out[v] = meanOverHits(scene, firstPass.readBy(v), hits.data(), hits.data() + probes_);
+            out[v] = meanOverHits(scene, firstPass, v, hits.data(), hits.data() + probes_);
         }
         if (progress) progress->add(r.size() * uint64_t(rays_));
     });

@@ -68,11 +68,23 @@ public:
     // vertex's own, which read `solved`, F as it is. What lies a hair over a covered vertex (a
     // plate over a floor, a light panel under a ceiling: each covers the other) is covered too,
     // and its stand-in is the light outside the gap, not in it.
+    // Where the albedo varies over a triangle (a texture, vertex colours: `surfaces`), a hit reads
+    // the irradiance D + I interpolated over it times the albedo at the hit, not F interpolated
+    // (which would average the texture between the vertices): `filledIrradiance` and
+    // `solvedIrradiance` then hold D + I as `filled` and `solved` hold F.
     struct FirstPass {
         const std::vector<Vec3f>& filled;
         const std::vector<Vec3f>& solved;
         const std::vector<uint8_t>& covered;  // empty: every vertex reads `filled`
-        const std::vector<Vec3f>& readBy(uint32_t v) const { return v < covered.size() && covered[v] ? solved : filled; }
+        const SurfaceLookup* surfaces = nullptr;  // null or none varies: F everywhere
+        const std::vector<Vec3f>* filledIrradiance = nullptr;
+        const std::vector<Vec3f>* solvedIrradiance = nullptr;
+        bool coveredVertex(uint32_t v) const { return v < covered.size() && covered[v]; }
+        const std::vector<Vec3f>& readBy(uint32_t v) const { return coveredVertex(v) ? solved : filled; }
+        const std::vector<Vec3f>* irradianceReadBy(uint32_t v) const {
+            if (!surfaces || !surfaces->any()) return nullptr;
+            return coveredVertex(v) ? solvedIrradiance : filledIrradiance;
+        }
     };
     // Each vertex's gathered irradiance from the first pass; 0 at a vertex that does not have all
     // M rays (a cache interpolates those).
@@ -125,7 +137,7 @@ private:
     static constexpr uint32_t kNoSlot = UINT32_MAX;
     // The mean over a vertex's M hits (first its probes, then the rest, in ray order) of F
     // interpolated at each (gather's sum, castAndGather's).
-    Vec3f meanOverHits(const Scene& scene, const std::vector<Vec3f>& firstPass, const GatherHit* probes,
+    Vec3f meanOverHits(const Scene& scene, const FirstPass& firstPass, uint32_t v, const GatherHit* probes,
                        const GatherHit* rest) const;
     GatherHit castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                       const Vec3f& direction) const;

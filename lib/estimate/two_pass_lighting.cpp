@@ -38,8 +38,8 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const Verte
         if (progress) progress->start("gathering", scene.vertexCount());
         // castAndGather keeps no hit: the rays that tell covered vertices are cast first.
         covered_ = gather_.castCovered(scene, bvh, starts_);
-        const std::vector<Vec3f> solved = firstPass(scene, photons), filled = withStandIns(scene, solved);
-        gather_.castAndGather(scene, bvh, starts_, FinalGather::FirstPass{filled, solved, covered_}, out.irradiance, progress);
+        const FirstPassValues first = firstPass(scene, photons);
+        gather_.castAndGather(scene, bvh, starts_, first.view(covered_), out.irradiance, progress);
         stats.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
         addDirect(scene, out);
         stats.gatherSeconds = clock.seconds();
@@ -92,19 +92,28 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Move
     stats.gatherSeconds = clock.seconds();
 }
 
-std::vector<Vec3f> TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons) const {
+TwoPassLighting::FirstPassValues TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons) {
+    if (!surfaces_) surfaces_.emplace(scene);
     const std::vector<Vec3f>& direct = direct_.irradiance();
-    std::vector<Vec3f> first(scene.vertexCount());
-    for (size_t v = 0; v < first.size(); ++v) {
-        const Material& m = scene.materials[scene.vertexMaterial[v]];
-        first[v] = scene.vertexHidden[v] ? Vec3f(0.0f) : m.albedo * (direct[v] + photons.irradiance[v]);
+    FirstPassValues first;
+    first.solved.resize(scene.vertexCount());
+    const bool varies = surfaces_->any();
+    if (varies) {
+        first.surfaces = &*surfaces_;
+        first.solvedIrradiance.resize(scene.vertexCount());
+    }
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
+        const Vec3f arriving = scene.vertexHidden[v] ? Vec3f(0.0f) : direct[v] + photons.irradiance[v];
+        first.solved[v] = scene.vertexHidden[v] ? Vec3f(0.0f) : vertexAlbedo(scene, v) * arriving;
+        if (varies) first.solvedIrradiance[v] = arriving;
+    }
+    first.filled = first.solved;
+    fillCoveredFirstPass(scene, covered_, first.filled);
+    if (varies) {
+        first.filledIrradiance = first.solvedIrradiance;
+        fillCoveredFirstPass(scene, covered_, first.filledIrradiance);
     }
     return first;
-}
-
-std::vector<Vec3f> TwoPassLighting::withStandIns(const Scene& scene, std::vector<Vec3f> firstPass) const {
-    fillCoveredFirstPass(scene, covered_, firstPass);
-    return firstPass;
 }
 
 void TwoPassLighting::addDirect(const Scene& scene, VertexRadiosity& out) const {
@@ -119,8 +128,8 @@ void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons
     out.irradiance.resize(n);
     if (settings_.gathers()) {
         covered_ = gather_.coveredFromKept(scene, starts_);
-        const std::vector<Vec3f> solved = firstPass(scene, photons), filled = withStandIns(scene, solved);
-        gather_.gather(scene, FinalGather::FirstPass{filled, solved, covered_}, out.irradiance);
+        const FirstPassValues first = firstPass(scene, photons);
+        gather_.gather(scene, first.view(covered_), out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);
         addDirect(scene, out);
         return;

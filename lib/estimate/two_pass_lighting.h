@@ -58,11 +58,17 @@ public:
 
 private:
     void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out);
-    // F_u = ρ_u (D_u + I_u), 0 at hidden vertices.
-    std::vector<Vec3f> firstPass(const Scene& scene, const VertexRadiosity& photons) const;
-    // The same with the covered vertices' (covered_) stand-ins (fillCoveredFirstPass): what the
-    // rays of every other vertex read (FinalGather::FirstPass).
-    std::vector<Vec3f> withStandIns(const Scene& scene, std::vector<Vec3f> firstPass) const;
+    // What the gather reads of the first pass: F_u = ρ_u (D_u + I_u), 0 at hidden vertices, as
+    // solved and with the covered vertices' (covered_) stand-ins (fillCoveredFirstPass), which
+    // the rays of every other vertex read; where an albedo varies over a triangle, D + I alike.
+    struct FirstPassValues {
+        std::vector<Vec3f> solved, filled, solvedIrradiance, filledIrradiance;
+        const SurfaceLookup* surfaces = nullptr;
+        FinalGather::FirstPass view(const std::vector<uint8_t>& covered) const {
+            return {filled, solved, covered, surfaces, &filledIrradiance, &solvedIrradiance};
+        }
+    };
+    FirstPassValues firstPass(const Scene& scene, const VertexRadiosity& photons);
     // E = D + the gathered mean, and B.
     void addDirect(const Scene& scene, VertexRadiosity& out) const;
     // With the cache: the records for the current pose, and the rest of their rays.
@@ -74,6 +80,7 @@ private:
     FinalGather gather_;
     std::optional<GatherCache> cache_;  // with --gather-cache A
     std::vector<uint8_t> covered_;
+    std::optional<SurfaceLookup> surfaces_;  // made at the first solve (materials never change)
     bool solved_ = false;
 };
 

@@ -1,5 +1,7 @@
 #include "estimate/vertex_radiosity.h"
 
+#include "scene/emission_pieces.h"
+#include "scene/surface_lookup.h"
 #include "trace/sampling.h"
 
 namespace qsgi {
@@ -13,8 +15,7 @@ void computeRadiosity(const Scene& scene, VertexRadiosity& result) {
             result.irradiance[v] = result.radiosity[v] = Vec3f(0.0f);
             continue;
         }
-        const Material& m = scene.materials[scene.vertexMaterial[v]];
-        result.radiosity[v] = m.albedo * result.irradiance[v] + m.emission * kPi;
+        result.radiosity[v] = vertexAlbedo(scene, uint32_t(v)) * result.irradiance[v] + vertexEmission(scene, uint32_t(v)) * kPi;
     }
 }
 

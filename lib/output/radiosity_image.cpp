@@ -5,6 +5,7 @@
 
 #include <limits>
 
+#include "scene/surface_lookup.h"
 #include "trace/counter_rng.h"
 #include "trace/sampling.h"
 
@@ -18,6 +19,10 @@ RgbImage renderRadiosityImage(const Scene& scene, const SceneBvh& bvh, const Ver
     image.pixels.assign(size_t(settings.width) * size_t(settings.height) * 3, 0.0f);
     const int spp = std::max(1, settings.samplesPerPixel);
     const float tnear = std::max(camera.znear, 0.0f);
+    // Where the albedo varies over a triangle the pixel shows the texel's albedo times the
+    // interpolated irradiance (plus the emission), as the artist's engine shows the bake on the
+    // textured asset; elsewhere B interpolated, which is the same.
+    const SurfaceLookup surfaces(scene);
     // Each pixel depends only on its own rays, so tiles can run in any order.
     tbb::parallel_for(tbb::blocked_range2d<int>(0, settings.height, 16, 0, settings.width, 16),
                       [&](const tbb::blocked_range2d<int>& tile) {
@@ -33,6 +38,13 @@ RgbImage renderRadiosityImage(const Scene& scene, const SceneBvh& bvh, const Ver
                     const auto hit = bvh.intersect(ray.origin, ray.direction, tnear, std::numeric_limits<float>::infinity());
                     if (!hit) continue;
                     const Triangle& t = scene.triangles[hit->triangle];
+                    if (surfaces.varies(hit->triangle)) {
+                        const Vec3f e = solution.irradiance[t.v[0]] * (1 - hit->u - hit->v) +
+                                        solution.irradiance[t.v[1]] * hit->u + solution.irradiance[t.v[2]] * hit->v;
+                        sum += Vec3d(surfaces.albedo(hit->triangle, hit->u, hit->v) * e +
+                                     surfaces.emission(hit->triangle, hit->u, hit->v) * float(M_PI));
+                        continue;
+                    }
                     const Vec3f b = solution.radiosity[t.v[0]] * (1 - hit->u - hit->v) +
                                     solution.radiosity[t.v[1]] * hit->u + solution.radiosity[t.v[2]] * hit->v;
                     sum += Vec3d(b);

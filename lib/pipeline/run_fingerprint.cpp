@@ -80,6 +80,28 @@ RunFingerprint runFingerprint(const RenderSettings& s, const Scene& scene, const
             f.addValue(m.albedo);
             f.addValue(m.emission);
         }
+        // What the materials read besides their factors (issue 57), only where a scene has it,
+        // so that this part stays as it was for scenes of plain colour factors.
+        for (const Material& m : scene.materials)
+            if (m.baseColour.used() || m.alphaMode != AlphaMode::Opaque || m.alpha != 1 || m.doubleSided) {
+                f.addValue(m.alpha);
+                f.addValue(int(m.alphaMode));
+                f.addValue(m.alphaCutoff);
+                f.addValue(int(m.doubleSided));
+                f.addValue(m.baseColour.texture);
+                f.addValue(m.baseColour.texCoord);
+                f.addValue(m.baseColour.transform);
+            }
+        if (scene.textures)
+            for (const Texture& t : *scene.textures) {
+                if (!t.image) continue;
+                f.addValue(t.image->width);
+                f.addValue(t.image->height);
+                f.add(t.image->rgba);
+                f.addValue(int(t.wrapS) * 4 + int(t.wrapT) * 2 + int(t.nearest));
+            }
+        for (const std::vector<TexCoord>& set : scene.vertexTexCoords) f.add(set);
+        if (!scene.vertexColours.empty()) f.add(scene.vertexColours);
     });
     both(lights, [&](Fingerprinter& f) {
         for (const PunctualLight& l : scene.lights) {

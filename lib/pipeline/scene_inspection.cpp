@@ -121,12 +121,30 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
             highest[c] = std::max(highest[c], scene.materials[m].albedo[c]);
         }
     if (used.empty()) lowest = highest = Vec3f(0.0f);
+    // What the used materials read besides their factors (issue 57, docs/inputs.md).
+    uint64_t textured = 0, mask = 0, blend = 0, doubleSided = 0;
+    for (uint32_t m : used) {
+        const Material& material = scene.materials[m];
+        textured += material.baseColour.used();
+        mask += material.alphaMode == AlphaMode::Mask;
+        blend += material.alphaMode == AlphaMode::Blend;
+        doubleSided += material.doubleSided;
+    }
+    uint64_t textureBytes = 0;
+    if (scene.textures)
+        for (const Texture& t : *scene.textures) textureBytes += t.bytes();
     r["materials"] = {{"count", scene.materials.size()},
                       {"used", used.size()},
                       {"albedo_min", vec(lowest)},
                       {"albedo_max", vec(highest)},
                       {"emissive", emissive.size()},
-                      {"emissive_triangles", emissiveTriangles}};
+                      {"emissive_triangles", emissiveTriangles},
+                      {"base_colour_textured", textured},
+                      {"alpha_mask", mask},
+                      {"alpha_blend", blend},
+                      {"double_sided", doubleSided},
+                      {"vertex_colours", !scene.vertexColours.empty()},
+                      {"texture_bytes", textureBytes}};
 
     // Each emitter's power as the photon tracer shares photons among them (unaimed).
     const LightSampler sampler(scene, 1, scene.sceneEpsilon());
@@ -245,6 +263,11 @@ std::string inspectionText(const nlohmann::json& r) {
          "; albedo " + triple(m["albedo_min"]) + " to " + triple(m["albedo_max"]) + "; " +
          std::to_string(m["emissive"].get<uint64_t>()) + " emissive (" + std::to_string(m["emissive_triangles"].get<uint64_t>()) +
          " triangles, " + number(100 * r["emissive_surfaces"]["share"].get<double>(), "%.1f") + " % of the power)");
+    line("  base colour textured " + std::to_string(m["base_colour_textured"].get<uint64_t>()) + " (" +
+         number(double(m["texture_bytes"].get<uint64_t>()) / (1 << 20), "%.1f") + " MiB decoded), alpha MASK " +
+         std::to_string(m["alpha_mask"].get<uint64_t>()) + ", BLEND " + std::to_string(m["alpha_blend"].get<uint64_t>()) +
+         ", double-sided " + std::to_string(m["double_sided"].get<uint64_t>()) + "; vertex colours " +
+         (m["vertex_colours"].get<bool>() ? "yes" : "no"));
     if (!r["lit"].get<bool>())
         line("lights     none: no emissive material and no light of any power; light the scene with \"lights\" in a "
              "config (docs/inputs.md), --sky R,G,B or --environment FILE before rendering");

@@ -77,72 +77,165 @@ const AccessorFormat kIndexFormat{
 
 // Textures and Materials
 
-// The mean colour of texture `textureIndex`, decoded from a buffer view or from the bytes of its
-// uri's file that gltf_document.cpp kept (or, if it could not read them, why not). The image is
-// added to `decoded`.
-TextureColour textureColour(const GltfDocument& document, const AccessorReader& reader, int textureIndex,
-                            const std::string& usedBy, std::set<int>& decoded) {
-    const tinygltf::Model& model = document.model;
-    TextureColour none;
-    if (textureIndex < 0 || textureIndex >= int(model.textures.size())) {
-        none.problem = "refers to texture " + std::to_string(textureIndex) + ", which does not exist";
-        return none;
-    }
-    const int source = model.textures[textureIndex].source;
-    if (source < 0 || source >= int(model.images.size())) {
-        none.problem = gltfPlace("textures", textureIndex) + " has no image qsgi can read";
-        return none;
-    }
-    const tinygltf::Image& image = model.images[source];
-    const std::string imagePlace = gltfPlace("images", source);
-    decoded.insert(source);
-    TextureColour colour;
-    if (image.bufferView >= 0) {
-        const auto bytes = reader.viewBytes(image.bufferView, usedBy + " -> " + imagePlace);
-        colour = meanTextureColour(bytes.data, bytes.size);
-    } else if (!image.image.empty()) {
-        colour = meanTextureColour(image.image.data(), image.image.size());
-    } else {
-        const auto why = document.unreadableImages.find(source);
-        colour.problem = imagePlace + ".uri '" + image.uri.substr(0, 200) + "' " +
-                         (why != document.unreadableImages.end() ? why->second : "could not be read");
-        return colour;
-    }
-    if (!colour.mean) colour.problem = imagePlace + " " + colour.problem;
-    return colour;
-}
-
 Vec3f vec3FromFactor(const std::vector<double>& f, Vec3f fallback) {
     return f.size() >= 3 ? Vec3f(float(f[0]), float(f[1]), float(f[2])) : fallback;
 }
 
+// The textures the materials read whole (base colour: albedo per texel), each image decoded once
+// however many textures and materials share it. What a texture's sampler says comes with it.
+class TextureImages {
+public:
+    TextureImages(const GltfDocument& document, const AccessorReader& reader) : document_(document), reader_(reader) {}
+
+    // Texture `index` with its sampler, or why its image cannot be read; the image is added to
+    // `decoded` (read, whatever came of it).
+    std::pair<std::optional<Texture>, std::string> texture(int index, const std::string& usedBy, std::set<int>& decoded) {
+        const tinygltf::Model& model = document_.model;
+        if (index < 0 || index >= int(model.textures.size()))
+            return {std::nullopt, "refers to texture " + std::to_string(index) + ", which does not exist"};
+        const tinygltf::Texture& t = model.textures[size_t(index)];
+        const int source = t.source;
+        if (source < 0 || source >= int(model.images.size()))
+            return {std::nullopt, gltfPlace("textures", index) + " has no image qsgi can read"};
+        decoded.insert(source);
+        auto [at, added] = images_.emplace(source, DecodedTexture());
+        if (added) at->second = decode(source, usedBy);
+        if (!at->second.image) return {std::nullopt, at->second.problem};
+        Texture out;
+        out.image = at->second.image;
+        if (t.sampler >= 0 && t.sampler < int(model.samplers.size())) {
+            const tinygltf::Sampler& sampler = model.samplers[size_t(t.sampler)];
+            out.nearest = sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+            out.wrapS = wrapOf(sampler.wrapS);
+            out.wrapT = wrapOf(sampler.wrapT);
+        }
+        return {out, ""};
+    }
+    size_t bytes() const {
+        size_t total = 0;
+        for (const auto& [image, decoded] : images_) total += decoded.image ? decoded.image->bytes() : 0;
+        return total;
+    }
+
+private:
+    static TextureWrap wrapOf(int mode) {
+        return mode == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? TextureWrap::ClampToEdge
+               : mode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? TextureWrap::MirroredRepeat
+                                                               : TextureWrap::Repeat;
+    }
+    DecodedTexture decode(int source, const std::string& usedBy) const {
+        const tinygltf::Image& image = document_.model.images[size_t(source)];
+        const std::string imagePlace = gltfPlace("images", source);
+        DecodedTexture out;
+        // Decoded textures count against the memory the process may use: what the images decoded
+        // so far hold is not there for the next.
+        const uint64_t usable = usableMemory().bytes, budget = usable > bytes() ? usable - bytes() : 0;
+        if (image.bufferView >= 0) {
+            const auto bytes = reader_.viewBytes(image.bufferView, usedBy + " -> " + imagePlace);
+            out = decodeTextureImage(bytes.data, bytes.size, budget);
+        } else if (!image.image.empty()) {
+            out = decodeTextureImage(image.image.data(), image.image.size(), budget);
+        } else {
+            const auto why = document_.unreadableImages.find(source);
+            out.problem = imagePlace + ".uri '" + image.uri.substr(0, 200) + "' " +
+                          (why != document_.unreadableImages.end() ? why->second : "could not be read");
+            return out;
+        }
+        if (!out.image) out.problem = imagePlace + " " + out.problem;
+        return out;
+    }
+
+    const GltfDocument& document_;
+    const AccessorReader& reader_;
+    std::map<int, DecodedTexture> images_;  // by image index
+};
+
+// A number of a material's extension or textureInfo: finite, or the default when absent.
+double extensionNumber(const tinygltf::Value& object, const char* key, double fallback, const std::string& file,
+                       const std::string& place) {
+    if (!object.Has(key)) return fallback;
+    const tinygltf::Value& v = object.Get(key);
+    if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
+        throw InputError(file, place + "." + key, "must be a finite number");
+    return v.GetNumberAsDouble();
+}
+
+// How a material reads texture `info` (its texCoord, or the KHR_texture_transform's that
+// overrides it, and that extension's offset, rotation and scale).
+TextureSlot textureSlot(const tinygltf::TextureInfo& info, const std::string& file, const std::string& place) {
+    TextureSlot slot;
+    slot.texture = info.index;
+    slot.texCoord = info.texCoord;
+    auto transform = info.extensions.find("KHR_texture_transform");
+    if (transform == info.extensions.end()) return slot;
+    const tinygltf::Value& x = transform->second;
+    const std::string at = place + ".extensions.KHR_texture_transform";
+    // The texCoord override is checked with the primitive that reads it (addPrimitive).
+    if (x.Has("texCoord") && x.Get("texCoord").IsNumber()) slot.texCoord = int(x.Get("texCoord").GetNumberAsDouble());
+    for (const char* key : {"offset", "scale"}) {
+        if (!x.Has(key)) continue;
+        const tinygltf::Value& pair = x.Get(key);
+        if (!pair.IsArray() || pair.ArrayLen() != 2 || !pair.Get(0).IsNumber() || !pair.Get(1).IsNumber() ||
+            !std::isfinite(pair.Get(0).GetNumberAsDouble()) || !std::isfinite(pair.Get(1).GetNumberAsDouble()))
+            throw InputError(file, at + "." + key, "must be two finite numbers");
+        float* into = std::strcmp(key, "offset") == 0 ? slot.transform.offset : slot.transform.scale;
+        into[0] = float(pair.Get(0).GetNumberAsDouble());
+        into[1] = float(pair.Get(1).GetNumberAsDouble());
+    }
+    slot.transform.rotation = float(extensionNumber(x, "rotation", 0.0, file, at));
+    return slot;
+}
+
 Material convertMaterial(const GltfDocument& document, const AccessorReader& reader, int index, const std::string& file,
-                         Warnings& warnings, std::set<int>& decodedImages) {
+                         Warnings& warnings, std::set<int>& decodedImages, TextureImages& images,
+                         std::map<int, Texture>& textures) {
     const tinygltf::Material& m = document.model.materials[index];
     const std::string place = gltfPlace("materials", index);
     Material out;
     out.name = m.name;
     const auto& pbr = m.pbrMetallicRoughness;
     out.albedo = vec3FromFactor(pbr.baseColorFactor, Vec3f(1.0f));
+    out.alpha = pbr.baseColorFactor.size() >= 4 ? float(pbr.baseColorFactor[3]) : 1.0f;
     // glTF 2.0: each factor lies in [0, 1] (a surface that reflects more than it receives would
     // make energy); refused, not clamped, so that the render is of the file as written.
-    if (!isFinite(out.albedo) || out.albedo.x < 0 || out.albedo.y < 0 || out.albedo.z < 0 || maxComponent(out.albedo) > 1)
+    if (!isFinite(out.albedo) || out.albedo.x < 0 || out.albedo.y < 0 || out.albedo.z < 0 || maxComponent(out.albedo) > 1 ||
+        !(out.alpha >= 0 && out.alpha <= 1))
         throw InputError(file, place + ".pbrMetallicRoughness.baseColorFactor", "must lie in [0, 1] (glTF 2.0)");
     if (pbr.baseColorTexture.index >= 0) {
         const std::string texturePlace = place + ".pbrMetallicRoughness.baseColorTexture";
-        const TextureColour base = textureColour(document, reader, pbr.baseColorTexture.index, texturePlace, decodedImages);
-        if (base.mean) out.albedo = out.albedo * *base.mean;
-        else warnings.add(file + ": " + texturePlace + ": " + base.problem + "; using baseColorFactor alone");
+        const TextureSlot slot = textureSlot(pbr.baseColorTexture, file, texturePlace);
+        auto [texture, problem] = images.texture(pbr.baseColorTexture.index, texturePlace, decodedImages);
+        if (texture) {
+            out.baseColour = slot;
+            textures.emplace(slot.texture, std::move(*texture));
+        } else {
+            warnings.add(file + ": " + texturePlace + ": " + problem + "; using baseColorFactor alone");
+        }
     }
+    // glTF 2.0 (§5.19): alphaMode OPAQUE (the default), MASK or BLEND; alphaCutoff ≥ 0, read
+    // under MASK only.
+    if (m.alphaMode == "MASK") out.alphaMode = AlphaMode::Mask;
+    else if (m.alphaMode == "BLEND") out.alphaMode = AlphaMode::Blend;
+    else if (!m.alphaMode.empty() && m.alphaMode != "OPAQUE")
+        throw InputError(file, place + ".alphaMode", "is '" + m.alphaMode.substr(0, 40) + "', not OPAQUE, MASK or BLEND");
+    if (!(m.alphaCutoff >= 0) || !std::isfinite(m.alphaCutoff))
+        throw InputError(file, place + ".alphaCutoff", "must be a finite number of at least 0 (glTF 2.0)");
+    out.alphaCutoff = float(m.alphaCutoff);
+    out.doubleSided = m.doubleSided;
     if (pbr.metallicRoughnessTexture.index >= 0 || m.normalTexture.index >= 0 || m.occlusionTexture.index >= 0)
         warnings.add(file + ": metallic/roughness, normal and occlusion maps are ignored (surfaces are Lambertian)");
 
     Vec3f emissive = vec3FromFactor(m.emissiveFactor, Vec3f(0.0f));
     if (m.emissiveTexture.index >= 0 && maxComponent(emissive) > 0) {
         const std::string texturePlace = place + ".emissiveTexture";
-        const TextureColour texture = textureColour(document, reader, m.emissiveTexture.index, texturePlace, decodedImages);
-        if (texture.mean) emissive = emissive * *texture.mean;
-        else warnings.add(file + ": " + texturePlace + ": " + texture.problem + "; using emissiveFactor alone");
+        const TextureSlot slot = textureSlot(m.emissiveTexture, file, texturePlace);
+        auto [texture, problem] = images.texture(m.emissiveTexture.index, texturePlace, decodedImages);
+        if (texture) {
+            out.emissive = slot;
+            textures.emplace(slot.texture, std::move(*texture));
+        } else {
+            warnings.add(file + ": " + texturePlace + ": " + problem + "; using emissiveFactor alone");
+        }
     }
     auto strength = m.extensions.find("KHR_materials_emissive_strength");
     if (strength != m.extensions.end() && strength->second.Has("emissiveStrength")) {
@@ -277,7 +370,8 @@ public:
         scene.nodes = buildHierarchy(model_, file_, nodeErrors);
         for (size_t i = 0; i < model_.materials.size(); ++i) {
             try {
-                scene.materials.push_back(convertMaterial(document_, reader_, int(i), file_, warnings_, decodedImages_));
+                scene.materials.push_back(
+                    convertMaterial(document_, reader_, int(i), file_, warnings_, decodedImages_, images_, textures_));
             } catch (const InputError& e) {
                 materialErrors.emplace(int(i), e);  // refused below if a rendered primitive uses it
                 scene.materials.push_back(Material{"(unusable)", Vec3f(1.0f), Vec3f(0.0f)});
@@ -352,12 +446,30 @@ public:
                 unusedObjectError(InputError(file_, gltfPlace("images", image) + ".uri",
                                              "'" + model_.images[size_t(image)].uri.substr(0, 200) + "' " + why),
                                   gltfPlace("images", image));
+        keepUsedTextures(scene);
         scene.finalize();
         checkSceneExtent(scene.positions, scene.bounds(), file_, "nodes");
         return scene;
     }
 
 private:
+    // The scene keeps the textures its materials read; the images only unused materials read are
+    // let go. Materials the render does not use lose their textures (nothing reads them).
+    void keepUsedTextures(Scene& scene) {
+        auto set = std::make_shared<TextureSet>(model_.textures.size());
+        for (size_t i = 0; i < scene.materials.size(); ++i)
+            for (TextureSlot* slot : {&scene.materials[i].baseColour, &scene.materials[i].emissive}) {
+                if (!slot->used()) continue;
+                if (!usedMaterials_.count(int(i))) {
+                    *slot = TextureSlot();
+                    continue;
+                }
+                (*set)[size_t(slot->texture)] = textures_.at(slot->texture);
+            }
+        textures_.clear();
+        scene.textures = std::move(set);
+    }
+
     // An error in an object the render does not use (glTF objects nothing in the default scene
     // reaches): a warning naming it, or, under --strict, a refusal.
     // object "": a slip in the document itself that leaves it readable (an empty top-level
@@ -746,9 +858,36 @@ private:
                 objectNormals[i] = Vec3f(float((*normals)(i, 0)), float((*normals)(i, 1)), float((*normals)(i, 2)));
         }
         scene.addInstance(nodeIndex, std::move(objectPositions), std::move(objectNormals), tri, material, &world);
+        addSurfaceAttributes(scene, prim, place, scene.materials[material]);
         MeshInstance& instance = scene.instances.back();
         if (skin >= 0) addInfluences(scene, instance, prim, place, skin);
         addMorphTargets(instance, prim, place, morphWeights, normals.has_value());
+    }
+
+    // The per-vertex data the material reads (issue 57), into the scene's arrays for the block the
+    // last addInstance added: the TEXCOORD_n set its base colour texture reads, and COLOR_0 (RGB
+    // or RGBA, float or normalised integers; checked by checkOtherAttributes), linear as glTF says.
+    void addSurfaceAttributes(Scene& scene, const tinygltf::Primitive& prim, const std::string& place,
+                              const Material& material) {
+        const size_t first = scene.instances.back().firstVertex, count = scene.instances.back().vertexCount;
+        for (const TextureSlot* slot : {&material.baseColour, &material.emissive}) {
+            if (!slot->used()) continue;
+            const size_t set = size_t(slot->texCoord);
+            const std::string name = "TEXCOORD_" + std::to_string(set);
+            const AccessorData uv = reader_.read(prim.attributes.at(name), place + ".attributes." + name, kTexcoordFormat);
+            if (scene.vertexTexCoords.size() <= set) scene.vertexTexCoords.resize(set + 1);
+            std::vector<TexCoord>& into = scene.vertexTexCoords[set];
+            into.resize(scene.positions.size());
+            for (size_t i = 0; i < count && i < uv.count; ++i) into[first + i] = {float(uv(i, 0)), float(uv(i, 1))};
+        }
+        auto colour = prim.attributes.find("COLOR_0");
+        if (colour == prim.attributes.end()) return;
+        const bool rgba = colour->second >= 0 && colour->second < int(model_.accessors.size()) &&
+                          model_.accessors[size_t(colour->second)].type == TINYGLTF_TYPE_VEC4;
+        const AccessorData c = reader_.read(colour->second, place + ".attributes.COLOR_0", rgba ? kColourRgbaFormat : kColourRgbFormat);
+        scene.vertexColours.resize(scene.positions.size(), Rgba{1, 1, 1, 1});
+        for (size_t i = 0; i < count && i < c.count; ++i)
+            scene.vertexColours[first + i] = {float(c(i, 0)), float(c(i, 1)), float(c(i, 2)), rgba ? float(c(i, 3)) : 1.0f};
     }
 
     // glTF 2.0 (§3.7.3.1): a skin's joints hang from one common root, and its skeleton, if
@@ -1074,6 +1213,8 @@ private:
     std::map<int, int> skinOf_;  // glTF skin -> Scene::skins
     std::set<int> usedMeshes_, usedMaterials_, usedLights_;
     std::set<int> decodedImages_;  // the images materials' textures decoded (convertMaterial)
+    TextureImages images_{document_, reader_};
+    std::map<int, Texture> textures_;  // the base colour and emissive textures that could be read, by texture index
     std::set<std::vector<int>> warnedWeights_;  // the WEIGHTS_n accessors already warned about (addInfluences)
     bool readingUnusedObjects_ = false;         // within checkUnusedObjects
     uint32_t defaultMaterial_ = 0;

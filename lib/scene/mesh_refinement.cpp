@@ -37,6 +37,16 @@ public:
     InstanceRefiner(const Scene& scene, const MeshInstance& inst, const RefinementTracks* tracks = nullptr)
         : inst_(inst), positions_(inst.objectPositions), normals_(inst.objectNormals), joints_(inst.skinJoints),
           weights_(inst.skinWeights), morphPositions_(inst.morphPositions), morphNormals_(inst.morphNormals) {
+        // What the materials read per vertex (issue 57), the block's own values, flattened.
+        for (const std::vector<TexCoord>& set : scene.vertexTexCoords) {
+            std::vector<float>& uv = texCoords_.emplace_back();
+            for (uint32_t i = 0; i < inst.vertexCount && !set.empty(); ++i)
+                uv.insert(uv.end(), {set[inst.firstVertex + i].s, set[inst.firstVertex + i].t});
+        }
+        for (uint32_t i = 0; i < inst.vertexCount && !scene.vertexColours.empty(); ++i) {
+            const Rgba& c = scene.vertexColours[inst.firstVertex + i];
+            colours_.insert(colours_.end(), c.begin(), c.end());
+        }
         world_.reserve(inst.vertexCount);
         for (uint32_t i = 0; i < inst.vertexCount; ++i) world_.push_back(Vec3d(scene.positions[inst.firstVertex + i]));
         for (uint32_t t = 0; t < inst.triangleCount; ++t) {
@@ -99,6 +109,9 @@ public:
         for (std::vector<Vec3f>& target : morphPositions_) appendRefinedVectors(target, refinedFrom_, RefinedRule::Mean);
         for (std::vector<Vec3f>& target : morphNormals_)
             if (!target.empty()) appendRefinedVectors(target, refinedFrom_, RefinedRule::Mean);
+        for (std::vector<float>& uv : texCoords_)
+            if (!uv.empty()) appendRefinedValues(uv, 2, refinedFrom_, RefinedRule::Mean);
+        if (!colours_.empty()) appendRefinedValues(colours_, 4, refinedFrom_, RefinedRule::Mean);
         inst.firstVertex = firstVertex;
         inst.vertexCount = uint32_t(world_.size());
         inst.firstTriangle = firstTriangle;
@@ -116,6 +129,12 @@ public:
             scene.vertexHidden.push_back(0);
             scene.vertexMaterial.push_back(material);
         }
+        for (size_t set = 0; set < texCoords_.size(); ++set)
+            for (uint32_t i = 0; i < inst.vertexCount; ++i)
+                scene.vertexTexCoords[set].push_back(texCoords_[set].empty() ? TexCoord()
+                                                                             : TexCoord{texCoords_[set][2 * i], texCoords_[set][2 * i + 1]});
+        for (uint32_t i = 0; i < inst.vertexCount && !colours_.empty(); ++i)
+            scene.vertexColours.push_back({colours_[4 * i], colours_[4 * i + 1], colours_[4 * i + 2], colours_[4 * i + 3]});
         for (const LocalTriangle& t : triangles_) {
             scene.triangles.push_back({{firstVertex + t[0], firstVertex + t[1], firstVertex + t[2]}});
             scene.triangleMaterial.push_back(triangleMaterial);
@@ -184,6 +203,8 @@ private:
     std::vector<uint16_t> joints_;
     std::vector<float> weights_;
     std::vector<std::vector<Vec3f>> morphPositions_, morphNormals_;
+    std::vector<std::vector<float>> texCoords_;  // per TEXCOORD set, 2 floats a vertex
+    std::vector<float> colours_;                 // COLOR_0, 4 floats a vertex, or none
     std::vector<Vec3d> world_;  // the current pose's, for lengths
     std::vector<LocalTriangle> triangles_;
     std::vector<uint32_t> piece_;                 // per triangle: its piece of surface (RefinementTracks)
@@ -296,6 +317,8 @@ RefinementReport storeRefined(Scene& scene, std::vector<InstanceRefiner>& refine
     scene.normals.clear();
     scene.vertexHidden.clear();
     scene.vertexMaterial.clear();
+    for (std::vector<TexCoord>& set : scene.vertexTexCoords) set.clear();
+    scene.vertexColours.clear();
     scene.triangles.clear();
     scene.triangleMaterial.clear();
     for (size_t i = 0; i < scene.instances.size(); ++i)

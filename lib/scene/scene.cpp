@@ -366,6 +366,8 @@ void Scene::addInstance(int node, std::vector<Vec3f> objectPositions, std::vecto
     normals.resize(normals.size() + inst.vertexCount, Vec3f(0.0f));
     vertexHidden.resize(vertexHidden.size() + inst.vertexCount, 0);
     vertexMaterial.resize(vertexMaterial.size() + inst.vertexCount, material);
+    for (std::vector<TexCoord>& set : vertexTexCoords) set.resize(positions.size());
+    if (!vertexColours.empty()) vertexColours.resize(positions.size(), Rgba{1, 1, 1, 1});
     for (size_t t = 0; t + 2 < indices.size(); t += 3) {
         // A mirroring transform reverses the winding; swapping keeps the front side CCW in world space.
         Triangle out{{inst.firstVertex + indices[t], inst.firstVertex + indices[t + 1], inst.firstVertex + indices[t + 2]}};

@@ -13,16 +13,39 @@
 #include "scene/camera.h"
 #include "scene/environment_light.h"
 #include "scene/keyframes.h"
+#include "scene/texture.h"
 #include "util/vecmath.h"
 
 namespace qsgi {
 
-// Lambertian material. emission is the radiance L_e (W m^-2 sr^-1) of the front side.
+// glTF's alphaMode: OPAQUE ignores alpha; MASK removes the points whose alpha is below the
+// cutoff; BLEND lets 1 − alpha of the light through.
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
+// Lambertian material (docs/inputs.md). At a point, the albedo is albedo × the base colour
+// texture's RGB × the vertex colour's RGB, and alpha is alpha × the texture's A × the vertex
+// colour's A (lib/scene/surface_lookup.h). emission is the radiance L_e (W m^-2 sr^-1) of the
+// front side.
 struct Material {
+    Material(std::string materialName = {}, Vec3f factor = Vec3f(0.8f), Vec3f radiance = Vec3f(0.0f))
+        : name(std::move(materialName)), albedo(factor), emission(radiance) {}
     std::string name;
-    Vec3f albedo{0.8f};
-    Vec3f emission{0.0f};
+    Vec3f albedo;  // baseColorFactor's RGB (by itself, the albedo of an untextured surface)
+    Vec3f emission;
+    float alpha = 1;     // baseColorFactor's A
+    TextureSlot baseColour;
+    // emission × this texture's RGB (sRGB-decoded) at the point: emission per texel.
+    TextureSlot emissive;
+    // KHR_materials_transmission: the share of the light that passes straight through (× the
+    // texture's R), tinted by the base colour.
+    float transmission = 0;
+    TextureSlot transmissionTexture;
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    float alphaCutoff = 0.5f;
+    bool doubleSided = false;
     bool isEmissive() const { return maxComponent(emission) > 0; }
+    // Rays may pass through it (a cut-out or a blend): SceneBvh asks it at every hit.
+    bool letsLightThrough() const { return alphaMode != AlphaMode::Opaque; }
 };
 
 struct Triangle {
@@ -149,6 +172,13 @@ struct Scene {
     std::vector<uint32_t> vertexMaterial;
     std::vector<Triangle> triangles;
     std::vector<uint32_t> triangleMaterial;
+    // What the materials' textures read (issue 57): the decoded textures, and per vertex its
+    // TEXCOORD_n sets (vertexTexCoords[n], empty when no primitive has set n; a vertex of a
+    // primitive without it holds (0, 0)) and its COLOR_0 as linear RGBA (empty when no primitive
+    // has one; white elsewhere). Set by the loader, refined with the mesh (--subdivide).
+    std::shared_ptr<const TextureSet> textures;
+    std::vector<std::vector<TexCoord>> vertexTexCoords;
+    std::vector<Rgba> vertexColours;
     // A vertex is hidden while its transform is singular — a zero scale, on any axis, is how glTF
     // animates visibility (docs/design.md §3). A hidden rigid instance is collapsed to its node's origin,
     // so its zero-area triangles block and receive nothing; a skinned vertex goes where its

@@ -12,11 +12,10 @@
 #include <vector>
 
 #include "util/error.h"
+#include "util/memory.h"
 
 namespace qsgi {
 namespace {
-
-double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 
 // The container's signature decides the reader (the mimeType and the file name may lie).
 const char* extensionOf(const unsigned char* bytes, size_t size) {
@@ -32,35 +31,57 @@ std::string tooManyPixels(uint64_t width, uint64_t height) {
            " pixels, more than qsgi decodes (16384 x 16384); skipped";
 }
 
-// The sum of the pixels' linear colours. 8-bit values go through a table of the sRGB curve, and
-// so do 16-bit ones (one pow per possible value, not per pixel).
-class LinearSum {
+// Where a decoder puts the pixels: once the size (before any row, so that a sink may refuse
+// nothing and allocate once), then every row, top to bottom (an interlaced PNG pass by pass,
+// each row with the x and y of its pixels).
+class RowSink {
 public:
-    explicit LinearSum(bool sixteen) : sixteen_(sixteen), linear_(sixteen ? 65536 : 256) {
-        for (size_t v = 0; v < linear_.size(); ++v) linear_[v] = srgbToLinear(double(v) / double(linear_.size() - 1));
+    virtual ~RowSink() = default;
+    // "" to go on, or why the image is not taken (decoding stops there).
+    virtual std::string begin(uint32_t width, uint32_t height, bool sixteen) = 0;
+    // `pixels` pixels of `channels` interleaved values (grey is one channel, grey and alpha two);
+    // 16-bit values in the given byte order. Pixel i lies at (x0 + i·dx, y) of the image.
+    virtual void addRow(const unsigned char* row, size_t pixels, int channels, bool bigEndian, uint32_t y, uint32_t x0,
+                        uint32_t dx) = 0;
+};
+
+// The pixels as stored, 8 bits a channel, RGBA (TextureImage): 16-bit values rounded to 8.
+class ImageRows : public RowSink {
+public:
+    explicit ImageRows(uint64_t budget) : budget_(budget) {}
+    std::string begin(uint32_t width, uint32_t height, bool sixteen) override {
+        const uint64_t bytes = 4 * uint64_t(width) * height;
+        if (bytes > budget_)
+            return "is " + std::to_string(width) + " x " + std::to_string(height) + " pixels, which would need " +
+                   formatBytes(bytes) + " decoded, more than the " + formatBytes(budget_) + " of memory left for textures; skipped";
+        image_ = std::make_shared<TextureImage>();
+        image_->width = width;
+        image_->height = height;
+        image_->rgba.assign(size_t(width) * height * 4, 255);
+        sixteen_ = sixteen;
+        return "";
     }
-    // `pixels` pixels of `channels` interleaved values (grey is one channel: it counts for all
-    // three); 16-bit values in the given byte order.
-    void addRow(const unsigned char* row, size_t pixels, int channels, bool bigEndian) {
-        for (size_t x = 0; x < pixels; ++x)
-            for (int c = 0; c < 3; ++c) {
-                const size_t at = x * size_t(channels) + size_t(channels >= 3 ? c : 0);
-                size_t value = row[at];
-                if (sixteen_) {
-                    const unsigned char* v = row + 2 * at;
-                    value = bigEndian ? (size_t(v[0]) << 8 | v[1]) : (size_t(v[1]) << 8 | v[0]);
-                }
-                sum_[c] += linear_[value];
-            }
+    void addRow(const unsigned char* row, size_t pixels, int channels, bool bigEndian, uint32_t y, uint32_t x0,
+                uint32_t dx) override {
+        auto value = [&](size_t at) -> uint8_t {
+            if (!sixteen_) return row[at];
+            const unsigned char* v = row + 2 * at;
+            const uint32_t wide = bigEndian ? (uint32_t(v[0]) << 8 | v[1]) : (uint32_t(v[1]) << 8 | v[0]);
+            return uint8_t((wide * 255 + 32767) / 65535);
+        };
+        for (size_t i = 0; i < pixels; ++i) {
+            uint8_t* out = image_->rgba.data() + 4 * (size_t(y) * image_->width + x0 + i * dx);
+            const size_t at = i * size_t(channels);
+            for (int c = 0; c < 3; ++c) out[c] = value(at + size_t(channels >= 3 ? c : 0));
+            if (channels == 2 || channels == 4) out[3] = value(at + size_t(channels - 1));
+        }
     }
-    Vec3f mean(double pixels) const {
-        return Vec3f(float(sum_[0] / pixels), float(sum_[1] / pixels), float(sum_[2] / pixels));
-    }
+    std::shared_ptr<const TextureImage> take() { return std::move(image_); }
 
 private:
-    bool sixteen_;
-    std::vector<double> linear_;
-    double sum_[3] = {0, 0, 0};
+    uint64_t budget_;
+    std::shared_ptr<TextureImage> image_;
+    bool sixteen_ = false;
 };
 
 // ---- PNG ----
@@ -158,22 +179,16 @@ bool withPngErrors(PngDecoder& d, Work&& work) {
     return true;
 }
 
-TextureColour meanPngColour(const unsigned char* bytes, size_t size) {
-    TextureColour out;
+// Decodes a PNG into `sink`; "" or why it could not.
+std::string decodePng(const unsigned char* bytes, size_t size, RowSink& sink) {
     PngHeader header;
-    out.problem = pngHeaderProblem(bytes, size, header);
-    if (!out.problem.empty()) return out;
-    if (uint64_t(header.width) * header.height > kMaxTexturePixels) {
-        out.problem = tooManyPixels(header.width, header.height);
-        return out;
-    }
+    const std::string problem = pngHeaderProblem(bytes, size, header);
+    if (!problem.empty()) return problem;
+    if (uint64_t(header.width) * header.height > kMaxTexturePixels) return tooManyPixels(header.width, header.height);
     PngDecoder d(bytes, size);
     d.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &d, pngStop, pngIgnoreWarning);
     if (d.png) d.info = png_create_info_struct(d.png);
-    if (!d.png || !d.info) {
-        out.problem = "cannot be decoded: libpng could not start";
-        return out;
-    }
+    if (!d.png || !d.info) return "cannot be decoded: libpng could not start";
     png_set_read_fn(d.png, &d, pngReadBytes);
     // libpng refuses more than 10^6 pixels a side by default; the pixel count is qsgi's limit.
     png_set_user_limits(d.png, 0x7FFFFFFF, 0x7FFFFFFF);
@@ -186,7 +201,8 @@ TextureColour meanPngColour(const unsigned char* bytes, size_t size) {
             channels = png_get_channels(d.png, d.info);
             rowBytes = png_get_rowbytes(d.png, d.info);
         })) {
-        LinearSum sum(header.bitDepth == 16);
+        const std::string refused = sink.begin(header.width, header.height, header.bitDepth == 16);
+        if (!refused.empty()) return refused;
         std::vector<unsigned char> row(rowBytes);
         // A row at a time; an interlaced image pass by pass, its rows as the pass holds them
         // (each pixel lies in exactly one pass), so memory stays at one row.
@@ -195,74 +211,66 @@ TextureColour meanPngColour(const unsigned char* bytes, size_t size) {
                     const uint32_t cols = header.interlace ? PNG_PASS_COLS(header.width, pass) : header.width;
                     const uint32_t rows = header.interlace ? PNG_PASS_ROWS(header.height, pass) : header.height;
                     if (cols == 0) continue;  // libpng skips such passes
+                    const uint32_t x0 = header.interlace ? PNG_PASS_START_COL(pass) : 0;
+                    const uint32_t dx = header.interlace ? 1u << PNG_PASS_COL_SHIFT(pass) : 1;
+                    const uint32_t y0 = header.interlace ? PNG_PASS_START_ROW(pass) : 0;
+                    const uint32_t dy = header.interlace ? 1u << PNG_PASS_ROW_SHIFT(pass) : 1;
                     for (uint32_t r = 0; r < rows; ++r) {
                         png_read_row(d.png, row.data(), nullptr);
-                        sum.addRow(row.data(), cols, channels, true);
+                        sink.addRow(row.data(), cols, channels, true, y0 + r * dy, x0, dx);
                     }
                 }
-            })) {
-            out.mean = sum.mean(double(header.width) * double(header.height));
-            return out;
-        }
+            }))
+            return "";
     }
-    out.problem = std::string("is a corrupt PNG (libpng: ") + d.error + ")";
-    return out;
+    return std::string("is a corrupt PNG (libpng: ") + d.error + ")";
 }
 
 // ---- JPEG ----
 // Through OpenImageIO, whose JPEG reader takes over both of libjpeg's message routines
 // (error_exit and output_message), so libjpeg prints nothing.
-TextureColour meanJpegColour(const unsigned char* bytes, size_t size) {
-    TextureColour out;
+std::string decodeJpeg(const unsigned char* bytes, size_t size, RowSink& sink) {
     OIIO::Filesystem::IOMemReader memory(bytes, size);
     // OIIO picks its plugin by the name's extension, so the name handed to it is "texture.jpg".
     auto input = OIIO::ImageInput::create("jpg");
-    if (!input || !input->supports("ioproxy") || !input->set_ioproxy(&memory)) {
-        out.problem = "cannot be decoded: this OpenImageIO cannot read jpg from memory";
-        return out;
-    }
+    if (!input || !input->supports("ioproxy") || !input->set_ioproxy(&memory))
+        return "cannot be decoded: this OpenImageIO cannot read jpg from memory";
     OIIO::ImageSpec config, opened;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    if (!input->open("texture.jpg", opened, config)) {
-        out.problem = "cannot be decoded: " + oneLine(input->geterror());
-        return out;
-    }
+    if (!input->open("texture.jpg", opened, config)) return "cannot be decoded: " + oneLine(input->geterror());
     const OIIO::ImageSpec& spec = input->spec();
     const size_t width = size_t(std::max(spec.width, 0)), height = size_t(std::max(spec.height, 0));
     const int channels = spec.nchannels;
-    if (width == 0 || height == 0 || channels <= 0 || spec.depth > 1) {
-        out.problem = "has no pixels";
-        return out;
-    }
-    if (width > kMaxTexturePixels / height) {
-        out.problem = tooManyPixels(width, height);
-        return out;
-    }
+    if (width == 0 || height == 0 || channels <= 0 || spec.depth > 1) return "has no pixels";
+    if (width > kMaxTexturePixels / height) return tooManyPixels(width, height);
     const bool sixteen = spec.format.size() > 1;
     const OIIO::TypeDesc readAs = sixteen ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8;
-    LinearSum sum(sixteen);
+    const std::string refused = sink.begin(uint32_t(width), uint32_t(height), sixteen);
+    if (!refused.empty()) return refused;
     std::vector<unsigned char> row(width * size_t(channels) * (sixteen ? 2 : 1));
     for (int y = spec.y; y < spec.y + spec.height; ++y) {
-        if (!input->read_scanline(y, spec.z, readAs, row.data())) {
-            out.problem = "is truncated or corrupt: " + oneLine(input->geterror());
-            return out;
-        }
-        sum.addRow(row.data(), width, channels, false);  // native order: little-endian, as every machine qsgi builds on
+        if (!input->read_scanline(y, spec.z, readAs, row.data()))
+            return "is truncated or corrupt: " + oneLine(input->geterror());
+        // native order: little-endian, as every machine qsgi builds on
+        sink.addRow(row.data(), width, channels, false, uint32_t(y - spec.y), 0, 1);
     }
-    out.mean = sum.mean(double(width) * double(height));
-    return out;
+    return "";
+}
+
+std::string decode(const unsigned char* bytes, size_t size, RowSink& sink) {
+    const char* extension = extensionOf(bytes, size);
+    if (!extension) return "is neither PNG nor JPEG (the image formats glTF 2.0 allows)";
+    return std::strcmp(extension, "png") == 0 ? decodePng(bytes, size, sink) : decodeJpeg(bytes, size, sink);
 }
 
 }  // namespace
 
-TextureColour meanTextureColour(const unsigned char* bytes, size_t size) {
-    const char* extension = extensionOf(bytes, size);
-    if (!extension) {
-        TextureColour out;
-        out.problem = "is neither PNG nor JPEG (the image formats glTF 2.0 allows)";
-        return out;
-    }
-    return std::strcmp(extension, "png") == 0 ? meanPngColour(bytes, size) : meanJpegColour(bytes, size);
+DecodedTexture decodeTextureImage(const unsigned char* bytes, size_t size, uint64_t budget) {
+    DecodedTexture out;
+    ImageRows rows(budget);
+    out.problem = decode(bytes, size, rows);
+    if (out.problem.empty()) out.image = rows.take();
+    return out;
 }
 
 }  // namespace qsgi

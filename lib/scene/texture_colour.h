@@ -1,18 +1,18 @@
-// The mean colour of a glTF texture image, decoded from its encoded bytes: PNG with libpng under
-// qsgi's own error handler, JPEG with OpenImageIO (which takes over libjpeg's messages); neither
-// prints anything, so a broken texture is one warning in qsgi's words, also under --quiet.
-//
-// qsgi's surfaces are Lambertian with one albedo per material, so a base colour texture counts
-// only through its mean linear colour. tinygltf is told not to decode images at all (its decoder,
+// A glTF texture image decoded from its encoded bytes: PNG with libpng under qsgi's own error
+// handler, JPEG with OpenImageIO (which takes over libjpeg's messages); neither prints anything,
+// so a broken texture is one warning in qsgi's words, also under --quiet. The materials read a
+// texture whole (albedo and emission per texel, issue 57). tinygltf is told not to decode images at all (its decoder,
 // stb_image, reads outside its input on hostile files, and it decodes every image of a file, used
 // or not); gltf_document.cpp keeps the encoded bytes of URI images, and embedded images are read
 // from their buffer view through the checked accessor reader. Only the textures a material uses
-// are decoded, a scanline at a time, so memory stays at one row whatever the image's size.
+// are decoded.
 #pragma once
 
 #include <cstddef>
-#include <optional>
+#include <cstdint>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "util/vecmath.h"
 
@@ -23,14 +23,26 @@ namespace qsgi {
 // it takes seconds, while a hostile header may claim far more.
 constexpr size_t kMaxTexturePixels = size_t(1) << 28;
 
-struct TextureColour {
-    std::optional<Vec3f> mean;  // mean linear (sRGB-decoded) RGB, when the image could be read
-    std::string problem;        // why it could not, for the warning
+// A texture image as stored, 8 bits a channel, RGBA: grey fills R, G and B, a missing alpha is
+// 255, 16-bit values are rounded to 8 (a step of 0.4 % of the range, far below a bake's noise).
+// Row 0 is the image's top row, which glTF's texture coordinate t = 0 reads. Not yet linear: a
+// colour texture is sRGB-encoded, alpha and data textures are not (Texture::sample decodes).
+struct TextureImage {
+    uint32_t width = 0, height = 0;
+    std::vector<uint8_t> rgba;
+    size_t bytes() const { return rgba.capacity(); }
 };
 
-// Decodes a PNG or JPEG (the formats glTF 2.0 allows) from memory and averages its pixels after
-// the sRGB transfer function; grey images give grey. Never throws on bad bytes and never prints:
-// reports them (a PNG's header is checked against the PNG specification before libpng reads it).
-TextureColour meanTextureColour(const unsigned char* bytes, size_t size);
+struct DecodedTexture {
+    std::shared_ptr<const TextureImage> image;  // when it could be read
+    std::string problem;                        // why it could not
+};
+
+// Decodes a PNG or JPEG into 4 bytes a pixel (at most kMaxTexturePixels of them: 1 GiB). Never
+// throws on bad bytes and never prints: reports them (a PNG's header is checked against the PNG
+// specification before libpng reads it).
+// An image whose decoded pixels would need more than `budget` bytes is not decoded (the problem
+// says so).
+DecodedTexture decodeTextureImage(const unsigned char* bytes, size_t size, uint64_t budget = UINT64_MAX);
 
 }  // namespace qsgi

@@ -57,8 +57,15 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         const Material& m = scene.materials[scene.triangleMaterial[t]];
         const float area = scene.triangleArea(t);
         if (!m.isEmissive() || !(area > 0)) continue;
-        // One-sided Lambertian emitter: exitance π L_e over the area.
-        emitters_.push_back({Emitter::Triangle, t, m.emission * (kPi * area), Vec3f(0.0f), -1, scene.geometricNormal(t)});
+        // One-sided Lambertian emitter: exitance π L_e over the area; a textured one piece by
+        // piece, each its own emitter (emission_pieces.h).
+        for (const EmissionPiece& piece : emissionPieces(scene, t)) {
+            const bool whole = piece.areaShare == 1 && piece.corner[1][0] == 1 && piece.corner[2][1] == 1;
+            const int32_t index = whole ? -1 : int32_t(pieces_.size());
+            if (!whole) pieces_.push_back(piece);
+            emitters_.push_back({Emitter::Triangle, t, piece.radiance * (kPi * (area * piece.areaShare)), Vec3f(0.0f), -1,
+                                 scene.geometricNormal(t), index});
+        }
     }
     if (scene.environment) {
         // Through the disc of radius R facing each direction: π R² ∫ L dω.
@@ -280,6 +287,13 @@ PhotonEmission LightSampler::sample(const PathNumbers& rng) const {
             const Triangle& tri = scene_.triangles[e.index];
             float b1, b2;
             uniformTriangle(u0, u1, b1, b2);
+            if (e.piece >= 0) {
+                // The point within the piece, as barycentrics of its triangle.
+                const auto& c = pieces_[size_t(e.piece)].corner;
+                const float p1 = b1, p2 = b2, p0 = 1 - p1 - p2;
+                b1 = c[0][0] * p0 + c[1][0] * p1 + c[2][0] * p2;
+                b2 = c[0][1] * p0 + c[1][1] * p1 + c[2][1] * p2;
+            }
             const Vec3f& a = scene_.positions[tri.v[0]];
             const Vec3f& b = scene_.positions[tri.v[1]];
             const Vec3f& c = scene_.positions[tri.v[2]];

@@ -11,6 +11,7 @@
 #include <optional>
 #include <vector>
 
+#include "scene/emission_pieces.h"
 #include "scene/scene.h"
 #include "trace/photon_numbers.h"
 #include "trace/projection_map.h"
@@ -73,12 +74,14 @@ private:
         Vec3f photonPower;
         int aim = -1;     // into aims_, −1: unaimed
         Vec3f normal{0.0f};  // a triangle's front (lights are static: worked out once, not per photon)
+        int32_t piece = -1;  // a triangle's piece of constant emission (pieces_), −1: the whole triangle
     };
     void aimLight(Emitter& e, const EmissionAim& aim);
     size_t chooseEmitter(float u) const;
 
     const Scene& scene_;
     std::vector<Emitter> emitters_;
+    std::vector<EmissionPiece> pieces_;  // the emissive textures' pieces (emission_pieces.h)
     std::vector<Aim> aims_;
     std::vector<double> cdf_;
     std::vector<uint64_t> firstPhoton_;  // dealing: per emitter, and the photon count last

@@ -2,6 +2,7 @@
 
 #include <map>
 #include <optional>
+#include <tuple>
 #include <utility>
 
 namespace qsgi {
@@ -11,14 +12,17 @@ PhotonSource::PhotonSource(const Scene& scene, uint64_t photons, uint64_t seed, 
     : seed_(seed), sampling_(sampling),
       lights_(scene, photons, rayEpsilon, aim,
               sampling.kind == SamplerKind::Sobol ? std::optional<uint64_t>(seed) : std::nullopt) {
+    auto lookup = std::make_shared<const SurfaceLookup>(scene);
+    if (lookup->any()) lookup_ = std::move(lookup);
     surfaceOf_.resize(scene.triangleCount());
-    std::map<std::pair<uint32_t, uint8_t>, uint32_t> index;  // (material, dynamic) -> surface
+    std::map<std::tuple<uint32_t, uint8_t, uint8_t>, uint32_t> index;  // (material, dynamic, varies) -> surface
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
-        const auto key = std::make_pair(uint32_t(scene.triangleMaterial[t]), uint8_t(scene.triangleDynamic[t]));
+        const uint8_t varies = lookup_ && lookup_->varies(t);
+        const auto key = std::make_tuple(uint32_t(scene.triangleMaterial[t]), uint8_t(scene.triangleDynamic[t]), varies);
         auto [at, added] = index.emplace(key, uint32_t(surfaces_.size()));
         if (added) {
-            const Vec3f albedo = scene.materials[key.first].albedo;
-            surfaces_.push_back(Surface{albedo, maxComponent(albedo), key.second});
+            const Vec3f albedo = scene.materials[std::get<0>(key)].albedo;
+            surfaces_.push_back(Surface{albedo, maxComponent(albedo), std::get<1>(key), varies});
         }
         surfaceOf_[t] = at->second;
     }

@@ -6,9 +6,11 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "scene/scene.h"
+#include "scene/surface_lookup.h"
 #include "trace/light_sampler.h"
 #include "trace/photon_numbers.h"
 
@@ -25,25 +27,35 @@ public:
     PhotonEmission emission(uint64_t path) const { return lights_.sample(numbersFor(path)); }
 
     // What a bounce reads of the triangle it hit: one 4-byte index per triangle into the few
-    // distinct (material, dynamic) surfaces. A 20-byte record per triangle was an 800 KB table
-    // on data/cornell, and its cache misses half of the kernel's own time (three scattered
+    // distinct (material, dynamic, varies) surfaces. A 20-byte record per triangle was an 800 KB
+    // table on data/cornell, and its cache misses half of the kernel's own time (three scattered
     // lookups, material index, material and dynamic flag, had been a tenth of the tracer's).
     struct Surface {
-        Vec3f albedo;
+        Vec3f albedo;    // the material's, unless it varies over the triangle (surfaceAt)
         float survival;  // Russian roulette: the albedo's largest component
         uint8_t dynamic;
+        uint8_t varies;  // the albedo varies over the triangle (a texture, vertex colours)
     };
     const Surface& surface(uint32_t triangle) const { return surfaces_[surfaceOf_[triangle]]; }
-    // The power a photon carries on after surviving an impact on `triangle`.
-    Vec3f powerAfter(const Vec3f& power, uint32_t triangle) const {
-        const Surface& s = surface(triangle);
-        return power * s.albedo / s.survival;
+    // The surface a photon meets at barycentrics (b1, b2) of `triangle`: its albedo there.
+    Surface surfaceAt(uint32_t triangle, float b1, float b2) const {
+        Surface s = surface(triangle);
+        if (s.varies) {
+            s.albedo = lookup_->albedo(triangle, b1, b2);
+            s.survival = maxComponent(s.albedo);
+        }
+        return s;
     }
+    // The power a photon carries on after surviving an impact on surface `s`.
+    static Vec3f powerAfter(const Vec3f& power, const Surface& s) { return power * s.albedo / s.survival; }
+    // Some triangle's albedo varies: impacts there keep where they took place.
+    bool anyVaries() const { return lookup_ && lookup_->any(); }
 
 private:
     uint64_t seed_;
     PhotonSampling sampling_;
     LightSampler lights_;
+    std::shared_ptr<const SurfaceLookup> lookup_;
     std::vector<Surface> surfaces_;    // the distinct ones
     std::vector<uint32_t> surfaceOf_;  // per scene triangle
 };

@@ -63,15 +63,17 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
             append(out, s);
             return;
         }
-        const PhotonSource::Surface& surface = source_->surface(hit->triangle);
+        const PhotonSource::Surface surface = source_->surfaceAt(hit->triangle, hit->u, hit->v);
         s.length = hit->t;
         s.triangle = hit->triangle;
         s.impactDynamic = surface.dynamic;
+        s.impactVaries = surface.varies;
+        if (surface.varies) s.b1 = hit->u, s.b2 = hit->v;
         append(out, s);
 
-        // Russian roulette on the albedo, then a cosine-weighted bounce on the incoming side.
+        // Russian roulette on the albedo at the hit, then a cosine-weighted bounce on the incoming side.
         if (!(rng.uniform(bounce + 1, kSurvival) < surface.survival)) return;
-        power = source_->powerAfter(power, hit->triangle);
+        power = PhotonSource::powerAfter(power, surface);
         // The hit's own normal (first traces and retraces both take it from Embree).
         Vec3f n = normalize(hit->ng);
         if (dot(n, direction) > 0) n = -n;

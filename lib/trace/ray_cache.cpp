@@ -13,6 +13,8 @@ void RayCache::BlockWriter::clear() {
     first_.clear();
     later_.clear();
     laterBegin_.clear();
+    hits_.clear();
+    hitsBegin_.clear();
     segments_ = 0;
 }
 
@@ -21,6 +23,8 @@ RayCache::BlockWriter RayCache::BlockWriter::exactCopy() const {
     copy.first_.assign(first_.begin(), first_.end());
     copy.later_.assign(later_.begin(), later_.end());
     copy.laterBegin_.assign(laterBegin_.begin(), laterBegin_.end());
+    copy.hits_.assign(hits_.begin(), hits_.end());
+    copy.hitsBegin_.assign(hitsBegin_.begin(), hitsBegin_.end());
     copy.segments_ = segments_;
     return copy;
 }
@@ -29,6 +33,7 @@ void RayCache::BlockWriter::beginPath() {
     if (laterBegin_.empty()) laterBegin_.push_back(0);
     first_.push_back({0.0f, kNoSegment});
     laterBegin_.push_back(uint32_t(later_.size()));
+    if (!hitsBegin_.empty()) hitsBegin_.push_back(uint32_t(hits_.size()));
 }
 
 void RayCache::BlockWriter::add(const Segment& s) {
@@ -38,6 +43,11 @@ void RayCache::BlockWriter::add(const Segment& s) {
     } else {
         later_.push_back({s.origin, s.direction, s.length, s.triangle});
         laterBegin_.back() = uint32_t(later_.size());
+    }
+    if (s.impactVaries) {
+        if (hitsBegin_.empty()) hitsBegin_.assign(first_.size() + 1, 0);  // the block's first such impact
+        hits_.push_back({s.b1, s.b2});
+        hitsBegin_.back() = uint32_t(hits_.size());
     }
     ++segments_;
 }
@@ -78,6 +88,7 @@ size_t RayCache::bytes() const {
         total += b.records.first_.capacity() * sizeof(BlockWriter::First) +
                  b.records.later_.capacity() * sizeof(BlockWriter::Later) +
                  b.records.laterBegin_.capacity() * sizeof(uint32_t) + b.verbatim.capacity() * sizeof(Segment) +
+                 b.records.hits_.capacity() * sizeof(b.records.hits_[0]) + b.records.hitsBegin_.capacity() * sizeof(uint32_t) +
                  b.verbatimPathBegin.capacity() * sizeof(uint64_t);
     return total;
 }
@@ -95,11 +106,20 @@ uint64_t RayCache::pathsMissingScene() const {
 
 namespace {
 
+// Where an impact on a triangle whose albedo varies took place: the path's kept barycentrics, in
+// order.
+void placeImpact(const PhotonSource& source, Segment& s, const std::array<float, 2>*& hit) {
+    s.impactDynamic = s.hasImpact() ? source.surface(s.triangle).dynamic : 0;
+    s.impactVaries = s.hasImpact() ? source.surface(s.triangle).varies : 0;
+    s.b1 = s.impactVaries ? (*hit)[0] : 0.0f;
+    s.b2 = s.impactVaries ? (*hit++)[1] : 0.0f;
+}
+
 // Appends path `path`'s segments from its records: the first from the emission, the later ones
 // from their records, power carried on with the tracer's own arithmetic.
 template <class First, class Later, class Out>
 void decodeRecords(const PhotonSource& source, uint64_t path, const First& first, const Later* later, const Later* end,
-                   Out out) {
+                   const std::array<float, 2>* hit, Out out) {
     const PhotonEmission e = source.emission(path);
     Segment s;
     s.origin = e.origin;
@@ -109,16 +129,16 @@ void decodeRecords(const PhotonSource& source, uint64_t path, const First& first
     s.triangle = first.triangle;
     s.path = uint32_t(path);
     s.bounce = 0;
-    s.impactDynamic = s.hasImpact() ? source.surface(s.triangle).dynamic : 0;
+    placeImpact(source, s, hit);
     *out++ = s;
     for (; later != end; ++later) {
-        s.power = source.powerAfter(s.power, s.triangle);
+        s.power = PhotonSource::powerAfter(s.power, source.surfaceAt(s.triangle, s.b1, s.b2));
         s.origin = later->origin;
         s.direction = later->direction;
         s.length = later->length;
         s.triangle = later->triangle;
         ++s.bounce;
-        s.impactDynamic = s.hasImpact() ? source.surface(s.triangle).dynamic : 0;
+        placeImpact(source, s, hit);
         *out++ = s;
     }
 }
@@ -141,7 +161,8 @@ void RayCache::decodeBlockInto(size_t b, Segment* out) const {
         if (r.first_[p].triangle == kNoSegment) continue;
         const size_t count = 1 + r.laterBegin_[p + 1] - r.laterBegin_[p];
         decodeRecords(*source_, block.firstPath + p, r.first_[p], r.later_.data() + r.laterBegin_[p],
-                      r.later_.data() + r.laterBegin_[p + 1], out);
+                      r.later_.data() + r.laterBegin_[p + 1], r.hitsBegin_.empty() ? nullptr : r.hits_.data() + r.hitsBegin_[p],
+                      out);
         out += count;
     }
 }
@@ -162,7 +183,8 @@ void RayCache::appendPath(uint64_t path, std::vector<Segment>& out) const {
     const BlockWriter& r = block.records;
     if (!source_ || local >= r.first_.size() || r.first_[local].triangle == kNoSegment) return;
     decodeRecords(*source_, path, r.first_[local], r.later_.data() + r.laterBegin_[local],
-                  r.later_.data() + r.laterBegin_[local + 1], std::back_inserter(out));
+                  r.later_.data() + r.laterBegin_[local + 1],
+                  r.hitsBegin_.empty() ? nullptr : r.hits_.data() + r.hitsBegin_[local], std::back_inserter(out));
 }
 
 void RayCache::forEachBlock(const std::function<void(size_t, const std::vector<Segment>&)>& visit) const {

@@ -16,6 +16,7 @@
 // Consumers read segments only through the accessors below, never by field.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -39,6 +40,10 @@ struct Segment {
     uint32_t path = 0;
     uint16_t bounce = 0;
     uint8_t impactDynamic = 0;        // impacted dynamic geometry
+    // Impacted a triangle whose albedo varies over it (a texture, vertex colours): the bounce's
+    // power depends on where, so the records keep the hit's barycentrics (b1, b2) for it.
+    uint8_t impactVaries = 0;
+    float b1 = 0, b2 = 0;
 
     bool hasImpact() const { return triangle != kNoTriangle; }
     Vec3f impactPoint() const { return origin + direction * length; }
@@ -125,6 +130,11 @@ public:
         std::vector<First> first_;           // per path
         std::vector<Later> later_;           // bounces ≥ 1, path after path
         std::vector<uint32_t> laterBegin_;   // per path and one more: its first later record
+        // The barycentrics of the impacts on varying triangles (Segment::impactVaries), in order,
+        // and per path (and one more) its first: both empty while a block has none, so a scene of
+        // plain colours pays nothing.
+        std::vector<std::array<float, 2>> hits_;
+        std::vector<uint32_t> hitsBegin_;
         size_t segments_ = 0;
     };
     static_assert(sizeof(BlockWriter::First) + sizeof(uint32_t) == kBytesPerPath, "the record sizes named above");

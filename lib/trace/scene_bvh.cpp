@@ -1,6 +1,9 @@
 #include "trace/scene_bvh.h"
 
+#include "trace/counter_rng.h"
+
 #include <algorithm>
+#include <cstring>
 #include <limits>
 #include <unordered_map>
 
@@ -25,7 +28,46 @@ void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args) {
     }
 }
 
+float blendChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle) {
+    auto bits = [](float x) {
+        uint32_t b;
+        std::memcpy(&b, &x, sizeof b);
+        return uint64_t(b);
+    };
+    uint64_t h = mix64(bits(origin.x) << 32 | bits(origin.y));
+    h = mix64(h ^ (bits(origin.z) << 32 | bits(direction.x)));
+    h = mix64(h ^ (bits(direction.y) << 32 | bits(direction.z)));
+    h = mix64(h ^ triangle);
+    return float(h >> 40) * 0x1p-24f;
+}
+
 namespace {
+
+// Drops the hits where the surface lets the ray through (PassThrough); true if lane i survives.
+bool stopsRay(const RTCFilterFunctionNArguments* args, unsigned i) {
+    const auto* pass = static_cast<const PassThrough*>(args->geometryUserPtr);
+    const uint32_t triangle = pass->sceneTriangle[RTCHitN_primID(args->hit, args->N, i)];
+    if (!pass->lookup->letsLightThrough(triangle)) return true;
+    const Vec3f origin(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                       RTCRayN_org_z(args->ray, args->N, i));
+    const Vec3f direction(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                          RTCRayN_dir_z(args->ray, args->N, i));
+    return pass->lookup->stops(triangle, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i),
+                               blendChoice(origin, direction, triangle));
+}
+
+// Closest hits through surfaces that let light through: those dropped, then the tie rule.
+void passThroughThenLowestPrimitive(const RTCFilterFunctionNArguments* args) {
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i] != 0 && !stopsRay(args, i)) args->valid[i] = 0;
+    lowestPrimitiveOnTies(args);
+}
+
+// Occlusion through surfaces that let light through.
+void passThroughOccluded(const RTCFilterFunctionNArguments* args) {
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i] != 0 && !stopsRay(args, i)) args->valid[i] = 0;
+}
 
 RTCRayHit makeRay(const Vec3f& o, const Vec3f& d, float tnear, float tfar) {
     RTCRayHit rh;
@@ -75,8 +117,9 @@ SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     rtcSetSceneFlags(staticScene_.get(), RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneFlags(dynamicScene_.get(), RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(staticScene_.get(), RTC_BUILD_QUALITY_HIGH);
-    static_ = addPart(staticScene_.get(), scene, false, RTC_BUILD_QUALITY_HIGH);
-    dynamic_ = addPart(dynamicScene_.get(), scene, true, RTC_BUILD_QUALITY_REFIT);
+    auto lookup = std::make_shared<const SurfaceLookup>(scene);
+    static_ = addPart(staticScene_.get(), scene, false, RTC_BUILD_QUALITY_HIGH, lookup);
+    dynamic_ = addPart(dynamicScene_.get(), scene, true, RTC_BUILD_QUALITY_REFIT, lookup);
     rtcCommitScene(staticScene_.get());
     rtcCommitScene(dynamicScene_.get());
     device_.checkError("building the scene BVH");
@@ -89,7 +132,8 @@ SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     boundDynamic(scene);
 }
 
-SceneBvh::Part SceneBvh::addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality) {
+SceneBvh::Part SceneBvh::addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality,
+                                 const std::shared_ptr<const SurfaceLookup>& lookup) {
     Part part;
     std::unordered_map<uint32_t, uint32_t> remap;
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
@@ -108,7 +152,16 @@ SceneBvh::Part SceneBvh::addPart(RTCScene target, const Scene& scene, bool dynam
     for (size_t i = 0; i < part.triangles.size(); ++i)
         for (int k = 0; k < 3; ++k) index[3 * i + k] = remap[scene.triangles[part.triangles[i]].v[k]];
     fillVertices(geom, part, scene);
-    rtcSetGeometryIntersectFilterFunction(geom, lowestPrimitiveOnTies);
+    bool passes = false;
+    for (uint32_t t : part.triangles) passes = passes || lookup->letsLightThrough(t);
+    if (passes) {
+        part.passThrough = std::make_unique<PassThrough>(PassThrough{lookup, part.triangles});
+        rtcSetGeometryUserData(geom, part.passThrough.get());
+        rtcSetGeometryIntersectFilterFunction(geom, passThroughThenLowestPrimitive);
+        rtcSetGeometryOccludedFilterFunction(geom, passThroughOccluded);
+    } else {
+        rtcSetGeometryIntersectFilterFunction(geom, lowestPrimitiveOnTies);
+    }
     rtcCommitGeometry(geom);
     part.geomId = rtcAttachGeometry(target, geom);
     rtcReleaseGeometry(geom);  // the scene holds its own reference

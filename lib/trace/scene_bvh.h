@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "scene/scene.h"
+#include "scene/surface_lookup.h"
 #include "trace/embree_device.h"
 
 namespace qsgi {
@@ -33,6 +34,21 @@ struct TieBreakContext {
     unsigned bestPrim = RTC_INVALID_GEOMETRY_ID;
 };
 void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args);
+
+// Where light passes through a surface (issue 57): an alpha-MASK cut-out, or a BLEND's share
+// 1 − alpha. Every ray — photons, shadow and gather rays, start points, cover tests, the camera —
+// ignores a hit where the material does not stop it (SurfaceLookup::stops), inside Embree's
+// filters: the answer at a hit is a pure function of the ray (its origin and direction) and the
+// triangle, never of the order in which traversal meets hits, so a refitted and a rebuilt BVH,
+// and a retrace and a first trace, see the same surfaces. A BLEND's choice is a hash of the
+// ray's origin, direction and triangle: each ray decides once and for all, independently of the
+// next.
+struct PassThrough {
+    std::shared_ptr<const SurfaceLookup> lookup;
+    std::vector<uint32_t> sceneTriangle;  // Embree primID -> scene triangle (the part's)
+};
+// The BLEND choice in [0, 1) for a ray and a scene triangle.
+float blendChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle);
 
 // staticGeometryRises' test of one triangle: its box comes within `radius` of `centre`, and a
 // corner lies at `height` or more above `centre` along `normal`. Shared with OwnSurfaceTree's
@@ -95,9 +111,13 @@ private:
         std::vector<uint32_t> triangles;  // Embree primID -> scene triangle (increasing)
         std::vector<uint32_t> vertices;   // Embree vertex -> scene vertex
         unsigned geomId = RTC_INVALID_GEOMETRY_ID;
+        // Its filters' data when some of its triangles let light through (at a fixed address:
+        // Embree holds the pointer).
+        std::unique_ptr<PassThrough> passThrough;
         bool empty() const { return geomId == RTC_INVALID_GEOMETRY_ID; }
     };
-    Part addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality);
+    Part addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality,
+                 const std::shared_ptr<const SurfaceLookup>& lookup);
     void fillVertices(RTCGeometry geom, const Part& part, const Scene& scene);
     void boundDynamic(const Scene& scene);
     std::optional<SurfaceHit> intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,

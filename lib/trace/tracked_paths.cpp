@@ -65,7 +65,7 @@ void TrackedPaths::keep(std::vector<std::vector<Segment>>& kept, const Bounds3f&
         segments += tails.size();
     }
     const SegmentRefLayout layout(slots, longest);
-    store_ = SlottedPathStore<Record>(slots, {true}, std::min(generations_, layout.generations()));
+    store_ = SlottedPathStore<Record, HitPoint>(slots, {true, source_->anyVaries()}, std::min(generations_, layout.generations()));
     // Exactly the room needed: the store is most of the tracked state.
     store_.reserve(segments);
     pathOf_.reserve(slots);
@@ -78,8 +78,7 @@ void TrackedPaths::keep(std::vector<std::vector<Segment>>& kept, const Bounds3f&
             firstBounce_.push_back(tails[begin].bounce);
             power_.push_back(tails[begin].power);
             store_.append(s, uint32_t(end - begin));
-            Record* records = &store_.at<0>(s, 0);
-            for (size_t j = begin; j < end; ++j) records[j - begin] = recordOf(tails[j]);
+            writeRecords(s, 0, tails.data() + begin, uint32_t(end - begin));
         });
         std::vector<Segment>().swap(tails);
     }
@@ -93,11 +92,24 @@ double TrackedPaths::reach(const Record& r) const {
     return r.triangle != kNoTriangle ? double(r.length) + double(extension_) : std::numeric_limits<double>::infinity();
 }
 
+void TrackedPaths::writeRecords(uint32_t s, uint32_t at, const Segment* from, uint32_t count) {
+    if (count == 0) return;
+    Record* records = &store_.at<0>(s, at);
+    for (uint32_t j = 0; j < count; ++j) records[j] = recordOf(from[j]);
+    if (!source_->anyVaries()) return;
+    HitPoint* hits = &store_.at<1>(s, at);
+    for (uint32_t j = 0; j < count; ++j) hits[j] = {from[j].b1, from[j].b2};
+}
+
 void TrackedPaths::decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) const {
     const Record* records = store_.column<0>() + store_.slot(s).begin;
+    const HitPoint* hits = source_->anyVaries() ? store_.column<1>() + store_.slot(s).begin : nullptr;
     Vec3f power = power_[s];
     for (uint32_t j = 0; j < to; ++j) {
-        if (j) power = source_->powerAfter(power, records[j - 1].triangle);
+        if (j) {
+            const HitPoint at = hits ? hits[j - 1] : HitPoint{0, 0};
+            power = PhotonSource::powerAfter(power, source_->surfaceAt(records[j - 1].triangle, at[0], at[1]));
+        }
         if (j < from) continue;
         const Record& r = records[j];
         Segment& x = *out++;
@@ -109,6 +121,9 @@ void TrackedPaths::decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) 
         x.path = pathOf_[s];
         x.bounce = uint16_t(firstBounce_[s] + j);
         x.impactDynamic = r.triangle != kNoTriangle ? source_->surface(r.triangle).dynamic : 0;
+        x.impactVaries = r.triangle != kNoTriangle ? source_->surface(r.triangle).varies : 0;
+        x.b1 = x.impactVaries ? hits[j][0] : 0.0f;
+        x.b2 = x.impactVaries ? hits[j][1] : 0.0f;
     }
 }
 
@@ -320,8 +335,7 @@ void TrackedPaths::commit(const std::vector<AffectedPath>& affected, const NewTa
     tbb::parallel_for(tbb::blocked_range<size_t>(0, affected.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) {
             const auto tail = tails.runOf(i).segments.begin() + tails.first(i);
-            Record* records = &store_.at<0>(affected[i].slot, keepOf(i));
-            for (uint32_t j = 0; j < tails.length(i); ++j) records[j] = recordOf(tail[j]);
+            writeRecords(affected[i].slot, keepOf(i), &*tail, tails.length(i));
             std::copy_n(tail, tails.length(i), changes.added.begin() + int64_t(addedAt[i]));
         }
     });

@@ -12,6 +12,7 @@
 // and the triangle. Segments are handed out decoded.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -99,6 +100,11 @@ private:
         uint32_t triangle;
     };
     static Record recordOf(const Segment& s) { return {s.origin, s.direction, s.length, s.triangle}; }
+    // Where an impact on a triangle whose albedo varies took place (Segment::b1, b2): a column
+    // switched on only when the scene has such triangles.
+    using HitPoint = std::array<float, 2>;
+    // Writes tail segments [from, from + count) as slot s's records from place `at` on.
+    void writeRecords(uint32_t s, uint32_t at, const Segment* from, uint32_t count);
     // Slot s's segments at places [from, to), decoded into out[0, to − from).
     void decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) const;
     bool isLive(const SegmentRef& r) const { return store_.isLive(r.slot, r.place, r.generation); }
@@ -123,7 +129,7 @@ private:
     std::shared_ptr<const PhotonSource> source_;
     float extension_;
     uint32_t generations_;  // as asked; the store's limit is also bounded by the layout
-    SlottedPathStore<Record> store_;
+    SlottedPathStore<Record, HitPoint> store_;
     // Per slot: the path, the bounce of its first tracked segment, and that segment's power.
     std::vector<uint32_t> pathOf_;  // increasing
     std::vector<uint16_t> firstBounce_;

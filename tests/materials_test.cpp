@@ -1,0 +1,378 @@
+// Surfaces as the asset says (issue 57, docs/inputs.md): albedo per texel and per vertex colour,
+// alpha-MASK cut-outs and BLEND, through every ray (Embree's filters) and every bounce (the photon
+// records keep where a varying surface was hit). Expected values are worked out here from the
+// scene's own numbers; tolerances from the statistics of each estimate.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "estimate/direct_light.h"
+#include "estimate/vertex_starts.h"
+#include "pipeline/frame_solver.h"
+#include "scene/emission_pieces.h"
+#include "scene/surface_lookup.h"
+#include "test_support.h"
+#include "trace/light_sampler.h"
+#include "trace/photon_source.h"
+#include "trace/photon_tracer.h"
+#include "trace/scene_bvh.h"
+
+using namespace qsgi;
+
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+
+// A horizontal card `height` above the floor of plateUnderSheet, facing up, textured by a
+// width x height RGBA checker whose texel (x, y) is opaque where `opaque(x, y)`.
+struct CardScene {
+    Scene scene;
+    float half;  // the card's half size
+    int texels;  // per side
+};
+
+CardScene cardOverFloor(AlphaMode mode, float alpha, int texels, bool (*opaque)(int, int)) {
+    CardScene c{testscenes::plateUnderSheet(1.0f, 37, 0.8f, 8, 0.5f, true, Vec3f(0.5f)), 0.8f, texels};
+    Material card;
+    card.albedo = Vec3f(0.5f);
+    card.alpha = alpha;
+    card.alphaMode = mode;
+    card.doubleSided = true;
+    std::vector<uint8_t> rgba;
+    for (int y = 0; y < texels; ++y)
+        for (int x = 0; x < texels; ++x) rgba.insert(rgba.end(), {128, 128, 128, uint8_t(opaque(x, y) ? 255 : 0)});
+    const uint32_t m = testscenes::addTexturedMaterial(c.scene, card, texels, texels, rgba);
+    testscenes::paintInstance(c.scene, 1, m, 0, 2, Vec3f(-c.half, 0, -c.half), 2 * c.half);
+    PunctualLight sun;
+    sun.type = LightType::Directional;
+    sun.direction = Vec3f(0, -1, 0);
+    sun.intensity = Vec3f(2.0f);
+    c.scene.lights.push_back(sun);
+    return c;
+}
+
+bool quarterOpaque(int x, int y) { return (x + 2 * y) % 4 == 0; }  // 4 of 16 texels, one in each row
+bool allOpaque(int, int) { return true; }
+
+}  // namespace
+
+// Inside a closed sphere (R = 1, I = 1 W/sr at the centre) whose albedo is a texture: ρ₁ on the
+// half x < 0, ρ₂ on x ≥ 0 (a 2 x 1 NEAREST texture projected along x, so its seam is the plane
+// x = 0, which halves the icosphere's area by its symmetry). A sphere's form factor to any patch
+// is its area over 4πR², so the irradiance stays uniform however the albedo varies, and
+// E = E_d / (1 − ρ̄) with ρ̄ = (ρ₁ + ρ₂)/2, the albedo's mean over the surface: what holds only if
+// photons bounce with the albedo at their hit and gather rays read the albedo at theirs (a mean
+// colour per material would give it too, but the per-vertex check below would not: see the
+// mesh-exact formula of FinalGather.ClosedSphereTwoPassGivesTheAnalyticIrradiance, which this
+// one follows with ρ̄ for ρ).
+//
+// Noise: a gather ray returns ρ(hit)(D + I)(hit), two values ρ₁·2 and ρ₂·2 W/m² apart by
+// 2|ρ₂ − ρ₁| = 1.2, a standard deviation of 0.6 per ray; over M = 256 rays at most 0.6/16 = 0.0375
+// W/m², 1.9 % of E (the scrambled Sobol directions do better). The vertices' RMS is allowed three
+// times that; their mean, over n ≈ 10⁴ independent vertices, 3 × 1.9 %/√n + the photons' 0.1 %.
+// Textured per vertex too: the radiosity of each vertex is its own texel's albedo × E.
+TEST(Materials, AClosedSphereWithATexturedAlbedoGivesEdOverOneMinusTheMeanAlbedo) {
+    const auto start = std::chrono::steady_clock::now();
+    const uint8_t dark = 124, light = 231;  // sRGB bytes: ρ ≈ 0.202 and 0.799
+    const double rho1 = srgbToLinear(dark / 255.0), rho2 = srgbToLinear(light / 255.0), rho = (rho1 + rho2) / 2;
+    const double I = 1.0;
+    Scene scene = testscenes::closedSphere(1.0f, 5, Vec3f(1.0f));
+    Material textured;
+    textured.albedo = Vec3f(1.0f);
+    const uint32_t m = testscenes::addTexturedMaterial(scene, textured, 2, 1, {dark, dark, dark, 255, light, light, light, 255});
+    // s = (x + 2)/4 lies in [1/4, 3/4]: the seam at x = 0 and no wrap-around at the poles.
+    testscenes::paintInstance(scene, 0, m, 0, 1, Vec3f(-2.0f), 4.0f);
+    testscenes::addPointLight(scene, Vec3f(0.0f), Vec3f(float(I)));
+    const EmbreeDevice device;
+    FrameSolverSettings s;
+    s.estimator.kind = EstimatorKind::ImpactCount;
+    s.trace = TraceSettings{300000, 5, 32, EmissionAim{}, PhotonSampling{}};
+    s.lighting.direct = DirectLighting::Exact;
+    s.lighting.gatherRays = 256;
+    s.update.fullRecompute = true;
+    FrameSolver solver(scene, device, s);
+    FrameTiming stats;
+    const VertexRadiosity solution = solver.solve(scene.restPose(), stats);
+    const std::vector<Vec3f>& E = solution.irradiance;
+    const size_t n = scene.vertexCount();
+    double area = 0;
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t) area += scene.triangleArea(t);
+    const double indirect = 4 * M_PI * I * rho / ((1 - rho) * area);
+    std::vector<double> D(n);
+    double meanD = 0;
+    for (uint32_t v = 0; v < n; ++v) {
+        const Vec3d p(scene.positions[v]);
+        const double d2 = dot(p, p);
+        D[v] = I * dot(Vec3d(scene.normals[v]), -p / std::sqrt(d2)) / d2;
+        meanD += D[v] / double(n);
+    }
+    double sum2 = 0, mean = 0;
+    for (uint32_t v = 0; v < n; ++v) {
+        const double exact = D[v] + rho * (meanD + indirect);
+        const double e = double(E[v].y) / exact - 1;
+        sum2 += e * e;
+        mean += e / double(n);
+        // The vertex's own albedo: the texel its UV falls in (NEAREST).
+        const double own = scene.vertexTexCoords[0][v].s * 2 >= 1 ? rho2 : rho1;
+        ASSERT_NEAR(double(solution.radiosity[v].y), own * double(E[v].y), 1e-5 * double(E[v].y))
+            << "vertex " << v;
+    }
+    const double rms = std::sqrt(sum2 / double(n)), perVertex = 0.6 / 16 / 2;
+    std::printf("textured sphere: %zu vertices, rho %.4f / %.4f (mean %.4f), E/Ed ideal %.4f; vs mesh exact: RMS %.3f %%, "
+                "mean %+.3f %%; %.1f s\n",
+                n, rho1, rho2, rho, 1 / (1 - rho), 100 * rms, 100 * mean, seconds(start));
+    EXPECT_LT(rms, 3 * perVertex);
+    EXPECT_LT(std::abs(mean), 3 * perVertex / std::sqrt(double(n)) + 0.001);
+    // And not what a mean colour per material would give at the vertices: the two halves' own
+    // radiosities differ by ρ₂/ρ₁ ≈ 4 (checked per vertex above).
+}
+
+// Exact direct light from a sun straight overhead through an alpha-MASK checker card (a quarter of
+// its texels opaque, NEAREST): a floor vertex is lit, E = 2 W/m², exactly where the vertical
+// through it meets a cut-out texel, and 0 where it meets an opaque one, so the floor's mean under
+// the card is (1 − c)·E with c the card's coverage, up to which texels the floor's grid samples
+// (printed). The same card OPAQUE shades the whole footprint.
+TEST(Materials, AMaskCheckerCardLetsTheSunThroughItsCutOutTexelsOnly) {
+    for (const AlphaMode mode : {AlphaMode::Mask, AlphaMode::Opaque}) {
+        const CardScene c = cardOverFloor(mode, 1.0f, 4, quarterOpaque);
+        const SecondPassRig rig(c.scene);
+        DirectLight direct(4, 7);
+        direct.computeAll(c.scene, rig.bvh, rig.starts);
+        const MeshInstance& floor = c.scene.instances[0];
+        size_t under = 0, lit = 0, checked = 0;
+        for (uint32_t v = floor.firstVertex; v < floor.firstVertex + floor.vertexCount; ++v) {
+            const Vec3f p = c.scene.positions[v];
+            const double s = (p.x + c.half) / (2 * c.half) * c.texels, t = (p.z + c.half) / (2 * c.half) * c.texels;
+            const bool inside = s > 0 && s < c.texels && t > 0 && t < c.texels;
+            // A vertex within a hair of a texel's edge could fall either way: left out.
+            if (std::abs(s - std::round(s)) < 1e-3 || std::abs(t - std::round(t)) < 1e-3) continue;
+            ++checked;
+            const bool shaded = inside && (mode == AlphaMode::Opaque || quarterOpaque(int(s), int(t)));
+            const float e = direct.irradiance()[v].y;
+            EXPECT_EQ(e, shaded ? 0.0f : 2.0f) << "floor vertex at (" << p.x << ", " << p.z << ")";
+            if (inside) ++under, lit += e > 0;
+        }
+        std::printf("%s card: %zu floor vertices checked, %zu under the card, lit share %.4f (1 - coverage: %.2f)\n",
+                    mode == AlphaMode::Mask ? "MASK" : "OPAQUE", checked, under, double(lit) / double(under),
+                    mode == AlphaMode::Mask ? 0.75 : 0.0);
+        ASSERT_GT(under, 500u);
+    }
+}
+
+// BLEND of alpha α = 0.3: each shadow ray passes with probability 1 − α, decided once by a hash of
+// the ray and the card's triangle. One ray per vertex from a directional light, so the share of
+// the card's N floor vertices that are lit is binomial: (1 − α) within 4 √(α(1 − α)/N). And each
+// vertex decides the same way every time (a second solve gives the same bits).
+TEST(Materials, ABlendCardPassesItsShareOfTheSunsRays) {
+    const float alpha = 0.3f;
+    const CardScene c = cardOverFloor(AlphaMode::Blend, alpha, 1, allOpaque);
+    const SecondPassRig rig(c.scene);
+    DirectLight direct(4, 7), again(4, 7);
+    direct.computeAll(c.scene, rig.bvh, rig.starts);
+    again.computeAll(c.scene, rig.bvh, rig.starts);
+    const MeshInstance& floor = c.scene.instances[0];
+    size_t under = 0, lit = 0;
+    for (uint32_t v = floor.firstVertex; v < floor.firstVertex + floor.vertexCount; ++v) {
+        const Vec3f p = c.scene.positions[v];
+        ASSERT_EQ(direct.irradiance()[v].y, again.irradiance()[v].y);
+        if (std::abs(p.x) >= c.half - 1e-3f || std::abs(p.z) >= c.half - 1e-3f) continue;
+        const float e = direct.irradiance()[v].y;
+        ASSERT_TRUE(e == 0.0f || e == 2.0f) << e;
+        ++under, lit += e > 0;
+    }
+    const double share = double(lit) / double(under), sigma = std::sqrt(alpha * (1 - alpha) / double(under));
+    std::printf("BLEND card (alpha %.1f): %zu vertices under it, lit share %.4f (expected %.2f, sigma %.4f)\n", alpha, under,
+                share, 1 - alpha, sigma);
+    EXPECT_NEAR(share, 1 - alpha, 4 * sigma);
+}
+
+// Photons go through the cut-outs too: of the sun's photons that reach the card's footprint, the
+// share whose first impact is the floor (through a cut-out texel) rather than the card is
+// 1 − c = 3/4 within 4 binomial standard deviations; and every first impact on the card lies in an
+// opaque texel.
+TEST(Materials, PhotonsPassThroughTheCutOutTexelsAndLandOnlyOnOpaqueOnes) {
+    const CardScene c = cardOverFloor(AlphaMode::Mask, 1.0f, 4, quarterOpaque);
+    const EmbreeDevice device;
+    const SceneBvh bvh(device, c.scene);
+    TraceSettings settings;
+    settings.photons = 40000;
+    const PhotonTracer tracer(c.scene, bvh, settings);
+    const RayCache cache = tracer.traceAll();
+    const MeshInstance& card = c.scene.instances[1];
+    size_t onCard = 0, onFloor = 0;
+    cache.forEachSegment([&](const Segment& s) {
+        if (s.bounce != 0 || !s.hasImpact()) return;
+        const Vec3f p = s.impactPoint();
+        if (std::abs(p.x) >= c.half || std::abs(p.z) >= c.half) return;
+        if (s.triangle >= card.firstTriangle && s.triangle < card.firstTriangle + card.triangleCount) {
+            ++onCard;
+            const double u = (p.x + c.half) / (2 * c.half) * c.texels, w = (p.z + c.half) / (2 * c.half) * c.texels;
+            EXPECT_TRUE(quarterOpaque(int(u), int(w)) || std::abs(u - std::round(u)) < 1e-4 || std::abs(w - std::round(w)) < 1e-4)
+                << "a photon landed on a cut-out texel at (" << p.x << ", " << p.z << ")";
+        } else {
+            ++onFloor;
+        }
+    });
+    const double n = double(onCard + onFloor), share = double(onFloor) / n, sigma = std::sqrt(0.75 * 0.25 / n);
+    std::printf("photons over the card: %.0f, through it %.4f (expected 0.75, sigma %.4f)\n", n, share, sigma);
+    ASSERT_GT(n, 1000);
+    EXPECT_NEAR(share, 0.75, 4 * sigma);
+}
+
+// The ray cache keeps where photons hit a textured surface, so its decoded segments carry the
+// powers the tracer computed with the texel's albedo, to the bit (and a path decoded alone, too).
+TEST(Materials, TheRayCacheDecodesTexturedBouncesToTheTracersBits) {
+    Scene scene = testscenes::closedBox(8);
+    Material m;
+    const uint32_t textured = testscenes::addTexturedMaterial(
+        scene, m, 3, 2, {250, 30, 30, 255, 30, 250, 30, 255, 30, 30, 250, 255, 200, 200, 200, 255, 90, 90, 90, 255, 10, 10, 10, 255},
+        false);
+    testscenes::paintInstance(scene, 0, textured, 0, 2, Vec3f(-1.0f), 2.0f);
+    scene.vertexColours.assign(scene.vertexCount(), Rgba{1, 1, 1, 1});
+    for (uint32_t v = 0; v < scene.vertexCount(); v += 3) scene.vertexColours[v] = {0.4f, 0.9f, 0.7f, 1};
+    testscenes::addPointLight(scene, Vec3f(0.1f, 0.5f, -0.2f), Vec3f(5.0f));
+    const EmbreeDevice device;
+    const SceneBvh bvh(device, scene);
+    TraceSettings settings;
+    settings.photons = 5000;
+    settings.maxBounces = 6;
+    const PhotonTracer tracer(scene, bvh, settings);
+    const RayCache cache = tracer.traceAll();
+    const std::vector<Segment> decoded = cache.decodeAll();
+    std::vector<Segment> traced, alone;
+    size_t varying = 0;
+    for (uint64_t p = 0; p < settings.photons; ++p) tracer.tracePath(p, traced);
+    ASSERT_EQ(traced.size(), decoded.size());
+    for (size_t i = 0; i < traced.size(); ++i) {
+        const Segment &a = traced[i], &b = decoded[i];
+        ASSERT_EQ(a.power.x, b.power.x) << i;
+        ASSERT_EQ(a.power.y, b.power.y) << i;
+        ASSERT_EQ(a.power.z, b.power.z) << i;
+        ASSERT_EQ(a.triangle, b.triangle) << i;
+        ASSERT_EQ(a.impactVaries, b.impactVaries) << i;
+        ASSERT_EQ(a.b1, b.b1) << i;
+        ASSERT_EQ(a.b2, b.b2) << i;
+        varying += a.impactVaries;
+    }
+    cache.appendPath(1234, alone);
+    std::vector<Segment> one;
+    tracer.tracePath(1234, one);
+    ASSERT_EQ(alone.size(), one.size());
+    for (size_t i = 0; i < one.size(); ++i) ASSERT_EQ(alone[i].power.y, one[i].power.y);
+    EXPECT_GT(varying, traced.size() / 10);  // the textured wall was hit, often
+}
+
+// SurfaceLookup against the rule written out: factor × texel (sRGB-decoded, NEAREST or bilinear,
+// KHR_texture_transform, wrap modes) × interpolated vertex colour; MASK compares alpha with the
+// cutoff; OPAQUE ignores alpha.
+TEST(Materials, TheSurfaceLookupFollowsTheRuleAtEveryPoint) {
+    Scene scene = testscenes::plane(1.0f, 1, Vec3f(0.5f));
+    Material m;
+    m.albedo = Vec3f(0.5f, 1.0f, 0.8f);
+    m.alpha = 0.9f;
+    m.alphaMode = AlphaMode::Mask;
+    m.alphaCutoff = 0.5f;
+    // 2 x 2: red opaque, green half, blue clear, white opaque.
+    const uint32_t id = testscenes::addTexturedMaterial(scene, m, 2, 2,
+                                                        {255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 255, 255, 255, 255});
+    testscenes::paintInstance(scene, 0, id, 0, 2, Vec3f(-1.0f), 2.0f);
+    scene.vertexColours.assign(scene.vertexCount(), Rgba{1, 1, 1, 1});
+    scene.vertexColours[scene.triangles[0].v[1]] = {0.0f, 0.5f, 1.0f, 1.0f};
+    const SurfaceLookup lookup(scene);
+    ASSERT_TRUE(lookup.any());
+    ASSERT_TRUE(lookup.varies(0));
+    const Triangle& t = scene.triangles[0];
+    for (const auto& [b1, b2] : {std::pair{0.1f, 0.2f}, {0.6f, 0.3f}, {0.05f, 0.9f}, {0.33f, 0.33f}}) {
+        const float b0 = 1 - b1 - b2;
+        TexCoord uv{0, 0};
+        Rgba colour{0, 0, 0, 0};
+        for (int k = 0; k < 3; ++k) {
+            const float w = k == 0 ? b0 : k == 1 ? b1 : b2;
+            uv.s += w * scene.vertexTexCoords[0][t.v[k]].s;
+            uv.t += w * scene.vertexTexCoords[0][t.v[k]].t;
+            for (size_t c = 0; c < 4; ++c) colour[c] += w * scene.vertexColours[t.v[k]][c];
+        }
+        const int x = std::clamp(int(std::floor(uv.s * 2)), 0, 1), y = std::clamp(int(std::floor(uv.t * 2)), 0, 1);
+        const uint8_t* texel = &(*scene.textures)[0].image->rgba[size_t(4 * (2 * y + x))];
+        const Rgba got = lookup.baseColour(0, b1, b2);
+        for (size_t c = 0; c < 3; ++c)
+            EXPECT_NEAR(got[c], scene.materials[id].albedo[int(c)] * srgbToLinear(texel[c] / 255.0) * colour[c], 1e-5)
+                << "channel " << c << " at " << b1 << ", " << b2;
+        const double alpha = 0.9 * texel[3] / 255.0 * colour[3];
+        EXPECT_NEAR(got[3], alpha, 1e-5);
+        EXPECT_EQ(lookup.stops(0, b1, b2, 0.99f), alpha >= 0.5);
+    }
+    // Wrap modes: repeat, mirrored repeat and clamp, one texel past each edge.
+    Texture tex = (*scene.textures)[0];
+    const auto red = [&](float s, float u) { return tex.sample({s, u}, false)[0] > 0.5f; };
+    EXPECT_TRUE(red(0.25f, 0.25f));
+    EXPECT_FALSE(red(1.25f + 0.5f, 0.25f));  // repeat: (0.75, 0.25), green
+    tex.wrapS = TextureWrap::MirroredRepeat;
+    EXPECT_TRUE(red(1.75f, 0.25f));  // mirrored: 1.75 -> 0.25
+    tex.wrapS = TextureWrap::ClampToEdge;
+    EXPECT_TRUE(red(-3.0f, 0.25f));
+    EXPECT_FALSE(red(3.0f, 0.25f));
+    // KHR_texture_transform: an offset of half the texture moves red to where green was.
+    UvTransform shift;
+    shift.offset[0] = 0.5f;
+    const TexCoord moved = shift.apply({0.25f, 0.25f});
+    EXPECT_NEAR(moved.s, 0.75f, 1e-6);
+    UvTransform turn;
+    turn.rotation = float(M_PI / 2);
+    const TexCoord turned = turn.apply({1.0f, 0.0f});
+    EXPECT_NEAR(turned.s, 0.0f, 1e-6);  // the extension's own matrix: (1, 0) turns to (0, 1)
+    EXPECT_NEAR(turned.t, 1.0f, 1e-6);
+    // OPAQUE: alpha is 1 whatever the texture says, and every ray stops.
+    scene.materials[id].alphaMode = AlphaMode::Opaque;
+    const SurfaceLookup opaque(scene);
+    EXPECT_EQ(opaque.baseColour(0, 0.6f, 0.3f)[3], 1.0f);
+    EXPECT_FALSE(opaque.letsLightThrough(0));
+}
+
+// Emission per texel: a 2 m quad (3 x 3 cells, so its triangles cut across texels) whose emissive
+// texture (4 x 4, NEAREST) is black but for one white texel, a 0.5 m square of it. Its emitters
+// hold exactly the texel's power, π L_e · 0.25 m² (the pieces cut along the texel grid, so the
+// integral is exact but for float roundings), and every photon starts inside the texel's
+// footprint; the vertices' own radiance is the texel under each.
+TEST(Materials, AnEmissiveTextureEmitsFromItsBrightTexelAlone) {
+    Scene scene = testscenes::plane(1.0f, 3, Vec3f(0.5f));
+    std::vector<uint8_t> rgba(4 * 4 * 4, 0);
+    for (size_t i = 3; i < rgba.size(); i += 4) rgba[i] = 255;
+    const int brightX = 2, brightY = 1;
+    for (size_t c = 0; c < 3; ++c) rgba[size_t(4 * (4 * brightY + brightX)) + c] = 255;
+    const uint32_t id = testscenes::addTexturedMaterial(scene, Material("screen", Vec3f(0.5f)), 4, 4, rgba);
+    Material& screen = scene.materials[id];
+    screen.emissive = screen.baseColour;
+    screen.baseColour = TextureSlot();
+    screen.emission = Vec3f(2.0f, 1.0f, 0.5f);
+    testscenes::paintInstance(scene, 0, id, 0, 2, Vec3f(-1.0f), 2.0f);
+    const LightSampler lights(scene, 20000, scene.sceneEpsilon());
+    const Vec3f power = lights.emissiveTrianglePower();
+    const double footprint = 0.5 * 0.5;
+    EXPECT_NEAR(power.x, M_PI * 2.0 * footprint, 1e-5);
+    EXPECT_NEAR(power.y, M_PI * 1.0 * footprint, 1e-5);
+    EXPECT_NEAR(power.z, M_PI * 0.5 * footprint, 1e-5);
+    const PhotonSource source(scene, 20000, 3, 1e-6f, EmissionAim{}, PhotonSampling{});
+    const float x0 = -1 + 2.0f * brightX / 4, z0 = -1 + 2.0f * brightY / 4;
+    for (uint64_t p = 0; p < 20000; ++p) {
+        const PhotonEmission e = source.emission(p);
+        ASSERT_GE(e.origin.x, x0 - 1e-5f) << p;
+        ASSERT_LE(e.origin.x, x0 + 0.5f + 1e-5f) << p;
+        ASSERT_GE(e.origin.z, z0 - 1e-5f) << p;
+        ASSERT_LE(e.origin.z, z0 + 0.5f + 1e-5f) << p;
+    }
+    // A vertex's own radiance: the texel its UV falls in (NEAREST), so black but where a vertex
+    // lies inside the bright texel's footprint.
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
+        const TexCoord uv = scene.vertexTexCoords[0][v];
+        const bool bright = int(std::floor(uv.s * 4)) == brightX && int(std::floor(uv.t * 4)) == brightY;
+        EXPECT_EQ(vertexEmission(scene, v).x, bright ? 2.0f : 0.0f) << "vertex " << v;
+    }
+}
