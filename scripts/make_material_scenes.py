@@ -66,6 +66,7 @@ Writes OUT_DIR/NAME.gltf, NAME.bin and NAME_*.png for each scene (all of them wi
 Deterministic: the same arguments give the same bytes.
 """
 import argparse
+import math
 import os
 import struct
 import sys
@@ -451,6 +452,42 @@ def materials_room(b):
     b.camera([-1.5, 1.8, 1.5], [0.6, 0.5, -0.8])
 
 
+def foliage(b, cards=3000, seed=7):
+    """The benchmark's foliage (issue 57): `cards` double-sided alpha-MASK leaf cards (a 0.2 m quad
+    whose 16 x 16 texture is an opaque disc, 0.79 of it; the rest cut out), scattered with random
+    orientations over a 4 x 4 m ground at 0.3..2.3 m, under `--sky 1,1,1`. Written only when named
+    (it is not one of the checks)."""
+    import random
+    rng = random.Random(seed)
+    leaf = [[(60, 140, 50, 255 if (i - 7.5) ** 2 + (j - 7.5) ** 2 <= 64 else 0) for i in range(16)] for j in range(16)]
+    texture = b.texture("leaf", 16, 16, leaf, 4)
+    material = b.material("Leaf", [1.0, 1.0, 1.0], base_texture=texture, alpha_mode="MASK", cutoff=0.5, double_sided=True)
+    ground = b.material("Ground", [0.5, 0.5, 0.5])
+    b.mesh("Ground", [quad([-2, 0, 2], [4, 0, 0], [0, 0, -4], 20)], ground)
+    parts = []
+    for _ in range(cards):
+        centre = [rng.uniform(-1.8, 1.8), rng.uniform(0.3, 2.3), rng.uniform(-1.8, 1.8)]
+        # Two random perpendicular edges of 0.2 m.
+        while True:
+            a = [rng.gauss(0, 1) for _ in range(3)]
+            norm = math.sqrt(sum(x * x for x in a))
+            if norm > 1e-3:
+                break
+        a = [x / norm for x in a]
+        helper = [0.0, 1.0, 0.0] if abs(a[1]) < 0.9 else [1.0, 0.0, 0.0]
+        c = [a[1] * helper[2] - a[2] * helper[1], a[2] * helper[0] - a[0] * helper[2], a[0] * helper[1] - a[1] * helper[0]]
+        norm = math.sqrt(sum(x * x for x in c))
+        c = [x / norm for x in c]
+        u = [0.2 * x for x in a]
+        v = [0.2 * x for x in c]
+        corner = [centre[k] - (u[k] + v[k]) / 2 for k in range(3)]
+        parts.append(quad(corner, u, v, 1))
+    b.mesh("Leaves", parts, material)
+    b.camera([3.0, 2.0, 3.0], [0.0, 1.0, 0.0])
+
+
+BENCHES = ["foliage"]
+
 BUILDERS = {
     "textured_floor": textured_floor,
     "vertex_colour": vertex_colour,
@@ -464,6 +501,7 @@ BUILDERS = {
     "card_room_nocard": lambda b: alpha_mask(b, None),
     "glass_window_open": lambda b: glass_window(b, pane=False),
     "emissive_texture_factors": lambda b: emissive_texture(b, twin=True),
+    "foliage": foliage,
 }
 
 
@@ -477,6 +515,7 @@ def main():
     if args.list:
         print("\n".join(SCENES))
         print("\n".join("%s (--twins)" % t for t in TWINS))
+        print("\n".join("%s (when named: a benchmark)" % t for t in BENCHES))
         return
     if not args.out_dir:
         ap.error("OUT_DIR is required")

@@ -239,8 +239,9 @@ TEST(Incremental, ASheetSlidingAHairOverAPlateEqualsFull) {
 }
 
 // Surfaces as an asset gives them (issue 57): the cube a mover with a textured albedo, vertex
-// colours and an alpha-MASK checker cut out of it (so photons, shadow and gather rays pass through
-// its holes), the floor textured red and blue by halves; the hits' albedo is looked up per texel
+// colours, an alpha-MASK checker cut out of it (so photons, shadow and gather rays pass through
+// its holes) and a transmission of 0.3 (they pass its panes too), the floor textured red and blue
+// by halves; the hits' albedo is looked up per texel
 // on both, in the first trace, in every retrace and in the decoded records alike. Every estimator
 // kind, with the paper's method and with exact direct light and a gather.
 TEST(Incremental, ATexturedCutOutMoverEqualsFull) {
@@ -257,6 +258,7 @@ TEST(Incremental, ATexturedCutOutMoverEqualsFull) {
                               // The cube: a 4 x 4 checker, its dark cells cut out (alpha 0).
                               Material cube;
                               cube.alphaMode = AlphaMode::Mask;
+                              cube.transmission = 0.3f;  // and a pane: photons, shadow and gather rays pass its share
                               std::vector<uint8_t> checker;
                               for (int y = 0; y < 4; ++y)
                                   for (int x = 0; x < 4; ++x) {

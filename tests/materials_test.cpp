@@ -4,6 +4,8 @@
 // scene's own numbers; tolerances from the statistics of each estimate.
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +15,7 @@
 #include "estimate/vertex_starts.h"
 #include "pipeline/frame_solver.h"
 #include "scene/emission_pieces.h"
+#include "scene/gltf_loader.h"
 #include "scene/surface_lookup.h"
 #include "test_support.h"
 #include "trace/light_sampler.h"
@@ -21,6 +24,7 @@
 #include "trace/scene_bvh.h"
 
 using namespace qsgi;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -375,4 +379,134 @@ TEST(Materials, AnEmissiveTextureEmitsFromItsBrightTexelAlone) {
         const bool bright = int(std::floor(uv.s * 4)) == brightX && int(std::floor(uv.t * 4)) == brightY;
         EXPECT_EQ(vertexEmission(scene, v).x, bright ? 2.0f : 0.0f) << "vertex " << v;
     }
+}
+
+// A thin pane (KHR_materials_transmission T = 0.6, base colour t = (0.9, 0.5, 0.3)) over the floor,
+// under a sun straight overhead: the sun's shadow rays from the floor under it bring T · t of the
+// unoccluded 2 W/m², exactly (one pane, one factor); of the photons that reach its footprint a
+// share T passes (binomial, 4 σ) carrying its power times t, and the rest stop at the pane. The
+// pane's own radiosity is what it reflects: (1 − T) t E.
+TEST(Materials, AThinPaneLetsItsShareThroughTintedByItsBaseColour) {
+    CardScene c = cardOverFloor(AlphaMode::Opaque, 1.0f, 1, allOpaque);
+    const float T = 0.6f;
+    const Vec3f tint(0.9f, 0.5f, 0.3f);
+    Material& pane = c.scene.materials.back();
+    pane.transmission = T;
+    pane.albedo = tint;
+    pane.baseColour = TextureSlot();  // the tint from the factor alone
+    const SecondPassRig rig(c.scene);
+    ASSERT_TRUE(rig.bvh.anyTransmits());
+    DirectLight direct(4, 7);
+    direct.computeAll(c.scene, rig.bvh, rig.starts);
+    const MeshInstance& floor = c.scene.instances[0];
+    size_t under = 0;
+    for (uint32_t v = floor.firstVertex; v < floor.firstVertex + floor.vertexCount; ++v) {
+        const Vec3f p = c.scene.positions[v];
+        if (std::abs(p.x) >= c.half - 1e-3f || std::abs(p.z) >= c.half - 1e-3f) continue;
+        ++under;
+        const Vec3f e = direct.irradiance()[v];
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(e[k], 2.0 * double(T) * double(tint[k]), 1e-6) << "channel " << k << " at vertex " << v;
+    }
+    EXPECT_GT(under, 500u);
+    // Photons.
+    TraceSettings settings;
+    settings.photons = 40000;
+    const PhotonTracer tracer(c.scene, rig.bvh, settings);
+    const RayCache cache = tracer.traceAll();
+    const MeshInstance& card = c.scene.instances[1];
+    auto onCard = [&](uint32_t t) { return t >= card.firstTriangle && t < card.firstTriangle + card.triangleCount; };
+    size_t arrived = 0, passed = 0;
+    std::vector<Segment> path;
+    for (uint64_t p = 0; p < settings.photons; ++p) {
+        path.clear();
+        cache.appendPath(p, path);
+        if (path.empty() || !path[0].hasImpact() || !onCard(path[0].triangle)) continue;
+        ++arrived;
+        if (path.size() < 2 || dot(path[1].direction, path[0].direction) < 0.999f) continue;  // stopped or reflected
+        ++passed;
+        for (int k = 0; k < 3; ++k) ASSERT_NEAR(path[1].power[k], path[0].power[k] * tint[k], 1e-6f * path[0].power[k]);
+    }
+    const double share = double(passed) / double(arrived), sigma = std::sqrt(T * (1 - T) / double(arrived));
+    std::printf("pane: %zu photons arrived, %.4f passed (T = %.1f, sigma %.4f)\n", arrived, share, T, sigma);
+    ASSERT_GT(arrived, 1000u);
+    EXPECT_NEAR(share, T, 4 * sigma);
+    // Its vertices' reflectance.
+    for (uint32_t v = card.firstVertex; v < card.firstVertex + card.vertexCount; ++v)
+        for (int k = 0; k < 3; ++k) EXPECT_FLOAT_EQ(vertexAlbedo(c.scene, v)[k], tint[k] * (1 - T));
+}
+
+// What the loader reads of a material (docs/inputs.md): its base colour and emissive textures
+// with their sampler, alpha mode and cutoff, doubleSided, KHR_materials_transmission, and each
+// vertex's TEXCOORD_0 and COLOR_0; a vertex's reflectance is factor × texel × colour × (1 − T).
+TEST(Materials, TheLoaderReadsTexturesVertexColoursAlphaAndTransmission) {
+    const fs::path dir = testScratchDir("materials_loader");
+    {
+        const uint8_t pixels[8] = {255, 0, 0, 255, 0, 0, 255, 64};
+        OIIO::ImageSpec spec(2, 1, 4, OIIO::TypeDesc::UINT8);
+        spec.attribute("oiio:UnassociatedAlpha", 1);
+        auto out = OIIO::ImageOutput::create((dir / "red_blue.png").string());
+        ASSERT_TRUE(out && out->open((dir / "red_blue.png").string(), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels));
+        out->close();
+    }
+    testscenes::GltfWriter w;
+    const int positions = w.accessor({0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1}, "VEC3");
+    const int normals = w.accessor({0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0}, "VEC3");
+    const int uvs = w.accessor({0.25f, 0.5f, 0.75f, 0.5f, 0.75f, 0.5f, 0.25f, 0.5f}, "VEC2");
+    const int colours = w.accessor({1, 1, 1, 0.5f, 0.5f, 0.5f, 1, 0, 1, 1, 1, 1}, "VEC3");
+    const int indices = w.indices({0, 2, 1, 0, 3, 2});
+    w.doc["meshes"] = nlohmann::json::array({{{"primitives", {{{"attributes", {{"POSITION", positions}, {"NORMAL", normals},
+                                                                               {"TEXCOORD_0", uvs}, {"COLOR_0", colours}}},
+                                                               {"indices", indices}, {"material", 0}}}}}});
+    w.doc["images"] = nlohmann::json::array({{{"uri", "red_blue.png"}}});
+    w.doc["samplers"] = nlohmann::json::array({{{"magFilter", 9728}, {"minFilter", 9728}}});
+    w.doc["textures"] = nlohmann::json::array({{{"source", 0}, {"sampler", 0}}});
+    w.doc["materials"] = nlohmann::json::array(
+        {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"baseColorFactor", {1, 1, 1, 1}}}},
+          {"emissiveFactor", {0.5, 0.5, 0.5}},
+          {"emissiveTexture", {{"index", 0}}},
+          {"alphaMode", "MASK"},
+          {"alphaCutoff", 0.3},
+          {"doubleSided", true},
+          {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 0.4}}}}}}});
+    w.doc["extensionsUsed"] = {"KHR_materials_transmission"};
+    w.node({{"name", "Quad"}, {"mesh", 0}});
+    w.doc["scenes"] = nlohmann::json::array({{{"nodes", {0}}}});
+    const fs::path path = dir / "quad.gltf";
+    w.write(path.string());
+    Warnings warnings;
+    const Scene scene = loadGltfScene(path.string(), warnings);
+    for (const std::string& m : warnings.messages) EXPECT_EQ(m.find("transmission"), std::string::npos) << m;
+    ASSERT_EQ(scene.vertexCount(), 4u);
+    const Material& m = scene.materials[scene.triangleMaterial[0]];
+    EXPECT_TRUE(m.baseColour.used());
+    EXPECT_TRUE(m.emissive.used());
+    EXPECT_EQ(m.alphaMode, AlphaMode::Mask);
+    EXPECT_FLOAT_EQ(m.alphaCutoff, 0.3f);
+    EXPECT_TRUE(m.doubleSided);
+    EXPECT_FLOAT_EQ(m.transmission, 0.4f);
+    ASSERT_EQ(scene.vertexColours.size(), 4u);
+    ASSERT_GE(scene.vertexTexCoords.size(), 1u);
+    // Vertex 1: UV (0.75, 0.5), the blue texel (NEAREST), colour 0.5 grey, 60 % reflected.
+    EXPECT_FLOAT_EQ(scene.vertexTexCoords[0][1].s, 0.75f);
+    EXPECT_FLOAT_EQ(scene.vertexColours[1][0], 0.5f);
+    const Vec3f rho = vertexAlbedo(scene, 1);
+    EXPECT_FLOAT_EQ(rho.x, 0.0f);
+    EXPECT_NEAR(rho.z, 1.0 * 0.5 * 0.6, 1e-6);
+    // Vertex 2: the same texel, magenta: red 0, blue 0.6.
+    EXPECT_NEAR(vertexAlbedo(scene, 2).z, 0.6, 1e-6);
+    // Its emission: the factor times the texel (sRGB white in blue: 1), not times its colour.
+    EXPECT_NEAR(vertexEmission(scene, 1).z, 0.5, 1e-6);
+    EXPECT_EQ(vertexEmission(scene, 1).x, 0.0f);
+    // The blue texel's alpha, 64/255 = 0.25 < 0.3: cut out there; the red one stays.
+    const SurfaceLookup lookup(scene);
+    EXPECT_TRUE(lookup.letsLightThrough(0));
+    bool cut = false, kept = false;
+    for (float b1 = 0.05f; b1 < 0.95f; b1 += 0.1f)
+        for (float b2 = 0.05f; b1 + b2 < 0.95f; b2 += 0.1f) {
+            const bool stops = lookup.stops(0, b1, b2, 0.5f);
+            (stops ? kept : cut) = true;
+        }
+    EXPECT_TRUE(cut);
+    EXPECT_TRUE(kept);
 }

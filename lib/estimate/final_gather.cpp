@@ -73,7 +73,8 @@ GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& fr
     GatherHit out;
     // From t = 0: s_v lies a float error off v's own surface (VertexStarts), and a surface
     // beside v (the wall at a floor vertex's foot) lies as near, far nearer than a ray epsilon.
-    const auto hit = bvh.intersect(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
+    // Through a pane where the ray's own choice says so (SceneBvh::intersectThroughPanes).
+    const auto hit = bvh.intersectThroughPanes(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
     if (!hit) {
         out.t = std::numeric_limits<float>::infinity();
         return out;
@@ -323,7 +324,9 @@ Vec3f FinalGather::meanOverHits(const Scene& scene, const FirstPass& firstPass, 
         const Triangle& tri = scene.triangles[h.triangle];
         const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
         const double w0 = std::max(0.0, 1.0 - w1 - w2);
-        if (irradiance && firstPass.surfaces->varies(h.triangle)) {
+        // Where the albedo varies, or at a pane: E there times the base colour at the hit (a ray
+        // stops at a pane with probability 1 − T, so it reads ρ E, not the (1 − T) ρ E it reflects).
+        if (irradiance && (firstPass.surfaces->varies(h.triangle) || firstPass.surfaces->transmits(h.triangle))) {
             const std::vector<Vec3f>& e = *irradiance;
             const Vec3d arriving = Vec3d(e[tri.v[0]]) * w0 + Vec3d(e[tri.v[1]]) * w1 + Vec3d(e[tri.v[2]]) * w2;
             sum += arriving * Vec3d(firstPass.surfaces->albedo(h.triangle, float(w1), float(w2)));

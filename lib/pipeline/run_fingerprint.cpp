@@ -83,14 +83,18 @@ RunFingerprint runFingerprint(const RenderSettings& s, const Scene& scene, const
         // What the materials read besides their factors (issue 57), only where a scene has it,
         // so that this part stays as it was for scenes of plain colour factors.
         for (const Material& m : scene.materials)
-            if (m.baseColour.used() || m.alphaMode != AlphaMode::Opaque || m.alpha != 1 || m.doubleSided) {
+            if (m.baseColour.used() || m.emissive.used() || m.transmission > 0 || m.alphaMode != AlphaMode::Opaque ||
+                m.alpha != 1 || m.doubleSided) {
                 f.addValue(m.alpha);
                 f.addValue(int(m.alphaMode));
                 f.addValue(m.alphaCutoff);
                 f.addValue(int(m.doubleSided));
-                f.addValue(m.baseColour.texture);
-                f.addValue(m.baseColour.texCoord);
-                f.addValue(m.baseColour.transform);
+                f.addValue(m.transmission);
+                for (const TextureSlot* slot : {&m.baseColour, &m.emissive, &m.transmissionTexture}) {
+                    f.addValue(slot->texture);
+                    f.addValue(slot->texCoord);
+                    f.addValue(slot->transform);
+                }
             }
         if (scene.textures)
             for (const Texture& t : *scene.textures) {

@@ -122,13 +122,15 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
         }
     if (used.empty()) lowest = highest = Vec3f(0.0f);
     // What the used materials read besides their factors (issue 57, docs/inputs.md).
-    uint64_t textured = 0, mask = 0, blend = 0, doubleSided = 0;
+    uint64_t textured = 0, mask = 0, blend = 0, doubleSided = 0, transmissive = 0, emissionTextured = 0;
     for (uint32_t m : used) {
         const Material& material = scene.materials[m];
         textured += material.baseColour.used();
         mask += material.alphaMode == AlphaMode::Mask;
         blend += material.alphaMode == AlphaMode::Blend;
         doubleSided += material.doubleSided;
+        transmissive += material.transmission > 0;
+        emissionTextured += material.isEmissive() && material.emissive.used();
     }
     uint64_t textureBytes = 0;
     if (scene.textures)
@@ -143,6 +145,8 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
                       {"alpha_mask", mask},
                       {"alpha_blend", blend},
                       {"double_sided", doubleSided},
+                      {"transmissive", transmissive},
+                      {"emission_textured", emissionTextured},
                       {"vertex_colours", !scene.vertexColours.empty()},
                       {"texture_bytes", textureBytes}};
 
@@ -266,7 +270,9 @@ std::string inspectionText(const nlohmann::json& r) {
     line("  base colour textured " + std::to_string(m["base_colour_textured"].get<uint64_t>()) + " (" +
          number(double(m["texture_bytes"].get<uint64_t>()) / (1 << 20), "%.1f") + " MiB decoded), alpha MASK " +
          std::to_string(m["alpha_mask"].get<uint64_t>()) + ", BLEND " + std::to_string(m["alpha_blend"].get<uint64_t>()) +
-         ", double-sided " + std::to_string(m["double_sided"].get<uint64_t>()) + "; vertex colours " +
+         ", double-sided " + std::to_string(m["double_sided"].get<uint64_t>()) + ", transmissive " +
+         std::to_string(m["transmissive"].get<uint64_t>()) + ", emission textured " +
+         std::to_string(m["emission_textured"].get<uint64_t>()) + "; vertex colours " +
          (m["vertex_colours"].get<bool>() ? "yes" : "no"));
     if (!r["lit"].get<bool>())
         line("lights     none: no emissive material and no light of any power; light the scene with \"lights\" in a "

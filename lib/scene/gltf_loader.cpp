@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 
 // Extensions whose meaning qsgi implements, or which cannot change the radiosity it computes.
 const std::set<std::string> kSupportedExtensions = {
-    "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_mesh_quantization",
+    "KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_mesh_quantization",
     "KHR_texture_transform"};
 
 // What the glTF 2.0 specification (§3.7.2.1, and KHR_mesh_quantization when the file requires it)
@@ -186,7 +186,7 @@ TextureSlot textureSlot(const tinygltf::TextureInfo& info, const std::string& fi
     return slot;
 }
 
-Material convertMaterial(const GltfDocument& document, const AccessorReader& reader, int index, const std::string& file,
+Material convertMaterial(const GltfDocument& document, int index, const std::string& file,
                          Warnings& warnings, std::set<int>& decodedImages, TextureImages& images,
                          std::map<int, Texture>& textures) {
     const tinygltf::Material& m = document.model.materials[index];
@@ -222,6 +222,37 @@ Material convertMaterial(const GltfDocument& document, const AccessorReader& rea
         throw InputError(file, place + ".alphaCutoff", "must be a finite number of at least 0 (glTF 2.0)");
     out.alphaCutoff = float(m.alphaCutoff);
     out.doubleSided = m.doubleSided;
+    // KHR_materials_transmission: transmissionFactor × transmissionTexture's R, in [0, 1]. qsgi
+    // reads every surface as a dielectric (metallicFactor, 1 by default, is not modelled), so the
+    // share passes in full (docs/inputs.md).
+    auto transmission = m.extensions.find("KHR_materials_transmission");
+    if (transmission != m.extensions.end()) {
+        const std::string at = place + ".extensions.KHR_materials_transmission";
+        const double factor = extensionNumber(transmission->second, "transmissionFactor", 0.0, file, at);
+        if (!(factor >= 0 && factor <= 1))
+            throw InputError(file, at + ".transmissionFactor", "must lie in [0, 1] (KHR_materials_transmission)");
+        out.transmission = float(factor);
+        if (transmission->second.Has("transmissionTexture") && factor > 0) {
+            const tinygltf::Value& info = transmission->second.Get("transmissionTexture");
+            const std::string texturePlace = at + ".transmissionTexture";
+            tinygltf::TextureInfo textureInfo;
+            textureInfo.index = info.Has("index") && info.Get("index").IsNumber() ? int(info.Get("index").GetNumberAsDouble()) : -1;
+            textureInfo.texCoord = info.Has("texCoord") && info.Get("texCoord").IsNumber() ? int(info.Get("texCoord").GetNumberAsDouble()) : 0;
+            if (info.Has("extensions") && info.Get("extensions").Has("KHR_texture_transform"))
+                textureInfo.extensions["KHR_texture_transform"] = info.Get("extensions").Get("KHR_texture_transform");
+            const TextureSlot slot = textureSlot(textureInfo, file, texturePlace);
+            auto [texture, problem] = images.texture(textureInfo.index, texturePlace, decodedImages);
+            if (texture) {
+                out.transmissionTexture = slot;
+                textures.emplace(slot.texture, std::move(*texture));
+            } else {
+                warnings.add(file + ": " + texturePlace + ": " + problem + "; using transmissionFactor alone");
+            }
+        }
+        if (factor > 0 && (m.extensions.count("KHR_materials_volume") || m.extensions.count("KHR_materials_ior")))
+            warnings.add(file + ": " + place + ": KHR_materials_volume and KHR_materials_ior are ignored (a transmissive "
+                                               "surface is a thin pane: light passes straight through)");
+    }
     if (pbr.metallicRoughnessTexture.index >= 0 || m.normalTexture.index >= 0 || m.occlusionTexture.index >= 0)
         warnings.add(file + ": metallic/roughness, normal and occlusion maps are ignored (surfaces are Lambertian)");
 
@@ -371,7 +402,7 @@ public:
         for (size_t i = 0; i < model_.materials.size(); ++i) {
             try {
                 scene.materials.push_back(
-                    convertMaterial(document_, reader_, int(i), file_, warnings_, decodedImages_, images_, textures_));
+                    convertMaterial(document_, int(i), file_, warnings_, decodedImages_, images_, textures_));
             } catch (const InputError& e) {
                 materialErrors.emplace(int(i), e);  // refused below if a rendered primitive uses it
                 scene.materials.push_back(Material{"(unusable)", Vec3f(1.0f), Vec3f(0.0f)});
@@ -458,7 +489,8 @@ private:
     void keepUsedTextures(Scene& scene) {
         auto set = std::make_shared<TextureSet>(model_.textures.size());
         for (size_t i = 0; i < scene.materials.size(); ++i)
-            for (TextureSlot* slot : {&scene.materials[i].baseColour, &scene.materials[i].emissive}) {
+            for (TextureSlot* slot :
+                 {&scene.materials[i].baseColour, &scene.materials[i].emissive, &scene.materials[i].transmissionTexture}) {
                 if (!slot->used()) continue;
                 if (!usedMaterials_.count(int(i))) {
                     *slot = TextureSlot();
@@ -870,11 +902,14 @@ private:
     void addSurfaceAttributes(Scene& scene, const tinygltf::Primitive& prim, const std::string& place,
                               const Material& material) {
         const size_t first = scene.instances.back().firstVertex, count = scene.instances.back().vertexCount;
-        for (const TextureSlot* slot : {&material.baseColour, &material.emissive}) {
+        for (const TextureSlot* slot : {&material.baseColour, &material.emissive, &material.transmissionTexture}) {
             if (!slot->used()) continue;
             const size_t set = size_t(slot->texCoord);
             const std::string name = "TEXCOORD_" + std::to_string(set);
-            const AccessorData uv = reader_.read(prim.attributes.at(name), place + ".attributes." + name, kTexcoordFormat);
+            const auto attribute = prim.attributes.find(name);
+            if (attribute == prim.attributes.end())
+                throw InputError(file_, place, "has no " + name + ", which a texture of its material reads");
+            const AccessorData uv = reader_.read(attribute->second, place + ".attributes." + name, kTexcoordFormat);
             if (scene.vertexTexCoords.size() <= set) scene.vertexTexCoords.resize(set + 1);
             std::vector<TexCoord>& into = scene.vertexTexCoords[set];
             into.resize(scene.positions.size());

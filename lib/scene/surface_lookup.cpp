@@ -40,9 +40,19 @@ Rgba baseColourAt(const Material& m, const TextureSet* textures, TexCoord uv, co
 Vec3f vertexAlbedo(const Scene& scene, uint32_t v) {
     const Material& m = scene.materials[scene.vertexMaterial[v]];
     const bool coloured = !scene.vertexColours.empty();
-    if (!coloured && !textured(m, scene.textures.get())) return m.albedo;
-    const Rgba c = baseColourAt(m, scene.textures.get(), vertexTexCoord(scene, m.baseColour, v), coloured ? scene.vertexColours[v] : kWhite);
-    return Vec3f(c[0], c[1], c[2]);
+    Vec3f albedo = m.albedo;
+    if (coloured || textured(m, scene.textures.get())) {
+        const Rgba c = baseColourAt(m, scene.textures.get(), vertexTexCoord(scene, m.baseColour, v), coloured ? scene.vertexColours[v] : kWhite);
+        albedo = Vec3f(c[0], c[1], c[2]);
+    }
+    if (!(m.transmission > 0)) return albedo;
+    float transmission = m.transmission;
+    if (readsTexture(m.transmissionTexture, scene.textures.get())) {
+        const TextureSlot& slot = m.transmissionTexture;
+        const TexCoord uv = vertexTexCoord(scene, slot, v);
+        transmission *= (*scene.textures)[size_t(slot.texture)].sample(slot.transform.identity() ? uv : slot.transform.apply(uv), false)[0];
+    }
+    return albedo * (1 - transmission);
 }
 
 SurfaceLookup::SurfaceLookup(const Scene& scene) {
@@ -50,7 +60,8 @@ SurfaceLookup::SurfaceLookup(const Scene& scene) {
     const bool coloured = !scene.vertexColours.empty();
     bool needed = coloured;
     for (const Material& m : scene.materials)
-        needed = needed || textured(m, textures) || emissionTextured(m, textures) || m.letsLightThrough();
+        needed = needed || textured(m, textures) || emissionTextured(m, textures) || m.letsLightThrough() ||
+                 m.transmission > 0;
     if (!needed) return;
     materials_ = scene.materials;
     textures_ = scene.textures;
@@ -58,12 +69,15 @@ SurfaceLookup::SurfaceLookup(const Scene& scene) {
     cornerOf_.assign(scene.triangleCount(), kUniform);
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
         const Material& m = scene.materials[scene.triangleMaterial[t]];
-        if (!coloured && !textured(m, textures) && !emissionTextured(m, textures)) continue;
+        anyTransmits_ = anyTransmits_ || m.transmission > 0;
+        const bool transmissionTextured = m.transmission > 0 && readsTexture(m.transmissionTexture, textures);
+        if (!coloured && !textured(m, textures) && !emissionTextured(m, textures) && !transmissionTextured) continue;
         Corners c;
         for (size_t k = 0; k < 3; ++k) {
             const uint32_t v = scene.triangles[t].v[k];
             c.uv[k] = vertexTexCoord(scene, m.baseColour, v);
             c.emissiveUv[k] = vertexTexCoord(scene, m.emissive, v);
+            c.transmissionUv[k] = vertexTexCoord(scene, m.transmissionTexture, v);
             c.colour[k] = coloured ? scene.vertexColours[v] : kWhite;
         }
         cornerOf_[t] = uint32_t(corners_.size());
@@ -91,6 +105,19 @@ Vec3f SurfaceLookup::emission(uint32_t t, float b1, float b2) const {
                       b0 * c.emissiveUv[0].t + b1 * c.emissiveUv[1].t + b2 * c.emissiveUv[2].t};
     const TextureSlot& slot = m.emissive;
     return emissionAt(m, textures_.get(), slot.transform.identity() ? uv : slot.transform.apply(uv));
+}
+
+float SurfaceLookup::transmission(uint32_t t, float b1, float b2) const {
+    const Material& m = materials_[triangleMaterial_[t]];
+    if (!(m.transmission > 0) || cornerOf_[t] == kUniform || !readsTexture(m.transmissionTexture, textures_.get()))
+        return m.transmission;
+    const Corners& c = corners_[cornerOf_[t]];
+    const float b0 = std::max(0.0f, 1.0f - b1 - b2);
+    const TexCoord uv{b0 * c.transmissionUv[0].s + b1 * c.transmissionUv[1].s + b2 * c.transmissionUv[2].s,
+                      b0 * c.transmissionUv[0].t + b1 * c.transmissionUv[1].t + b2 * c.transmissionUv[2].t};
+    const TextureSlot& slot = m.transmissionTexture;
+    const Rgba texel = (*textures_)[size_t(slot.texture)].sample(slot.transform.identity() ? uv : slot.transform.apply(uv), false);
+    return m.transmission * texel[0];
 }
 
 bool SurfaceLookup::stops(uint32_t t, float b1, float b2, float choice) const {

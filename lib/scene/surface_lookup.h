@@ -26,7 +26,8 @@ bool readsTexture(const TextureSlot& slot, const TextureSet* textures);
 // scene has no such set).
 TexCoord vertexTexCoord(const Scene& scene, const TextureSlot& slot, uint32_t v);
 
-// Vertex v's own albedo: its material at its UV and colour. A vertex's radiosity is ρ_v E_v.
+// Vertex v's own diffuse reflectance: its material's base colour at its UV and colour, times the
+// share 1 − T its transmission does not pass. A vertex's radiosity is this times E_v.
 Vec3f vertexAlbedo(const Scene& scene, uint32_t v);
 
 class SurfaceLookup {
@@ -38,6 +39,11 @@ public:
     bool any() const { return !cornerOf_.empty(); }
     // The albedo, alpha or emission varies over triangle t (a texture, vertex colours).
     bool varies(uint32_t t) const { return !cornerOf_.empty() && cornerOf_[t] != kUniform; }
+    // Light passes straight through triangle t in part (KHR_materials_transmission).
+    bool transmits(uint32_t t) const { return any() && materials_[triangleMaterial_[t]].transmission > 0; }
+    bool anyTransmits() const { return anyTransmits_; }
+    // The share that passes at (b1, b2): transmission × its texture's R there (linear).
+    float transmission(uint32_t t, float b1, float b2) const;
     // Rays may pass through triangle t (MASK or BLEND).
     bool letsLightThrough(uint32_t t) const { return any() && materials_[triangleMaterial_[t]].letsLightThrough(); }
 
@@ -62,6 +68,7 @@ private:
     struct Corners {
         TexCoord uv[3];          // the base colour texture's set
         TexCoord emissiveUv[3];  // the emissive texture's
+        TexCoord transmissionUv[3];
         Rgba colour[3];
     };
     std::vector<Material> materials_;
@@ -69,6 +76,7 @@ private:
     std::vector<uint32_t> triangleMaterial_;
     std::vector<uint32_t> cornerOf_;  // per triangle: its Corners, or kUniform
     std::vector<Corners> corners_;
+    bool anyTransmits_ = false;
 };
 
 }  // namespace qsgi

@@ -21,8 +21,8 @@ PhotonSource::PhotonSource(const Scene& scene, uint64_t photons, uint64_t seed, 
         const auto key = std::make_tuple(uint32_t(scene.triangleMaterial[t]), uint8_t(scene.triangleDynamic[t]), varies);
         auto [at, added] = index.emplace(key, uint32_t(surfaces_.size()));
         if (added) {
-            const Vec3f albedo = scene.materials[std::get<0>(key)].albedo;
-            surfaces_.push_back(Surface{albedo, maxComponent(albedo), std::get<1>(key), varies});
+            const Material& m = scene.materials[std::get<0>(key)];
+            surfaces_.push_back(Surface{m.albedo, maxComponent(m.albedo), std::get<1>(key), varies, m.transmission});
         }
         surfaceOf_[t] = at->second;
     }

@@ -35,6 +35,7 @@ public:
         float survival;  // Russian roulette: the albedo's largest component
         uint8_t dynamic;
         uint8_t varies;  // the albedo varies over the triangle (a texture, vertex colours)
+        float transmission = 0;  // the share that passes straight through, tinted by the albedo
     };
     const Surface& surface(uint32_t triangle) const { return surfaces_[surfaceOf_[triangle]]; }
     // The surface a photon meets at barycentrics (b1, b2) of `triangle`: its albedo there.
@@ -43,11 +44,28 @@ public:
         if (s.varies) {
             s.albedo = lookup_->albedo(triangle, b1, b2);
             s.survival = maxComponent(s.albedo);
+            if (s.transmission > 0) s.transmission = lookup_->transmission(triangle, b1, b2);
         }
         return s;
     }
-    // The power a photon carries on after surviving an impact on surface `s`.
-    static Vec3f powerAfter(const Vec3f& power, const Surface& s) { return power * s.albedo / s.survival; }
+    // What a photon does at an impact on surface `s`, from its survival number u (the one number
+    // of the bounce that decides): passes straight on (u < the transmission T: a share T passes,
+    // tinted by the albedo), is reflected diffusely (the next share (1 − T)·survival), or stops.
+    enum class Impact { Passes, Reflects, Stops };
+    static Impact impact(const Surface& s, float u) {
+        if (s.transmission > 0) {
+            if (u < s.transmission) return Impact::Passes;
+            u = (u - s.transmission) / (1 - s.transmission);
+        }
+        return u < s.survival ? Impact::Reflects : Impact::Stops;
+    }
+    // The power a photon carries on after an impact on surface `s` that it passed or was reflected
+    // at: reflected, ρ/survival (the (1 − T) of choosing to reflect cancels); passed, the tint ρ.
+    static Vec3f powerAfter(const Vec3f& power, const Surface& s, Impact what = Impact::Reflects) {
+        return what == Impact::Passes ? power * s.albedo : power * s.albedo / s.survival;
+    }
+    // Some surface lets photons through (decoding then asks each impact there what it did).
+    bool anyTransmits() const { return lookup_ && lookup_->anyTransmits(); }
     // Some triangle's albedo varies: impacts there keep where they took place.
     bool anyVaries() const { return lookup_ && lookup_->any(); }
 

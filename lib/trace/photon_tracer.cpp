@@ -71,12 +71,19 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
         if (surface.varies) s.b1 = hit->u, s.b2 = hit->v;
         append(out, s);
 
-        // Russian roulette on the albedo at the hit, then a cosine-weighted bounce on the incoming side.
-        if (!(rng.uniform(bounce + 1, kSurvival) < surface.survival)) return;
-        power = PhotonSource::powerAfter(power, surface);
+        // Straight through a pane (its share T), or Russian roulette on the albedo at the hit and
+        // a cosine-weighted bounce on the incoming side.
+        const PhotonSource::Impact what = PhotonSource::impact(surface, rng.uniform(bounce + 1, kSurvival));
+        if (what == PhotonSource::Impact::Stops) return;
+        power = PhotonSource::powerAfter(power, surface, what);
         // The hit's own normal (first traces and retraces both take it from Embree).
         Vec3f n = normalize(hit->ng);
         if (dot(n, direction) > 0) n = -n;
+        if (what == PhotonSource::Impact::Passes) {
+            origin = s.impactPoint() - n * eps;  // just past the pane, on the far side
+            tnear = 0;
+            continue;
+        }
         origin = s.impactPoint() + n * eps;
         direction = cosineHemisphere(n, rng.uniform(bounce + 1, kScatterDirection0), rng.uniform(bounce + 1, kScatterDirection1));
         tnear = 0;

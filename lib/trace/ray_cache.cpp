@@ -121,6 +121,10 @@ template <class First, class Later, class Out>
 void decodeRecords(const PhotonSource& source, uint64_t path, const First& first, const Later* later, const Later* end,
                    const std::array<float, 2>* hit, Out out) {
     const PhotonEmission e = source.emission(path);
+    // What each impact did is the tracer's decision from the path's own numbers: asked again
+    // where some surface lets photons through.
+    const bool transmits = source.anyTransmits();
+    const PathNumbers numbers = transmits ? source.numbersFor(path) : PathNumbers(0, 0);
     Segment s;
     s.origin = e.origin;
     s.direction = e.direction;
@@ -132,7 +136,9 @@ void decodeRecords(const PhotonSource& source, uint64_t path, const First& first
     placeImpact(source, s, hit);
     *out++ = s;
     for (; later != end; ++later) {
-        s.power = PhotonSource::powerAfter(s.power, source.surfaceAt(s.triangle, s.b1, s.b2));
+        const PhotonSource::Surface at = source.surfaceAt(s.triangle, s.b1, s.b2);
+        s.power = PhotonSource::powerAfter(
+            s.power, at, transmits ? PhotonSource::impact(at, numbers.uniform(s.bounce + 1u, rng_dim::kSurvival)) : PhotonSource::Impact::Reflects);
         s.origin = later->origin;
         s.direction = later->direction;
         s.length = later->length;

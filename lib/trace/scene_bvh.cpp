@@ -3,6 +3,7 @@
 #include "trace/counter_rng.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <unordered_map>
@@ -28,7 +29,7 @@ void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args) {
     }
 }
 
-float blendChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle) {
+float rayChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle, RayChoice purpose) {
     auto bits = [](float x) {
         uint32_t b;
         std::memcpy(&b, &x, sizeof b);
@@ -37,7 +38,7 @@ float blendChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle
     uint64_t h = mix64(bits(origin.x) << 32 | bits(origin.y));
     h = mix64(h ^ (bits(origin.z) << 32 | bits(direction.x)));
     h = mix64(h ^ (bits(direction.y) << 32 | bits(direction.z)));
-    h = mix64(h ^ triangle);
+    h = mix64(h ^ triangle ^ uint64_t(purpose));
     return float(h >> 40) * 0x1p-24f;
 }
 
@@ -53,7 +54,7 @@ bool stopsRay(const RTCFilterFunctionNArguments* args, unsigned i) {
     const Vec3f direction(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                           RTCRayN_dir_z(args->ray, args->N, i));
     return pass->lookup->stops(triangle, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i),
-                               blendChoice(origin, direction, triangle));
+                               rayChoice(origin, direction, triangle, RayChoice::Blend));
 }
 
 // Closest hits through surfaces that let light through: those dropped, then the tie rule.
@@ -117,9 +118,9 @@ SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     rtcSetSceneFlags(staticScene_.get(), RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneFlags(dynamicScene_.get(), RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(staticScene_.get(), RTC_BUILD_QUALITY_HIGH);
-    auto lookup = std::make_shared<const SurfaceLookup>(scene);
-    static_ = addPart(staticScene_.get(), scene, false, RTC_BUILD_QUALITY_HIGH, lookup);
-    dynamic_ = addPart(dynamicScene_.get(), scene, true, RTC_BUILD_QUALITY_REFIT, lookup);
+    surfaces_ = std::make_shared<const SurfaceLookup>(scene);
+    static_ = addPart(staticScene_.get(), scene, false, RTC_BUILD_QUALITY_HIGH, surfaces_);
+    dynamic_ = addPart(dynamicScene_.get(), scene, true, RTC_BUILD_QUALITY_REFIT, surfaces_);
     rtcCommitScene(staticScene_.get());
     rtcCommitScene(dynamicScene_.get());
     device_.checkError("building the scene BVH");
@@ -222,6 +223,32 @@ std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& 
     if (!moving) return still;
     if (!still || moving->t < still->t || (moving->t == still->t && moving->triangle < still->triangle)) return moving;
     return still;
+}
+
+std::optional<SurfaceHit> SceneBvh::intersectThroughPanes(const Vec3f& origin, const Vec3f& direction, float tnear,
+                                                          float tfar) const {
+    std::optional<SurfaceHit> hit = intersect(origin, direction, tnear, tfar);
+    for (int pane = 0; hit && surfaces_->transmits(hit->triangle) && pane < kMostPanes; ++pane) {
+        if (!(rayChoice(origin, direction, hit->triangle, RayChoice::Pane) < surfaces_->transmission(hit->triangle, hit->u, hit->v)))
+            break;
+        hit = intersect(origin, direction, std::nextafter(hit->t, std::numeric_limits<float>::infinity()), tfar);
+    }
+    return hit;
+}
+
+Vec3f SceneBvh::transmittance(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
+    if (!surfaces_->anyTransmits()) return occluded(origin, direction, tnear, tfar) ? Vec3f(0.0f) : Vec3f(1.0f);
+    Vec3f through(1.0f);
+    float from = tnear;
+    for (int pane = 0; pane <= kMostPanes; ++pane) {
+        const std::optional<SurfaceHit> hit = intersect(origin, direction, from, tfar);
+        if (!hit) return through;
+        if (!surfaces_->transmits(hit->triangle) || pane == kMostPanes) break;
+        through = through * (surfaces_->albedo(hit->triangle, hit->u, hit->v) * surfaces_->transmission(hit->triangle, hit->u, hit->v));
+        if (!(maxComponent(through) > 0)) break;
+        from = std::nextafter(hit->t, std::numeric_limits<float>::infinity());
+    }
+    return Vec3f(0.0f);
 }
 
 bool SceneBvh::occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {

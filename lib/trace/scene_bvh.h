@@ -47,8 +47,10 @@ struct PassThrough {
     std::shared_ptr<const SurfaceLookup> lookup;
     std::vector<uint32_t> sceneTriangle;  // Embree primID -> scene triangle (the part's)
 };
-// The BLEND choice in [0, 1) for a ray and a scene triangle.
-float blendChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle);
+// A ray's own choice in [0, 1) at a scene triangle, for one `purpose` (BLEND's, a pane's: two
+// independent numbers for a surface that is both).
+enum class RayChoice : uint64_t { Blend = 0, Pane = 0x9E3779B97F4A7C15ull };
+float rayChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle, RayChoice purpose);
 
 // staticGeometryRises' test of one triangle: its box comes within `radius` of `centre`, and a
 // corner lies at `height` or more above `centre` along `normal`. Shared with OwnSurfaceTree's
@@ -65,6 +67,15 @@ public:
     void updateDynamic(const Scene& scene);
 
     std::optional<SurfaceHit> intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // The closest hit, passing straight through a pane (KHR_materials_transmission) where the
+    // ray's own choice says so: with probability T at the pane (rayChoice of the ray and the
+    // pane's triangle; at most kMostPanes panes). The final gather's rays.
+    std::optional<SurfaceHit> intersectThroughPanes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // What reaches the end of the segment (tnear, tfar): 0 where an opaque surface blocks it,
+    // else the product of T × base colour of the panes it crosses, in order (1 if none). Shadow rays.
+    Vec3f transmittance(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    bool anyTransmits() const { return surfaces_->anyTransmits(); }
+    static constexpr int kMostPanes = 16;
     // True if any geometry blocks the ray within (tnear, tfar).
     bool occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // True if the static geometry alone blocks the ray within (tnear, tfar): occluded() is this
@@ -124,6 +135,7 @@ private:
                                             const Vec3f& direction, float tnear, float tfar) const;
 
     const EmbreeDevice& device_;
+    std::shared_ptr<const SurfaceLookup> surfaces_;  // what the filters and the panes read
     EmbreeScene staticScene_, dynamicScene_;
     Part static_, dynamic_;
     float rayEpsilon_ = 1e-5f;

@@ -105,10 +105,17 @@ void TrackedPaths::decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) 
     const Record* records = store_.column<0>() + store_.slot(s).begin;
     const HitPoint* hits = source_->anyVaries() ? store_.column<1>() + store_.slot(s).begin : nullptr;
     Vec3f power = power_[s];
+    // What each impact did (PhotonSource::impact) where some surface lets photons through.
+    const bool transmits = source_->anyTransmits();
+    const PathNumbers numbers = transmits ? source_->numbersFor(pathOf_[s]) : PathNumbers(0, 0);
     for (uint32_t j = 0; j < to; ++j) {
         if (j) {
             const HitPoint at = hits ? hits[j - 1] : HitPoint{0, 0};
-            power = PhotonSource::powerAfter(power, source_->surfaceAt(records[j - 1].triangle, at[0], at[1]));
+            const PhotonSource::Surface surface = source_->surfaceAt(records[j - 1].triangle, at[0], at[1]);
+            const uint32_t bounce = firstBounce_[s] + j - 1;
+            power = PhotonSource::powerAfter(
+                power, surface,
+                transmits ? PhotonSource::impact(surface, numbers.uniform(bounce + 1, rng_dim::kSurvival)) : PhotonSource::Impact::Reflects);
         }
         if (j < from) continue;
         const Record& r = records[j];

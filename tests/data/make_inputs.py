@@ -389,6 +389,26 @@ bad("gltf", "light_colour_above_one.gltf",
 bad("gltf", "base_colour_above_one.gltf",
     edited(lambda m: m.update(materials=[{"pbrMetallicRoughness": {"baseColorFactor": [1.5, 0.5, 0.5, 1]}}])
            or m["meshes"][0]["primitives"][0].update(material=0)), "baseColorFactor")
+# Materials as the asset says them (issue 57): the values glTF bounds, refused where a rendered
+# primitive uses them.
+def material_edit(material):
+    return edited(lambda m: m.update(materials=[material]) or m["meshes"][0]["primitives"][0].update(material=0))
+bad("gltf", "alpha_cutoff_negative.gltf", material_edit({"alphaMode": "MASK", "alphaCutoff": -0.5}), "alphaCutoff")
+bad("gltf", "alpha_mode_unknown.gltf", material_edit({"alphaMode": "CLIP"}), "alphaMode")
+bad("gltf", "base_colour_alpha_above_one.gltf", material_edit({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 2]}}),
+    "baseColorFactor")
+bad("gltf", "transmission_above_one.gltf",
+    edited(lambda m: m.update(materials=[{"extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.5}}}],
+                              extensionsUsed=m.get("extensionsUsed", []) + ["KHR_materials_transmission"])
+           or m["meshes"][0]["primitives"][0].update(material=0)), "transmissionFactor")
+bad("gltf", "transmission_texture_without_texcoord.gltf",
+    edited(lambda m: m.update(materials=[{"extensions": {"KHR_materials_transmission": {
+        "transmissionFactor": 0.5, "transmissionTexture": {"index": 0, "texCoord": 3}}}}],
+        extensionsUsed=m.get("extensionsUsed", []) + ["KHR_materials_transmission"])
+           or m["meshes"][0]["primitives"][0].update(material=0), base=textured(True)), "TEXCOORD_3")
+bad("gltf", "texture_transform_offset_not_finite.gltf",
+    edited(lambda m: m["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"].update(
+        extensions={"KHR_texture_transform": {"offset": [0.5, "x"]}}), base=textured(True)), "offset")
 bad("gltf", "index_view_with_stride.gltf", edited(lambda m: m["bufferViews"][1].update(byteStride=4)), "byteStride")
 bad("gltf", "mesh_without_primitives.gltf", edited(lambda m: m["meshes"].append({"primitives": []})
                                                    or m["nodes"][0].update(mesh=1)), "at least one primitive")
