@@ -115,6 +115,7 @@ public:
             Segment tie = s;
             tie.path = nextPath_++;
             tie.bounce = 0;
+            tie.scattered = 0;
             tie.power = s.power * 0.5f;  // choosing the wrong one of a tie changes the sum
             c.added.push_back(tie);
             const Vec3f normal = front_[s.triangle];
@@ -122,6 +123,7 @@ public:
             Segment beside = s;
             beside.path = nextPath_++;
             beside.bounce = 1;
+            beside.scattered = 1;
             beside.origin = s.origin + side * (n % 2 ? 0.01f : -0.01f);
             beside.power = s.power * 1.5f;
             c.added.push_back(beside);

@@ -28,7 +28,7 @@ bool usesPaperRule(DetpBoundary rule, const VertexDisc& disc) { return rule == D
 
 // The segment crosses no disc: it is an emission segment, and only what arrives after the first
 // bounce is estimated (direct light is computed apart).
-bool leftOut(const Segment& s, bool afterFirstBounce) { return afterFirstBounce && s.bounce == 0; }
+bool leftOut(const Segment& s, bool afterFirstBounce) { return afterFirstBounce && !s.scattered; }
 }  // namespace
 
 Reach detpCrossing(const Segment& s, const Vec3f& centre, const Vec3f& normal, const VertexDisc& disc, float radius,

@@ -154,8 +154,8 @@ Vec3f DirectLight::vertexIrradiance(const Scene& scene, const SceneBvh& bvh, con
         const float end = std::isinf(tfar) ? tfar : tfar * (1 - 1e-5f) - bvh.rayEpsilon();
         if (end > 0) {
             ++rays;
-            // Through panes (KHR_materials_transmission), what they let through.
-            if (bvh.anyTransmits()) {
+            // Through panes (KHR_materials_transmission) and BLEND surfaces, what they let through.
+            if (bvh.passesShares()) {
                 sum += irradiance * Vec3d(bvh.transmittance(origin, w, 0.0f, end));
                 return;
             }

@@ -324,9 +324,12 @@ Vec3f FinalGather::meanOverHits(const Scene& scene, const FirstPass& firstPass, 
         const Triangle& tri = scene.triangles[h.triangle];
         const double w1 = double(h.b1) / kBarycentricScale, w2 = double(h.b2) / kBarycentricScale;
         const double w0 = std::max(0.0, 1.0 - w1 - w2);
-        // Where the albedo varies, or at a pane: E there times the base colour at the hit (a ray
-        // stops at a pane with probability 1 − T, so it reads ρ E, not the (1 − T) ρ E it reflects).
-        if (irradiance && (firstPass.surfaces->varies(h.triangle) || firstPass.surfaces->transmits(h.triangle))) {
+        // Where the albedo varies, or at a pane or a BLEND: E there times the base colour at the
+        // hit (a ray stops at a pane with probability 1 − T, at a BLEND with probability alpha, so
+        // it reads ρ E, not the share of it the surface reflects).
+        const SurfaceLookup* surfaces = firstPass.surfaces;
+        if (irradiance &&
+            (surfaces->varies(h.triangle) || surfaces->transmits(h.triangle) || surfaces->blends(h.triangle))) {
             const std::vector<Vec3f>& e = *irradiance;
             const Vec3d arriving = Vec3d(e[tri.v[0]]) * w0 + Vec3d(e[tri.v[1]]) * w1 + Vec3d(e[tri.v[2]]) * w2;
             sum += arriving * Vec3d(firstPass.surfaces->albedo(h.triangle, float(w1), float(w2)));

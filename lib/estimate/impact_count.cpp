@@ -38,7 +38,7 @@ void ImpactCount::updateGeometry(const Scene& scene) {
 }
 
 bool ImpactCount::counts(const Segment& s) const {
-    if (afterFirstBounce_ && s.bounce == 0) return false;
+    if (afterFirstBounce_ && !s.scattered) return false;
     return s.hasImpact() && dot(s.direction, frontNormal_[s.triangle]) < 0;
 }
 

@@ -46,7 +46,7 @@ public:
         // A segment left out (bounce 0, after the first bounce only) changed no sum.
         for (const auto* list : {&change.removed, &change.added})
             for (const Segment& s : *list)
-                if (s.hasImpact() && !(afterFirstBounce_ && s.bounce == 0)) mark(s.triangle);
+                if (s.hasImpact() && !(afterFirstBounce_ && !s.scattered)) mark(s.triangle);
         std::vector<uint32_t> vertices;
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
             if (changed[v]) vertices.push_back(v);

@@ -18,7 +18,7 @@ public:
 
 private:
     static bool indexed(const Segment& s, bool afterFirstBounce) {
-        return s.hasImpact() && !(afterFirstBounce && s.bounce == 0);
+        return s.hasImpact() && !(afterFirstBounce && !s.scattered);
     }
     static std::vector<Vec3f> impactPoints(const std::vector<Segment>& segments, bool afterFirstBounce);
     static std::vector<uint32_t> impactSegments(const std::vector<Segment>& segments, bool afterFirstBounce);

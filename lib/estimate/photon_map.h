@@ -112,7 +112,7 @@ private:
     static Impact impactOf(const Segment& s);
     // Whether the segment's impact belongs in the map: it has one, and after the first bounce
     // when only those count.
-    bool takes(const Segment& s) const { return s.hasImpact() && !(afterFirstBounce_ && s.bounce == 0); }
+    bool takes(const Segment& s) const { return s.hasImpact() && !(afterFirstBounce_ && !s.scattered); }
     // The impacts of the segments the map holds, and their points.
     void impactsOf(const std::vector<Segment>& segments, std::vector<Impact>& impacts, std::vector<Vec3f>& points) const;
 

@@ -41,7 +41,7 @@ RgbImage renderRadiosityImage(const Scene& scene, const SceneBvh& bvh, const Ver
                     if (surfaces.varies(hit->triangle)) {
                         const Vec3f e = solution.irradiance[t.v[0]] * (1 - hit->u - hit->v) +
                                         solution.irradiance[t.v[1]] * hit->u + solution.irradiance[t.v[2]] * hit->v;
-                        const float reflected = 1 - surfaces.transmission(hit->triangle, hit->u, hit->v);
+                        const float reflected = surfaces.reflectedShare(hit->triangle, hit->u, hit->v);
                         sum += Vec3d(surfaces.albedo(hit->triangle, hit->u, hit->v) * (e * reflected) +
                                      surfaces.emission(hit->triangle, hit->u, hit->v) * float(M_PI));
                         continue;

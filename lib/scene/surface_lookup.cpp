@@ -44,6 +44,9 @@ Vec3f vertexAlbedo(const Scene& scene, uint32_t v) {
     if (coloured || textured(m, scene.textures.get())) {
         const Rgba c = baseColourAt(m, scene.textures.get(), vertexTexCoord(scene, m.baseColour, v), coloured ? scene.vertexColours[v] : kWhite);
         albedo = Vec3f(c[0], c[1], c[2]);
+        if (m.alphaMode == AlphaMode::Blend) albedo = albedo * c[3];  // a BLEND reflects its alpha share
+    } else if (m.alphaMode == AlphaMode::Blend) {
+        albedo = albedo * m.alpha;
     }
     if (!(m.transmission > 0)) return albedo;
     float transmission = m.transmission;
@@ -70,6 +73,7 @@ SurfaceLookup::SurfaceLookup(const Scene& scene) {
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
         const Material& m = scene.materials[scene.triangleMaterial[t]];
         anyTransmits_ = anyTransmits_ || m.transmission > 0;
+        anyBlends_ = anyBlends_ || m.alphaMode == AlphaMode::Blend;
         const bool transmissionTextured = m.transmission > 0 && readsTexture(m.transmissionTexture, textures);
         if (!coloured && !textured(m, textures) && !emissionTextured(m, textures) && !transmissionTextured) continue;
         Corners c;
@@ -118,6 +122,11 @@ float SurfaceLookup::transmission(uint32_t t, float b1, float b2) const {
     const TextureSlot& slot = m.transmissionTexture;
     const Rgba texel = (*textures_)[size_t(slot.texture)].sample(slot.transform.identity() ? uv : slot.transform.apply(uv), false);
     return m.transmission * texel[0];
+}
+
+float SurfaceLookup::reflectedShare(uint32_t t, float b1, float b2) const {
+    const float kept = blends(t) ? baseColour(t, b1, b2)[3] : 1.0f;
+    return transmits(t) ? kept * (1 - transmission(t, b1, b2)) : kept;
 }
 
 bool SurfaceLookup::stops(uint32_t t, float b1, float b2, float choice) const {

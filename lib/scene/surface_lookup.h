@@ -27,7 +27,8 @@ bool readsTexture(const TextureSlot& slot, const TextureSet* textures);
 TexCoord vertexTexCoord(const Scene& scene, const TextureSlot& slot, uint32_t v);
 
 // Vertex v's own diffuse reflectance: its material's base colour at its UV and colour, times the
-// share 1 − T its transmission does not pass. A vertex's radiosity is this times E_v.
+// share of the light it does not let through (1 − T of a pane, alpha of a BLEND). A vertex's
+// radiosity is this times E_v.
 Vec3f vertexAlbedo(const Scene& scene, uint32_t v);
 
 class SurfaceLookup {
@@ -42,6 +43,9 @@ public:
     // Light passes straight through triangle t in part (KHR_materials_transmission).
     bool transmits(uint32_t t) const { return any() && materials_[triangleMaterial_[t]].transmission > 0; }
     bool anyTransmits() const { return anyTransmits_; }
+    // Triangle t is an alpha BLEND.
+    bool blends(uint32_t t) const { return any() && materials_[triangleMaterial_[t]].alphaMode == AlphaMode::Blend; }
+    bool anyBlends() const { return anyBlends_; }
     // The share that passes at (b1, b2): transmission × its texture's R there (linear).
     float transmission(uint32_t t, float b1, float b2) const;
     // Rays may pass through triangle t (MASK or BLEND).
@@ -55,6 +59,9 @@ public:
     }
     // Triangle t's emitted radiance L_e at (b1, b2): its emissive texture's texel there.
     Vec3f emission(uint32_t t, float b1, float b2) const;
+    // The share of the light arriving at (b1, b2) that triangle t reflects diffusely (× its base
+    // colour): 1 − T of a pane, alpha of a BLEND, both of a surface that is both; 1 elsewhere.
+    float reflectedShare(uint32_t t, float b1, float b2) const;
     // Whether a ray meets triangle t at (b1, b2): always, unless its material lets light through —
     // MASK: where alpha ≥ alphaCutoff; BLEND: where alpha > `choice`, a number in [0, 1) of the
     // ray's own (so that a share alpha of the rays stops there, each ray deciding the same way
@@ -76,7 +83,7 @@ private:
     std::vector<uint32_t> triangleMaterial_;
     std::vector<uint32_t> cornerOf_;  // per triangle: its Corners, or kUniform
     std::vector<Corners> corners_;
-    bool anyTransmits_ = false;
+    bool anyTransmits_ = false, anyBlends_ = false;
 };
 
 }  // namespace qsgi

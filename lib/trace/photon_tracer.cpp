@@ -37,17 +37,17 @@ void PhotonTracer::tracePathInto(uint64_t path, Out& out) const {
     const PathNumbers numbers = source_->numbersFor(path);
     const PhotonEmission e = source_->lights().sample(numbers);
     if (!(maxComponent(e.power) > 0)) return;  // a spot light's photon outside its cone: nothing sent
-    follow(numbers, path, 0, e.origin, e.direction, e.power, 0.0f, out);
+    follow(numbers, path, 0, e.origin, e.direction, e.power, 0.0f, false, out);
 }
 
 void PhotonTracer::continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power,
-                                float tnear, std::vector<Segment>& out) const {
-    follow(source_->numbersFor(path), path, bounce, origin, direction, power, tnear, out);
+                                float tnear, bool scattered, std::vector<Segment>& out) const {
+    follow(source_->numbersFor(path), path, bounce, origin, direction, power, tnear, scattered, out);
 }
 
 template <class Out>
 void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction,
-                          Vec3f power, float tnear, Out& out) const {
+                          Vec3f power, float tnear, bool scattered, Out& out) const {
     using namespace rng_dim;
     const float eps = bvh_.rayEpsilon();
     for (; bounce < settings_.maxBounces; ++bounce) {
@@ -57,6 +57,7 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
         s.power = power;
         s.path = uint32_t(path);
         s.bounce = uint16_t(bounce);
+        s.scattered = scattered;
         const auto hit = bvh_.intersect(origin, direction, tnear, std::numeric_limits<float>::infinity());
         if (!hit) {
             s.length = bounds_.exitDistance(origin, direction);
@@ -86,6 +87,7 @@ void PhotonTracer::follow(const PathNumbers& rng, uint64_t path, uint32_t bounce
         }
         origin = s.impactPoint() + n * eps;
         direction = cosineHemisphere(n, rng.uniform(bounce + 1, kScatterDirection0), rng.uniform(bounce + 1, kScatterDirection1));
+        scattered = true;
         tnear = 0;
     }
 }

@@ -40,9 +40,9 @@ public:
     // Appends every segment of `path`.
     void tracePath(uint64_t path, std::vector<Segment>& out) const;
     // Appends the segments of `path` from bounce `bounce` on, continuing from the state the path
-    // had there (origin, direction, power) with the same numbers.
+    // had there (origin, direction, power, whether its light was scattered) with the same numbers.
     void continuePath(uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power, float tnear,
-                      std::vector<Segment>& out) const;
+                      bool scattered, std::vector<Segment>& out) const;
 
     const LightSampler& lights() const { return source_->lights(); }
     // What decodes the caches it writes (and the tails it keeps).
@@ -54,7 +54,7 @@ private:
     void tracePathInto(uint64_t path, Out& out) const;
     template <class Out>
     void follow(const PathNumbers& numbers, uint64_t path, uint32_t bounce, Vec3f origin, Vec3f direction, Vec3f power,
-                float tnear, Out& out) const;
+                float tnear, bool scattered, Out& out) const;
 
     const SceneBvh& bvh_;
     TraceSettings settings_;

@@ -133,12 +133,15 @@ void decodeRecords(const PhotonSource& source, uint64_t path, const First& first
     s.triangle = first.triangle;
     s.path = uint32_t(path);
     s.bounce = 0;
+    s.scattered = 0;
     placeImpact(source, s, hit);
     *out++ = s;
     for (; later != end; ++later) {
         const PhotonSource::Surface at = source.surfaceAt(s.triangle, s.b1, s.b2);
-        s.power = PhotonSource::powerAfter(
-            s.power, at, transmits ? PhotonSource::impact(at, numbers.uniform(s.bounce + 1u, rng_dim::kSurvival)) : PhotonSource::Impact::Reflects);
+        const PhotonSource::Impact what =
+            transmits ? PhotonSource::impact(at, numbers.uniform(s.bounce + 1u, rng_dim::kSurvival)) : PhotonSource::Impact::Reflects;
+        s.power = PhotonSource::powerAfter(s.power, at, what);
+        s.scattered = s.scattered || what == PhotonSource::Impact::Reflects;
         s.origin = later->origin;
         s.direction = later->direction;
         s.length = later->length;

@@ -43,6 +43,10 @@ struct Segment {
     // Impacted a triangle whose albedo varies over it (a texture, vertex colours): the bounce's
     // power depends on where, so the records keep the hit's barycentrics (b1, b2) for it.
     uint8_t impactVaries = 0;
+    // The light it carries was reflected diffusely before (at bounce > 0, unless it only passed
+    // through panes, KHR_materials_transmission): what "after the first bounce" counts when
+    // direct light is computed apart (--direct exact).
+    uint8_t scattered = 0;
     float b1 = 0, b2 = 0;
 
     bool hasImpact() const { return triangle != kNoTriangle; }

@@ -45,10 +45,11 @@ float rayChoice(const Vec3f& origin, const Vec3f& direction, uint32_t triangle, 
 namespace {
 
 // Drops the hits where the surface lets the ray through (PassThrough); true if lane i survives.
-bool stopsRay(const RTCFilterFunctionNArguments* args, unsigned i) {
+// blendStops: BLEND surfaces stop it (transmittance() weighs them itself).
+bool stopsRay(const RTCFilterFunctionNArguments* args, unsigned i, bool blendStops) {
     const auto* pass = static_cast<const PassThrough*>(args->geometryUserPtr);
     const uint32_t triangle = pass->sceneTriangle[RTCHitN_primID(args->hit, args->N, i)];
-    if (!pass->lookup->letsLightThrough(triangle)) return true;
+    if (!pass->lookup->letsLightThrough(triangle) || (blendStops && pass->lookup->blends(triangle))) return true;
     const Vec3f origin(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
                        RTCRayN_org_z(args->ray, args->N, i));
     const Vec3f direction(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
@@ -59,15 +60,16 @@ bool stopsRay(const RTCFilterFunctionNArguments* args, unsigned i) {
 
 // Closest hits through surfaces that let light through: those dropped, then the tie rule.
 void passThroughThenLowestPrimitive(const RTCFilterFunctionNArguments* args) {
+    const bool blendStops = reinterpret_cast<const TieBreakContext*>(args->context)->blendStops;
     for (unsigned i = 0; i < args->N; ++i)
-        if (args->valid[i] != 0 && !stopsRay(args, i)) args->valid[i] = 0;
+        if (args->valid[i] != 0 && !stopsRay(args, i, blendStops)) args->valid[i] = 0;
     lowestPrimitiveOnTies(args);
 }
 
 // Occlusion through surfaces that let light through.
 void passThroughOccluded(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i)
-        if (args->valid[i] != 0 && !stopsRay(args, i)) args->valid[i] = 0;
+        if (args->valid[i] != 0 && !stopsRay(args, i, false)) args->valid[i] = 0;
 }
 
 RTCRayHit makeRay(const Vec3f& o, const Vec3f& d, float tnear, float tfar) {
@@ -198,10 +200,11 @@ void SceneBvh::boundDynamic(const Scene& scene) {
 }
 
 std::optional<SurfaceHit> SceneBvh::intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
-                                                  const Vec3f& direction, float tnear, float tfar) const {
+                                                  const Vec3f& direction, float tnear, float tfar, bool blendStops) const {
     if (part.empty()) return std::nullopt;
     TieBreakContext context;
     rtcInitIntersectContext(&context.base);
+    context.blendStops = blendStops;
     RTCRayHit rh = makeRay(origin, direction, tnear, tfar);
     rtcIntersect1(embree.get(), &context.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
@@ -210,7 +213,12 @@ std::optional<SurfaceHit> SceneBvh::intersectPart(const EmbreeScene& embree, con
 }
 
 std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    const std::optional<SurfaceHit> still = intersectPart(staticScene_, static_, origin, direction, tnear, tfar);
+    return closestHit(origin, direction, tnear, tfar, false);
+}
+
+std::optional<SurfaceHit> SceneBvh::closestHit(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
+                                               bool blendStops) const {
+    const std::optional<SurfaceHit> still = intersectPart(staticScene_, static_, origin, direction, tnear, tfar, blendStops);
     // The dynamic scene only needs to look as far as the static hit (inclusive: a tie there is
     // decided below by triangle id), and not at all when the ray misses the dynamic triangles'
     // padded bounds over that span, as most rays do (dynamicOccludes' test; a call into Embree
@@ -219,7 +227,7 @@ std::optional<SurfaceHit> SceneBvh::intersect(const Vec3f& origin, const Vec3f& 
     double t0 = tnear, t1 = still ? still->t : tfar;
     if (nearScene_.contains(origin) && !dynamicBounds_.clip(origin, direction, t0, t1)) return still;
     const std::optional<SurfaceHit> moving =
-        intersectPart(dynamicScene_, dynamic_, origin, direction, tnear, still ? still->t : tfar);
+        intersectPart(dynamicScene_, dynamic_, origin, direction, tnear, still ? still->t : tfar, blendStops);
     if (!moving) return still;
     if (!still || moving->t < still->t || (moving->t == still->t && moving->triangle < still->triangle)) return moving;
     return still;
@@ -237,14 +245,20 @@ std::optional<SurfaceHit> SceneBvh::intersectThroughPanes(const Vec3f& origin, c
 }
 
 Vec3f SceneBvh::transmittance(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    if (!surfaces_->anyTransmits()) return occluded(origin, direction, tnear, tfar) ? Vec3f(0.0f) : Vec3f(1.0f);
+    if (!passesShares()) return occluded(origin, direction, tnear, tfar) ? Vec3f(0.0f) : Vec3f(1.0f);
     Vec3f through(1.0f);
     float from = tnear;
-    for (int pane = 0; pane <= kMostPanes; ++pane) {
-        const std::optional<SurfaceHit> hit = intersect(origin, direction, from, tfar);
+    for (int crossed = 0; crossed <= kMostPanes; ++crossed) {
+        const std::optional<SurfaceHit> hit = closestHit(origin, direction, from, tfar, true);
         if (!hit) return through;
-        if (!surfaces_->transmits(hit->triangle) || pane == kMostPanes) break;
-        through = through * (surfaces_->albedo(hit->triangle, hit->u, hit->v) * surfaces_->transmission(hit->triangle, hit->u, hit->v));
+        const uint32_t t = hit->triangle;
+        const bool pane = surfaces_->transmits(t), blend = surfaces_->blends(t);
+        if ((!pane && !blend) || crossed == kMostPanes) break;
+        // A pane passes T of the light, tinted; a BLEND passes 1 − alpha, and its alpha share
+        // meets the pane (a surface that is both).
+        const Rgba base = surfaces_->baseColour(t, hit->u, hit->v);
+        const Vec3f paneShare = pane ? Vec3f(base[0], base[1], base[2]) * surfaces_->transmission(t, hit->u, hit->v) : Vec3f(0.0f);
+        through = through * (blend ? Vec3f(1 - base[3]) + paneShare * base[3] : paneShare);
         if (!(maxComponent(through) > 0)) break;
         from = std::nextafter(hit->t, std::numeric_limits<float>::infinity());
     }

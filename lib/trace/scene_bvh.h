@@ -32,6 +32,7 @@ struct TieBreakContext {
     RTCIntersectContext base;  // first member: Embree hands back a pointer to it
     float bestT = std::numeric_limits<float>::infinity();
     unsigned bestPrim = RTC_INVALID_GEOMETRY_ID;
+    bool blendStops = false;  // a BLEND surface stops the ray (transmittance() weighs it instead)
 };
 void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args);
 
@@ -72,9 +73,13 @@ public:
     // pane's triangle; at most kMostPanes panes). The final gather's rays.
     std::optional<SurfaceHit> intersectThroughPanes(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
     // What reaches the end of the segment (tnear, tfar): 0 where an opaque surface blocks it,
-    // else the product of T × base colour of the panes it crosses, in order (1 if none). Shadow rays.
+    // else the product, in order, of what each surface it crosses lets through (1 if none): a
+    // pane's T × base colour, a BLEND's 1 − alpha (its expectation, free of the per-ray choice's
+    // noise). Shadow rays.
     Vec3f transmittance(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
-    bool anyTransmits() const { return surfaces_->anyTransmits(); }
+    // Some surface lets a share of the light through (a pane or a BLEND): shadow rays then ask
+    // transmittance() rather than occluded().
+    bool passesShares() const { return surfaces_->anyTransmits() || surfaces_->anyBlends(); }
     static constexpr int kMostPanes = 16;
     // True if any geometry blocks the ray within (tnear, tfar).
     bool occluded(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
@@ -132,7 +137,10 @@ private:
     void fillVertices(RTCGeometry geom, const Part& part, const Scene& scene);
     void boundDynamic(const Scene& scene);
     std::optional<SurfaceHit> intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
-                                            const Vec3f& direction, float tnear, float tfar) const;
+                                            const Vec3f& direction, float tnear, float tfar, bool blendStops) const;
+    // intersect(), BLEND surfaces stopping the ray when `blendStops`.
+    std::optional<SurfaceHit> closestHit(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
+                                         bool blendStops) const;
 
     const EmbreeDevice& device_;
     std::shared_ptr<const SurfaceLookup> surfaces_;  // what the filters and the panes read

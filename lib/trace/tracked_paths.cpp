@@ -76,6 +76,7 @@ void TrackedPaths::keep(std::vector<std::vector<Segment>>& kept, const Bounds3f&
             const uint32_t s = uint32_t(pathOf_.size());
             pathOf_.push_back(tails[begin].path);
             firstBounce_.push_back(tails[begin].bounce);
+            if (source_->anyTransmits()) firstScattered_.push_back(tails[begin].scattered);
             power_.push_back(tails[begin].power);
             store_.append(s, uint32_t(end - begin));
             writeRecords(s, 0, tails.data() + begin, uint32_t(end - begin));
@@ -105,6 +106,7 @@ void TrackedPaths::decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) 
     const Record* records = store_.column<0>() + store_.slot(s).begin;
     const HitPoint* hits = source_->anyVaries() ? store_.column<1>() + store_.slot(s).begin : nullptr;
     Vec3f power = power_[s];
+    bool scattered = firstScatteredAt(s);
     // What each impact did (PhotonSource::impact) where some surface lets photons through.
     const bool transmits = source_->anyTransmits();
     const PathNumbers numbers = transmits ? source_->numbersFor(pathOf_[s]) : PathNumbers(0, 0);
@@ -113,9 +115,10 @@ void TrackedPaths::decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) 
             const HitPoint at = hits ? hits[j - 1] : HitPoint{0, 0};
             const PhotonSource::Surface surface = source_->surfaceAt(records[j - 1].triangle, at[0], at[1]);
             const uint32_t bounce = firstBounce_[s] + j - 1;
-            power = PhotonSource::powerAfter(
-                power, surface,
-                transmits ? PhotonSource::impact(surface, numbers.uniform(bounce + 1, rng_dim::kSurvival)) : PhotonSource::Impact::Reflects);
+            const PhotonSource::Impact what =
+                transmits ? PhotonSource::impact(surface, numbers.uniform(bounce + 1, rng_dim::kSurvival)) : PhotonSource::Impact::Reflects;
+            power = PhotonSource::powerAfter(power, surface, what);
+            scattered = scattered || what == PhotonSource::Impact::Reflects;
         }
         if (j < from) continue;
         const Record& r = records[j];
@@ -127,6 +130,7 @@ void TrackedPaths::decode(uint32_t s, uint32_t from, uint32_t to, Segment* out) 
         x.triangle = r.triangle;
         x.path = pathOf_[s];
         x.bounce = uint16_t(firstBounce_[s] + j);
+        x.scattered = scattered;
         x.impactDynamic = r.triangle != kNoTriangle ? source_->surface(r.triangle).dynamic : 0;
         x.impactVaries = r.triangle != kNoTriangle ? source_->surface(r.triangle).varies : 0;
         x.b1 = x.impactVaries ? hits[j][0] : 0.0f;
@@ -297,7 +301,8 @@ TrackedPaths::NewTails TrackedPaths::traceTails(const std::vector<AffectedPath>&
             const AffectedPath& a = affected[i];
             const uint32_t place = a.bounce - firstBounce_[a.slot];
             decode(a.slot, place, place + 1, &start);
-            tracer.continuePath(start.path, start.bounce, start.origin, start.direction, start.power, 0.0f, run.segments);
+            tracer.continuePath(start.path, start.bounce, start.origin, start.direction, start.power, 0.0f, start.scattered,
+                                run.segments);
             run.segmentsEnd.push_back(uint32_t(run.segments.size()));
         }
         for (const Segment& x : run.segments) {

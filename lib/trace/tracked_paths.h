@@ -133,6 +133,10 @@ private:
     // Per slot: the path, the bounce of its first tracked segment, and that segment's power.
     std::vector<uint32_t> pathOf_;  // increasing
     std::vector<uint16_t> firstBounce_;
+    // Whether its first tracked segment's light was scattered (Segment::scattered): kept where
+    // some surface lets photons through, else it is bounce > 0.
+    std::vector<uint8_t> firstScattered_;
+    bool firstScatteredAt(uint32_t s) const { return firstScattered_.empty() ? firstBounce_[s] > 0 : firstScattered_[s] != 0; }
     std::vector<Vec3f> power_;
     std::vector<uint64_t> retracedSinceSweep_;  // one bit per slot: its index entries may be stale
     // Mutable: queries drop stale entries as they pass them, which changes no answer.
