@@ -65,6 +65,20 @@ CardScene cardOverFloor(AlphaMode mode, float alpha, int texels, bool (*opaque)(
 // The card's texels' grey (sRGB 128), linear.
 float srgbLinear128() { return float(srgbToLinear(128 / 255.0)); }
 
+// Calls visit(v) for each floor vertex strictly under the card (a hair inside its edge).
+template <class Visit>
+size_t forEachFloorVertexUnderTheCard(const CardScene& c, Visit&& visit) {
+    const MeshInstance& floor = c.scene.instances[0];
+    size_t under = 0;
+    for (uint32_t v = floor.firstVertex; v < floor.firstVertex + floor.vertexCount; ++v) {
+        const Vec3f p = c.scene.positions[v];
+        if (std::abs(p.x) >= c.half - 1e-3f || std::abs(p.z) >= c.half - 1e-3f) continue;
+        ++under;
+        visit(v);
+    }
+    return under;
+}
+
 bool quarterOpaque(int x, int y) { return (x + 2 * y) % 4 == 0; }  // 4 of 16 texels, one in each row
 bool allOpaque(int, int) { return true; }
 
@@ -185,14 +199,8 @@ TEST(Materials, ABlendCardPassesItsShareOfTheSunsLight) {
     ASSERT_TRUE(rig.bvh.passesShares());
     DirectLight direct(4, 7);
     direct.computeAll(c.scene, rig.bvh, rig.starts);
-    const MeshInstance& floor = c.scene.instances[0];
-    size_t under = 0;
-    for (uint32_t v = floor.firstVertex; v < floor.firstVertex + floor.vertexCount; ++v) {
-        const Vec3f p = c.scene.positions[v];
-        if (std::abs(p.x) >= c.half - 1e-3f || std::abs(p.z) >= c.half - 1e-3f) continue;
-        ++under;
-        EXPECT_FLOAT_EQ(direct.irradiance()[v].y, 2.0f * (1 - alpha)) << "floor vertex " << v;
-    }
+    const size_t under = forEachFloorVertexUnderTheCard(
+        c, [&](uint32_t v) { EXPECT_FLOAT_EQ(direct.irradiance()[v].y, 2.0f * (1 - alpha)) << "floor vertex " << v; });
     EXPECT_GT(under, 500u);
     TraceSettings settings;
     settings.photons = 40000;
@@ -423,15 +431,10 @@ TEST(Materials, AThinPaneLetsItsShareThroughTintedByItsBaseColour) {
     ASSERT_TRUE(rig.bvh.passesShares());
     DirectLight direct(4, 7);
     direct.computeAll(c.scene, rig.bvh, rig.starts);
-    const MeshInstance& floor = c.scene.instances[0];
-    size_t under = 0;
-    for (uint32_t v = floor.firstVertex; v < floor.firstVertex + floor.vertexCount; ++v) {
-        const Vec3f p = c.scene.positions[v];
-        if (std::abs(p.x) >= c.half - 1e-3f || std::abs(p.z) >= c.half - 1e-3f) continue;
-        ++under;
+    const size_t under = forEachFloorVertexUnderTheCard(c, [&](uint32_t v) {
         const Vec3f e = direct.irradiance()[v];
         for (int k = 0; k < 3; ++k) EXPECT_NEAR(e[k], 2.0 * double(T) * double(tint[k]), 1e-6) << "channel " << k << " at vertex " << v;
-    }
+    });
     EXPECT_GT(under, 500u);
     // Photons.
     TraceSettings settings;

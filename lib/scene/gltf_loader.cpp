@@ -186,6 +186,21 @@ TextureSlot textureSlot(const tinygltf::TextureInfo& info, const std::string& fi
     return slot;
 }
 
+// Texture `info` as the material at `place` reads it, with its image added to `textures`; an
+// unused slot, with a warning that the material keeps `factor` alone, when the image cannot be read.
+TextureSlot readTexture(const tinygltf::TextureInfo& info, const std::string& place, const char* factor,
+                        const std::string& file, Warnings& warnings, std::set<int>& decodedImages, TextureImages& images,
+                        std::map<int, Texture>& textures) {
+    const TextureSlot slot = textureSlot(info, file, place);
+    auto [texture, problem] = images.texture(info.index, place, decodedImages);
+    if (!texture) {
+        warnings.add(file + ": " + place + ": " + problem + "; using " + factor + " alone");
+        return TextureSlot();
+    }
+    textures.emplace(slot.texture, std::move(*texture));
+    return slot;
+}
+
 Material convertMaterial(const GltfDocument& document, int index, const std::string& file,
                          Warnings& warnings, std::set<int>& decodedImages, TextureImages& images,
                          std::map<int, Texture>& textures) {
@@ -201,17 +216,9 @@ Material convertMaterial(const GltfDocument& document, int index, const std::str
     if (!isFinite(out.albedo) || out.albedo.x < 0 || out.albedo.y < 0 || out.albedo.z < 0 || maxComponent(out.albedo) > 1 ||
         !(out.alpha >= 0 && out.alpha <= 1))
         throw InputError(file, place + ".pbrMetallicRoughness.baseColorFactor", "must lie in [0, 1] (glTF 2.0)");
-    if (pbr.baseColorTexture.index >= 0) {
-        const std::string texturePlace = place + ".pbrMetallicRoughness.baseColorTexture";
-        const TextureSlot slot = textureSlot(pbr.baseColorTexture, file, texturePlace);
-        auto [texture, problem] = images.texture(pbr.baseColorTexture.index, texturePlace, decodedImages);
-        if (texture) {
-            out.baseColour = slot;
-            textures.emplace(slot.texture, std::move(*texture));
-        } else {
-            warnings.add(file + ": " + texturePlace + ": " + problem + "; using baseColorFactor alone");
-        }
-    }
+    if (pbr.baseColorTexture.index >= 0)
+        out.baseColour = readTexture(pbr.baseColorTexture, place + ".pbrMetallicRoughness.baseColorTexture", "baseColorFactor",
+                                     file, warnings, decodedImages, images, textures);
     // glTF 2.0 (§5.19): alphaMode OPAQUE (the default), MASK or BLEND; alphaCutoff ≥ 0, read
     // under MASK only.
     if (m.alphaMode == "MASK") out.alphaMode = AlphaMode::Mask;
@@ -240,14 +247,8 @@ Material convertMaterial(const GltfDocument& document, int index, const std::str
             textureInfo.texCoord = info.Has("texCoord") && info.Get("texCoord").IsNumber() ? int(info.Get("texCoord").GetNumberAsDouble()) : 0;
             if (info.Has("extensions") && info.Get("extensions").Has("KHR_texture_transform"))
                 textureInfo.extensions["KHR_texture_transform"] = info.Get("extensions").Get("KHR_texture_transform");
-            const TextureSlot slot = textureSlot(textureInfo, file, texturePlace);
-            auto [texture, problem] = images.texture(textureInfo.index, texturePlace, decodedImages);
-            if (texture) {
-                out.transmissionTexture = slot;
-                textures.emplace(slot.texture, std::move(*texture));
-            } else {
-                warnings.add(file + ": " + texturePlace + ": " + problem + "; using transmissionFactor alone");
-            }
+            out.transmissionTexture = readTexture(textureInfo, texturePlace, "transmissionFactor", file, warnings, decodedImages,
+                                                  images, textures);
         }
         if (factor > 0 && (m.extensions.count("KHR_materials_volume") || m.extensions.count("KHR_materials_ior")))
             warnings.add(file + ": " + place + ": KHR_materials_volume and KHR_materials_ior are ignored (a transmissive "
@@ -257,17 +258,9 @@ Material convertMaterial(const GltfDocument& document, int index, const std::str
         warnings.add(file + ": metallic/roughness, normal and occlusion maps are ignored (surfaces are Lambertian)");
 
     Vec3f emissive = vec3FromFactor(m.emissiveFactor, Vec3f(0.0f));
-    if (m.emissiveTexture.index >= 0 && maxComponent(emissive) > 0) {
-        const std::string texturePlace = place + ".emissiveTexture";
-        const TextureSlot slot = textureSlot(m.emissiveTexture, file, texturePlace);
-        auto [texture, problem] = images.texture(m.emissiveTexture.index, texturePlace, decodedImages);
-        if (texture) {
-            out.emissive = slot;
-            textures.emplace(slot.texture, std::move(*texture));
-        } else {
-            warnings.add(file + ": " + texturePlace + ": " + problem + "; using emissiveFactor alone");
-        }
-    }
+    if (m.emissiveTexture.index >= 0 && maxComponent(emissive) > 0)
+        out.emissive = readTexture(m.emissiveTexture, place + ".emissiveTexture", "emissiveFactor", file, warnings,
+                                   decodedImages, images, textures);
     auto strength = m.extensions.find("KHR_materials_emissive_strength");
     if (strength != m.extensions.end() && strength->second.Has("emissiveStrength")) {
         const auto& v = strength->second.Get("emissiveStrength");

@@ -132,6 +132,15 @@ SceneBvh::SceneBvh(const EmbreeDevice& device, const Scene& scene)
     rayEpsilon_ = std::max(1e-5f * b.extent(), 64 * std::numeric_limits<float>::epsilon() * b.maxAbsCoordinate());
     if (!(rayEpsilon_ > 0)) rayEpsilon_ = 1e-5f;
     nearScene_ = b.expanded(b.extent());
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
+        if (!surfaces_->transmits(t) && !surfaces_->blends(t)) continue;
+        if (scene.triangleDynamic[t]) {
+            shareBounds_ = nearScene_.expanded(nearScene_.extent());  // wherever it goes
+            break;
+        }
+        for (uint32_t v : scene.triangles[t].v) shareBounds_.extend(scene.positions[v]);
+    }
+    if (!shareBounds_.empty()) shareBounds_ = shareBounds_.expanded(rayEpsilon_);
     boundDynamic(scene);
 }
 
@@ -245,7 +254,9 @@ std::optional<SurfaceHit> SceneBvh::intersectThroughPanes(const Vec3f& origin, c
 }
 
 Vec3f SceneBvh::transmittance(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const {
-    if (!passesShares()) return occluded(origin, direction, tnear, tfar) ? Vec3f(0.0f) : Vec3f(1.0f);
+    double t0 = tnear, t1 = tfar;
+    if (!passesShares() || !shareBounds_.clip(origin, direction, t0, t1))
+        return occluded(origin, direction, tnear, tfar) ? Vec3f(0.0f) : Vec3f(1.0f);
     Vec3f through(1.0f);
     float from = tnear;
     for (int crossed = 0; crossed <= kMostPanes; ++crossed) {

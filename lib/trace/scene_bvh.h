@@ -154,6 +154,10 @@ private:
     // below the padding of dynamicBounds_, so intersect() may skip the dynamic part by them. A
     // camera farther out asks Embree whatever the bounds say.
     Bounds3f nearScene_;
+    // The surfaces that pass a share of the light (panes, BLENDs), padded; everything if one
+    // moves: a shadow ray that misses them asks occluded(), an any-hit query, not the closest-hit
+    // walk of transmittance() (FlightHelmet's one BLEND lens doubled the direct light's time).
+    Bounds3f shareBounds_;
 };
 
 }  // namespace qsgi
