@@ -15,6 +15,7 @@
 #include "estimate/direct_light.h"
 #include "estimate/vertex_starts.h"
 #include "output/ply_reader.h"
+#include "output/radiosity_image.h"
 #include "pipeline/frame_solver.h"
 #include "scene/emission_pieces.h"
 #include "scene/gltf_loader.h"
@@ -592,4 +593,32 @@ TEST(Materials, TheMaterialsRoomAgreesWithAnIndependentPathTracer) {
     std::printf("materials room (seed %s): %zu vertices, relative RMS %.4f, bias %+.4f\n", seed.c_str(), counted, rms, bias);
     EXPECT_LT(rms, kMaterialsRoomRms);
     EXPECT_LT(std::abs(bias), kMaterialsRoomBias);
+}
+
+// The camera composites a BLEND surface over what lies behind it: looking straight down at the
+// BLEND card (alpha 0.3) over the floor, a pixel shows the card's B (which holds its alpha share
+// already) plus 1 − alpha of the floor's, each divided by π; beside the card, the floor's alone.
+// (The card's texture is one grey texel, so its triangles vary and take the texel path: B = its
+// share × ρ × E.)
+TEST(Materials, TheCameraCompositesABlendSurfaceByItsAlpha) {
+    const float alpha = 0.3f;
+    const CardScene c = cardOverFloor(AlphaMode::Blend, alpha, 1, allOpaque);
+    const EmbreeDevice device;
+    const SceneBvh bvh(device, c.scene);
+    VertexRadiosity solution;
+    solution.irradiance.assign(c.scene.vertexCount(), Vec3f(2.0f));
+    computeRadiosity(c.scene, solution);
+    Camera camera;
+    camera.projection = Projection::Orthographic;
+    camera.position = Vec3f(0, 3, 0);
+    camera.forward = Vec3f(0, -1, 0);
+    camera.up = Vec3f(0, 0, -1);
+    camera.ymag = 1.0f;
+    ImageSettings settings;
+    settings.width = settings.height = 20;
+    const RgbImage image = renderRadiosityImage(c.scene, bvh, solution, camera, settings);
+    const double floorB = 2.0 * 0.5, cardB = 2.0 * 0.5 * srgbLinear128() * alpha;
+    auto pixel = [&](int x, int y) { return double(image.pixels[3 * size_t(y * settings.width + x)]); };
+    EXPECT_NEAR(pixel(10, 10), (cardB + (1 - alpha) * floorB) / M_PI, 1e-5) << "over the card";
+    EXPECT_NEAR(pixel(0, 0), floorB / M_PI, 1e-5) << "beside it";
 }

@@ -138,9 +138,15 @@ private:
     void boundDynamic(const Scene& scene);
     std::optional<SurfaceHit> intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
                                             const Vec3f& direction, float tnear, float tfar, bool blendStops) const;
-    // intersect(), BLEND surfaces stopping the ray when `blendStops`.
+
+public:
+    // intersect(), BLEND surfaces stopping the ray when `blendStops` (the camera composites them
+    // by their alpha; transmittance() weighs them).
     std::optional<SurfaceHit> closestHit(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
                                          bool blendStops) const;
+    const SurfaceLookup& surfaces() const { return *surfaces_; }
+
+private:
 
     const EmbreeDevice& device_;
     std::shared_ptr<const SurfaceLookup> surfaces_;  // what the filters and the panes read
