@@ -14,6 +14,24 @@ bool emissionTextured(const Material& m, const TextureSet* textures) {
 
 const Rgba kWhite{1, 1, 1, 1};
 
+TexCoord transformed(const TextureSlot& slot, TexCoord uv) { return slot.transform.identity() ? uv : slot.transform.apply(uv); }
+
+// The texture `slot` names at uv (before the slot's transform).
+Rgba readSlot(const TextureSlot& slot, const TextureSet& textures, TexCoord uv, bool srgb) {
+    return textures[size_t(slot.texture)].sample(transformed(slot, uv), srgb);
+}
+
+// The corners' coordinates interpolated at barycentrics (b0, b1, b2).
+TexCoord interpolated(const TexCoord (&uv)[3], float b0, float b1, float b2) {
+    return {b0 * uv[0].s + b1 * uv[1].s + b2 * uv[2].s, b0 * uv[0].t + b1 * uv[1].t + b2 * uv[2].t};
+}
+
+// Material m's transmission at uv of its transmission texture's set: factor × the texture's R.
+float transmissionAt(const Material& m, const TextureSet* textures, TexCoord uv) {
+    if (!(m.transmission > 0) || !readsTexture(m.transmissionTexture, textures)) return m.transmission;
+    return m.transmission * readSlot(m.transmissionTexture, *textures, uv, false)[0];
+}
+
 }  // namespace
 
 bool readsTexture(const TextureSlot& slot, const TextureSet* textures) {
@@ -29,8 +47,7 @@ TexCoord vertexTexCoord(const Scene& scene, const TextureSlot& slot, uint32_t v)
 Rgba baseColourAt(const Material& m, const TextureSet* textures, TexCoord uv, const Rgba& colour) {
     Rgba out{m.albedo.x * colour[0], m.albedo.y * colour[1], m.albedo.z * colour[2], m.alpha * colour[3]};
     if (textured(m, textures)) {
-        const TextureSlot& slot = m.baseColour;
-        const Rgba texel = (*textures)[size_t(slot.texture)].sample(slot.transform.identity() ? uv : slot.transform.apply(uv), true);
+        const Rgba texel = readSlot(m.baseColour, *textures, uv, true);
         for (size_t c = 0; c < 4; ++c) out[c] *= texel[c];
     }
     if (m.alphaMode == AlphaMode::Opaque) out[3] = 1;
@@ -49,13 +66,7 @@ Vec3f vertexAlbedo(const Scene& scene, uint32_t v) {
         albedo = albedo * m.alpha;
     }
     if (!(m.transmission > 0)) return albedo;
-    float transmission = m.transmission;
-    if (readsTexture(m.transmissionTexture, scene.textures.get())) {
-        const TextureSlot& slot = m.transmissionTexture;
-        const TexCoord uv = vertexTexCoord(scene, slot, v);
-        transmission *= (*scene.textures)[size_t(slot.texture)].sample(slot.transform.identity() ? uv : slot.transform.apply(uv), false)[0];
-    }
-    return albedo * (1 - transmission);
+    return albedo * (1 - transmissionAt(m, scene.textures.get(), vertexTexCoord(scene, m.transmissionTexture, v)));
 }
 
 SurfaceLookup::SurfaceLookup(const Scene& scene) {
@@ -94,7 +105,7 @@ Rgba SurfaceLookup::baseColour(uint32_t t, float b1, float b2) const {
     if (cornerOf_[t] == kUniform) return {m.albedo.x, m.albedo.y, m.albedo.z, m.alphaMode == AlphaMode::Opaque ? 1.0f : m.alpha};
     const Corners& c = corners_[cornerOf_[t]];
     const float b0 = std::max(0.0f, 1.0f - b1 - b2);
-    const TexCoord uv{b0 * c.uv[0].s + b1 * c.uv[1].s + b2 * c.uv[2].s, b0 * c.uv[0].t + b1 * c.uv[1].t + b2 * c.uv[2].t};
+    const TexCoord uv = interpolated(c.uv, b0, b1, b2);
     Rgba colour;
     for (size_t k = 0; k < 4; ++k) colour[k] = b0 * c.colour[0][k] + b1 * c.colour[1][k] + b2 * c.colour[2][k];
     return baseColourAt(m, textures_.get(), uv, colour);
@@ -105,23 +116,15 @@ Vec3f SurfaceLookup::emission(uint32_t t, float b1, float b2) const {
     if (cornerOf_[t] == kUniform || !emissionTextured(m, textures_.get())) return m.emission;
     const Corners& c = corners_[cornerOf_[t]];
     const float b0 = std::max(0.0f, 1.0f - b1 - b2);
-    const TexCoord uv{b0 * c.emissiveUv[0].s + b1 * c.emissiveUv[1].s + b2 * c.emissiveUv[2].s,
-                      b0 * c.emissiveUv[0].t + b1 * c.emissiveUv[1].t + b2 * c.emissiveUv[2].t};
-    const TextureSlot& slot = m.emissive;
-    return emissionAt(m, textures_.get(), slot.transform.identity() ? uv : slot.transform.apply(uv));
+    return emissionAt(m, textures_.get(), transformed(m.emissive, interpolated(c.emissiveUv, b0, b1, b2)));
 }
 
 float SurfaceLookup::transmission(uint32_t t, float b1, float b2) const {
     const Material& m = materials_[triangleMaterial_[t]];
-    if (!(m.transmission > 0) || cornerOf_[t] == kUniform || !readsTexture(m.transmissionTexture, textures_.get()))
-        return m.transmission;
+    if (cornerOf_[t] == kUniform) return m.transmission;
     const Corners& c = corners_[cornerOf_[t]];
     const float b0 = std::max(0.0f, 1.0f - b1 - b2);
-    const TexCoord uv{b0 * c.transmissionUv[0].s + b1 * c.transmissionUv[1].s + b2 * c.transmissionUv[2].s,
-                      b0 * c.transmissionUv[0].t + b1 * c.transmissionUv[1].t + b2 * c.transmissionUv[2].t};
-    const TextureSlot& slot = m.transmissionTexture;
-    const Rgba texel = (*textures_)[size_t(slot.texture)].sample(slot.transform.identity() ? uv : slot.transform.apply(uv), false);
-    return m.transmission * texel[0];
+    return transmissionAt(m, textures_.get(), interpolated(c.transmissionUv, b0, b1, b2));
 }
 
 float SurfaceLookup::reflectedShare(uint32_t t, float b1, float b2) const {
