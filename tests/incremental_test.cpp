@@ -14,6 +14,7 @@
 #include "pipeline/frame_solver.h"
 #include "scene/animation.h"
 #include "estimate/final_gather.h"
+#include "scene/back_sides.h"
 #include "test_support.h"
 
 using namespace qsgi;
@@ -240,7 +241,8 @@ TEST(Incremental, ASheetSlidingAHairOverAPlateEqualsFull) {
 
 // Surfaces as an asset gives them (issue 57): the cube a mover with a textured albedo, vertex
 // colours, an alpha-MASK checker cut out of it (so photons, shadow and gather rays pass through
-// its holes) and a transmission of 0.3 (they pass its panes too), the floor textured red and blue
+// its holes), a transmission of 0.3 (they pass its panes too) and doubleSided (its inside, which
+// light reaches through the holes, is lit as its back sides), the floor textured red and blue
 // by halves; the hits' albedo is looked up per texel
 // on both, in the first trace, in every retrace and in the decoded records alike. Every estimator
 // kind, with the paper's method and with exact direct light and a gather.
@@ -259,6 +261,7 @@ TEST(Incremental, ATexturedCutOutMoverEqualsFull) {
                               Material cube;
                               cube.alphaMode = AlphaMode::Mask;
                               cube.transmission = 0.3f;  // and a pane: photons, shadow and gather rays pass its share
+                              cube.doubleSided = true;   // and two-sided: its inside, seen through the cut-outs, is lit
                               std::vector<uint8_t> checker;
                               for (int y = 0; y < 4; ++y)
                                   for (int x = 0; x < 4; ++x) {
@@ -275,6 +278,7 @@ TEST(Incremental, ATexturedCutOutMoverEqualsFull) {
                               s.vertexColours.assign(s.vertexCount(), Rgba{1, 1, 1, 1});
                               for (uint32_t v = s.instances[1].firstVertex; v < s.vertexCount(); ++v)
                                   s.vertexColours[v] = {0.5f + 0.5f * float(v % 2), 1.0f, 0.8f, 1.0f};
+                              addBackSides(s);
                               return s;
                           },
                           "Cube", [](int f) { return slide(f, 0.11, 0.05); }, 4};

@@ -10,7 +10,7 @@ namespace qsgi {
 void fillCoveredFirstPass(const Scene& scene, const std::vector<uint8_t>& covered, std::vector<Vec3f>& firstPass) {
     const size_t n = scene.vertexCount();
     if (std::find(covered.begin(), covered.end(), uint8_t(1)) == covered.end()) return;
-    const MeshTopology topology(scene.positions, scene.triangles);
+    const MeshTopology topology(scene);
     // known[v]: v's value is final — visible, or a covered vertex filled in an earlier ring.
     std::vector<uint8_t> known(n);
     for (size_t v = 0; v < n; ++v) known[v] = !covered[v] && !scene.vertexHidden[v];

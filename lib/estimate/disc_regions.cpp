@@ -340,7 +340,7 @@ std::vector<uint32_t> DiscRegions::compute(const Scene& scene, const SceneBvh& b
             }
     }
     std::vector<uint8_t> changed(vertices.size(), 0);
-    const MeshTopology topology(scene.positions, scene.triangles);
+    const MeshTopology topology(scene);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
     // The tree pays where own surfaces hold many triangles — a dense mesh, where walking them or
     // visiting every triangle near (Embree's point query) is what costs — and costs about what

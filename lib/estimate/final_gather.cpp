@@ -182,12 +182,14 @@ void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const Vert
 
 namespace {
 // The covered-vertex rule on v's cover rays: each meets a back face, or a front face lower above
-// v's tangent plane than the start's cover height (VertexStart::coverHeight).
-bool coveredBy(const GatherHit* hits, uint32_t count, const Vec3f& normal, float coverHeight) {
+// v's tangent plane than the start's cover height (VertexStart::coverHeight). The rule is
+// geometric: the back side of a doubleSided surface (lib/scene/back_sides.h) is its back face,
+// so the inside of a closed doubleSided mesh is covered, as it is without its back sides.
+bool coveredBy(const Scene& scene, const GatherHit* hits, uint32_t count, const Vec3f& normal, float coverHeight) {
     if (count == 0) return false;
     for (uint32_t j = 0; j < count; ++j) {
-        if (hits[j].triangle == GatherHit::kBackFace) continue;
         if (hits[j].triangle == GatherHit::kMiss) return false;
+        if (hits[j].triangle == GatherHit::kBackFace || scene.isBackTriangle(hits[j].triangle)) continue;
         const float height = hits[j].t * dot(FinalGather::rayDirection(hits[j]), normal);
         if (!(height < coverHeight)) return false;
     }
@@ -199,7 +201,7 @@ std::vector<uint8_t> FinalGather::coveredFromKept(const Scene& scene, const Vert
     std::vector<uint8_t> covered(scene.vertexCount(), 0);
     if (rays_ == 0 || probeHits_.empty()) return covered;
     for (uint32_t v = 0; v < covered.size(); ++v)
-        covered[v] = coveredBy(&probeHits_[size_t(v) * probes_], coverRays(), starts.normal(v), starts.coverHeight(v));
+        covered[v] = coveredBy(scene, &probeHits_[size_t(v) * probes_], coverRays(), starts.normal(v), starts.coverHeight(v));
     return covered;
 }
 
@@ -211,7 +213,7 @@ std::vector<uint8_t> FinalGather::castCovered(const Scene& scene, const SceneBvh
         GatherHit hits[kCoverRays];
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             castVertexInto(scene, bvh, starts, frontNormals, v, 0, coverRays(), hits);
-            covered[v] = coveredBy(hits, coverRays(), starts.normal(v), starts.coverHeight(v));
+            covered[v] = coveredBy(scene, hits, coverRays(), starts.normal(v), starts.coverHeight(v));
         }
     });
     return covered;

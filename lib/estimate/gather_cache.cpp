@@ -169,7 +169,7 @@ void GatherCache::select(const Scene& scene, const SceneBvh& bvh, const VertexSt
 
     // Each vertex asks for a record in its cell; each (level, cell, piece, axis) asked for gets
     // the asking vertex nearest the cell's centre.
-    const MeshTopology topology(scene.positions, scene.triangles);
+    const MeshTopology topology(scene);
     const std::vector<uint32_t> pieces = topology.vertexPieces(scene.triangles);
     const Adjacency adjacency(scene, bvh, starts, topology);
     record_.assign(n, 0);

@@ -199,7 +199,7 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
 void VertexStarts::computeAll(const Scene& scene, const SceneBvh& bvh) {
     starts_.assign(scene.vertexCount(), VertexStart{});
     normals_.assign(scene.normals.begin(), scene.normals.end());
-    const MeshTopology topology(scene.positions, scene.triangles);
+    const MeshTopology topology(scene);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 256), [&](const tbb::blocked_range<uint32_t>& r) {
         for (uint32_t v = r.begin(); v != r.end(); ++v) starts_[v] = vertexRayStart(scene, bvh, topology, frontNormals, v);
@@ -228,7 +228,7 @@ std::vector<uint32_t> VertexStarts::update(const Scene& scene, const SceneBvh& b
     });
     std::vector<uint32_t> changed;
     if (std::find(touched.begin(), touched.end(), uint8_t(1)) == touched.end()) return changed;
-    const MeshTopology topology(scene.positions, scene.triangles);
+    const MeshTopology topology(scene);
     const std::vector<Vec3f> frontNormals = scene.frontFaceNormals();
     std::vector<uint8_t> differs(scene.vertexCount(), 0);
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 1024), [&](const tbb::blocked_range<uint32_t>& r) {

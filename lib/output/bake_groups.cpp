@@ -34,7 +34,8 @@ MeshGroups groupNodesByBake(json& doc, const Scene& scene, const BakedFrame& fir
     MeshGroups result;
     // Which nodes show which glTF mesh, in the order the scene placed them.
     std::map<int, MeshUse>& uses = result.uses;
-    for (const MeshInstance& instance : scene.instances) {
+    for (size_t i = 0; i < scene.frontInstanceCount(); ++i) {  // the back sides are the fronts' (back_sides.h)
+        const MeshInstance& instance = scene.instances[i];
         MeshUse& use = uses[instance.mesh];
         auto& list = use.instances[instance.node];
         if (list.empty()) {

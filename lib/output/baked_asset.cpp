@@ -23,7 +23,8 @@ void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const
             if (e == "EXT_meshopt_compression")
                 throw InputError(sceneFile, "extensionsUsed", "has EXT_meshopt_compression, whose buffers --gltf-out cannot repack");
     std::set<int> meshes;
-    for (const MeshInstance& instance : scene.instances) {
+    for (size_t i = 0; i < scene.frontInstanceCount(); ++i) {  // the back sides are the fronts' (back_sides.h)
+        const MeshInstance& instance = scene.instances[i];
         if (instance.mesh < 0) throw InputError(kOption, "", "needs a scene read from a glTF file");
         meshes.insert(instance.mesh);
         const json& primitive = doc["meshes"][size_t(instance.mesh)]["primitives"][size_t(instance.primitive)];
@@ -58,7 +59,7 @@ void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const
         for (const json& buffer : doc["buffers"])
             if (buffer.is_object() && buffer.contains("byteLength") && buffer["byteLength"].is_number_unsigned())
                 declared = saturatingAdd(declared, buffer["byteLength"].get<uint64_t>());
-    const uint64_t atLeast = saturatingAdd(declared, saturatingMultiply(scene.vertexCount(), 2 * sizeof(Vec3f)));
+    const uint64_t atLeast = saturatingAdd(declared, saturatingMultiply(scene.frontVertexCount(), 2 * sizeof(Vec3f)));
     const std::string what = "asset.glb (--gltf-out: the scene's buffers, " + formatBytes(declared) + ", and the bake)";
     if (atLeast > kMaxGlbBytes - 65536)
         throw InputError(sceneFile, "buffers", what + " would be " + formatBytes(atLeast) + " or more, beyond the 4 GiB a GLB file holds");

@@ -218,6 +218,11 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     // three or none.
     const PlyProperty* irradiance[3] = {rows.find("irradiance_r"), rows.find("irradiance_g"), rows.find("irradiance_b")};
     const bool hasIrradiance = irradiance[0] && irradiance[1] && irradiance[2];
+    // The back sides of doubleSided surfaces (since issue 57): all six or none.
+    const PlyProperty* back[6] = {rows.find("back_radiosity_r"),  rows.find("back_radiosity_g"),  rows.find("back_radiosity_b"),
+                                  rows.find("back_irradiance_r"), rows.find("back_irradiance_g"), rows.find("back_irradiance_b")};
+    bool hasBack = true;
+    for (const PlyProperty* p : back) hasBack = hasBack && p;
     const PlyProperty* referenced = rows.find("referenced");
     readFirstElementRows(path, in, elements[0], rows);
     const size_t vertexCount = size_t(elements[0].count);
@@ -227,6 +232,7 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
     out.radiosity.resize(vertexCount);
     if (hasIrradiance) out.irradiance.resize(vertexCount);
     if (referenced) out.referenced.resize(vertexCount);
+    if (hasBack) out.backRadiosity.resize(vertexCount), out.backIrradiance.resize(vertexCount);
     auto asFloat = [&](size_t v, const PlyProperty& p) {
         const double value = rows.value(v, p);
         const float f = float(value);
@@ -243,6 +249,11 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
         if (referenced) out.referenced[v] = rows.value(v, *referenced) != 0;
         if (hasIrradiance)
             for (int c = 0; c < 3; ++c) out.irradiance[v][c] = asFloat(v, *irradiance[c]);
+        if (hasBack)
+            for (int c = 0; c < 3; ++c) {
+                out.backRadiosity[v][c] = asFloat(v, *back[c]);
+                out.backIrradiance[v][c] = asFloat(v, *back[3 + c]);
+            }
     }
 
     // Faces (fanned into triangles), for the edge regions of `qsgi compare`. Elements between the

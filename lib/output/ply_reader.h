@@ -14,6 +14,9 @@ namespace qsgi {
 struct VertexRadiosityPly {
     std::vector<Vec3f> positions, normals, radiosity;
     std::vector<Vec3f> irradiance;    // empty when the file has none (written before issue 35)
+    // The back sides of doubleSided surfaces (back_radiosity_*, back_irradiance_*): empty when the
+    // file has none (a scene without such surfaces, or written before issue 57).
+    std::vector<Vec3f> backRadiosity, backIrradiance;
     std::vector<Triangle> triangles;  // from `element face` (polygons fanned), if present
     // A reference of a vertex subset (scripts/reference.py --vertices N) flags the vertices it
     // computed in a `referenced` property; empty when the file has none (every vertex counts).

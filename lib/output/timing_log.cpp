@@ -31,7 +31,8 @@ std::string TimingLog::text() const {
     j["scene"] = {{"file", pathJson(scene)}, {"vertices", vertices}, {"triangles", triangles},
                   {"dynamic_vertices", dynamicVertices}, {"lights", lights},
                   {"degenerate_triangles", degenerateTriangles}, {"animation_diagonal", animationDiagonal},
-                  {"input_vertices", inputVertices}, {"contact_refinement", contactRefinement},
+                  {"input_vertices", inputVertices}, {"back_side_vertices", backSideVertices},
+                  {"contact_refinement", contactRefinement},
                   {"fit_samples", fitSamples ? nlohmann::json(fitSamples) : nlohmann::json(nullptr)}};
     // Aimed emission's effect (issue 12), from the run's first frame: the share of the lights'
     // power sent toward the scene, and the photons whose first segment still hit nothing.

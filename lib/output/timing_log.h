@@ -26,6 +26,7 @@ struct TimingLog {
     uint64_t vertices = 0, triangles = 0, dynamicVertices = 0, lights = 0;
     uint64_t degenerateTriangles = 0;
     uint64_t inputVertices = 0;  // before --subdivide and --refine-contacts
+    uint64_t backSideVertices = 0;  // the back sides of doubleSided surfaces (lib/scene/back_sides.h)
     // --refine-contacts: the vertices it added and the frames whose poses it judged (null without it).
     nlohmann::json contactRefinement;
     // --vertex-fit least-squares: the sampling mesh's vertices, which the frames are solved on (0 without it).

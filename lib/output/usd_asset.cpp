@@ -259,7 +259,7 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
     std::map<int, size_t> nodeIndex;
     std::vector<NodePlan> nodes;
     std::vector<UniqueNames> meshNames;
-    for (size_t i = 0; i < scene.instances.size(); ++i) {
+    for (size_t i = 0; i < scene.frontInstanceCount(); ++i) {  // the back sides are the fronts' (back_sides.h)
         const MeshInstance& inst = scene.instances[i];
         auto [at, isNew] = nodeIndex.emplace(inst.node, nodes.size());
         if (isNew) {

@@ -28,6 +28,7 @@
 #include "pipeline/frame_solver.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
+#include "scene/back_sides.h"
 #include "scene/contact_refinement.h"
 #include "scene/mesh_refinement.h"
 #include "trace/photon_tracer.h"
@@ -184,9 +185,12 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         if (!sampled)
             refuseRefinement("vertex_fit (--vertex-fit): its samples, edges within R of a contact split to R/2 with R", defaultRadius(scene_),
                              "use --vertex-fit point");
+        addBackSides(*samplingScene_);
         samplingScene_->markDynamic(animation_.movedNodes(), animation_.morphedNodes());
         sweepAnimationBounds(*samplingScene_, animation_);
     }
+    // Last, after every refinement (which would take a back side for a surface touching its front).
+    addBackSides(scene_);
     checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
     if (!settings_.animationPath.empty())
         checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");
@@ -344,9 +348,10 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     log.config["threads"] = settings_.threads > 0 ? settings_.threads
                                                   : int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     log.scene = settings_.scenePath;
-    log.vertices = scene_.vertexCount();
-    log.triangles = scene_.triangleCount();
-    for (uint8_t d : scene_.vertexDynamic) log.dynamicVertices += d;
+    log.vertices = scene_.frontVertexCount();
+    log.triangles = scene_.frontTriangleCount();
+    log.backSideVertices = scene_.vertexCount() - scene_.frontVertexCount();
+    for (size_t v = 0; v < scene_.frontVertexCount(); ++v) log.dynamicVertices += scene_.vertexDynamic[v];
     log.lights = scene_.lights.size();
     log.animationDiagonal = scene_.animationBounds.extent();
     log.inputVertices = inputVertices_;

@@ -42,7 +42,7 @@ std::optional<ContactRefinementReport> refineContacts(Scene& scene, double dista
         anyMoved = true;
     }
     if (anyMoved) scene.applyPose(scene.restPose());
-    const MeshTopology topology(scene.positions, scene.triangles);
+    const MeshTopology topology(scene);
     tracks.pieces = topology.edgeConnectedPieces(scene.triangles);
 
     // Triangles that move in some pose are looked for in each pose; the others once.

@@ -20,13 +20,17 @@ uint32_t positionBits(float x) {
 }
 }  // namespace
 
-MeshTopology::MeshTopology(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles) {
+MeshTopology::MeshTopology(const Scene& scene)
+    : MeshTopology(scene.positions, scene.triangles, uint32_t(scene.frontVertexCount())) {}
+
+MeshTopology::MeshTopology(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles, uint32_t sideFrom) {
     const size_t n = positions.size();
     // Sort vertex indices by position (then index): each run of equal positions is one weld.
     std::vector<uint32_t> order(n);
     std::iota(order.begin(), order.end(), 0u);
     auto place = [&](uint32_t v) {
-        return std::make_tuple(positionBits(positions[v].x), positionBits(positions[v].y), positionBits(positions[v].z));
+        return std::make_tuple(v >= sideFrom, positionBits(positions[v].x), positionBits(positions[v].y),
+                               positionBits(positions[v].z));
     };
     std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
         return std::make_tuple(place(a), a) < std::make_tuple(place(b), b);

@@ -11,10 +11,16 @@
 namespace qsgi {
 
 struct Triangle;
+struct Scene;
 
 class MeshTopology {
 public:
-    MeshTopology(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles);
+    // Vertices from `sideFrom` on weld only among themselves: a scene's back sides
+    // (lib/scene/back_sides.h) lie where their fronts do, but are surfaces of their own.
+    MeshTopology(const std::vector<Vec3f>& positions, const std::vector<Triangle>& triangles,
+                 uint32_t sideFrom = 0xFFFFFFFFu);
+    // The scene's: its back sides apart from their fronts.
+    explicit MeshTopology(const Scene& scene);
 
     // The smallest vertex index at v's position: equal for welded vertices.
     uint32_t weldedId(uint32_t v) const { return welded_[v]; }

@@ -120,6 +120,10 @@ struct MeshInstance {
     // of the file can be refined alike (lib/output/refined_attributes.cpp).
     std::vector<std::pair<uint32_t, uint32_t>> refinedFrom;
 
+    // A back side (addBackSides, lib/scene/back_sides.h): the reversed copy of instance `backOf`,
+    // whose material is doubleSided; -1 for the instances of the file.
+    int backOf = -1;
+
     bool deforms() const { return skin >= 0 || !morphPositions.empty(); }
 };
 
@@ -185,6 +189,24 @@ struct Scene {
     // singular blend puts it. Hidden vertices keep their last finite normal and carry radiosity 0
     // (computeRadiosity).
     std::vector<uint8_t> vertexHidden;
+
+    // The back sides of doubleSided surfaces (issue 57; lib/scene/back_sides.h): each such instance
+    // has a copy with reversed winding and negated normals, appended after every instance of the
+    // file, so that every stage lights its back as a surface of its own. The outputs show the
+    // front vertices and carry the back values beside them. Absent when no surface is doubleSided.
+    struct BackSides {
+        uint32_t firstVertex = 0, firstTriangle = 0, firstInstance = 0;
+        std::vector<uint32_t> backVertex;  // per front vertex: its back side's vertex, or kNone
+        static constexpr uint32_t kNone = 0xFFFFFFFFu;
+    };
+    std::optional<BackSides> backSides;
+    // What the outputs show: the vertices and triangles before the back sides.
+    size_t frontVertexCount() const { return backSides ? backSides->firstVertex : positions.size(); }
+    size_t frontTriangleCount() const { return backSides ? backSides->firstTriangle : triangles.size(); }
+    size_t frontInstanceCount() const { return backSides ? backSides->firstInstance : instances.size(); }
+    // A ray meets the one of a two-sided pair (a doubleSided triangle and its back side) that faces it.
+    bool twoSided(uint32_t tri) const { return backSides && materials[triangleMaterial[tri]].doubleSided; }
+    bool isBackTriangle(uint32_t tri) const { return backSides && tri >= backSides->firstTriangle; }
 
     // Dynamic = under a node the animation moves (docs/design.md §2). Filled by markDynamic.
     std::vector<uint8_t> vertexDynamic;

@@ -48,12 +48,20 @@ namespace {
 // blendStops: BLEND surfaces stop it (transmittance() weighs them itself).
 bool stopsRay(const RTCFilterFunctionNArguments* args, unsigned i, bool blendStops) {
     const auto* pass = static_cast<const PassThrough*>(args->geometryUserPtr);
-    const uint32_t triangle = pass->sceneTriangle[RTCHitN_primID(args->hit, args->N, i)];
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    const uint32_t triangle = pass->sceneTriangle[prim];
+    const Vec3f direction(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                          RTCRayN_dir_z(args->ray, args->N, i));
+    if (!pass->frontAlongNg.empty() && pass->frontAlongNg[prim] != 0) {
+        // One of a two-sided pair: the ray meets the one whose front faces it (at exactly
+        // grazing incidence both, and the tie rule picks).
+        const Vec3f ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
+                       RTCHitN_Ng_z(args->hit, args->N, i));
+        if (float(pass->frontAlongNg[prim]) * dot(direction, ng) > 0) return false;
+    }
     if (!pass->lookup->letsLightThrough(triangle) || (blendStops && pass->lookup->blends(triangle))) return true;
     const Vec3f origin(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
                        RTCRayN_org_z(args->ray, args->N, i));
-    const Vec3f direction(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
-                          RTCRayN_dir_z(args->ray, args->N, i));
     return pass->lookup->stops(triangle, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i),
                                rayChoice(origin, direction, triangle, RayChoice::Blend));
 }
@@ -164,10 +172,14 @@ SceneBvh::Part SceneBvh::addPart(RTCScene target, const Scene& scene, bool dynam
     for (size_t i = 0; i < part.triangles.size(); ++i)
         for (int k = 0; k < 3; ++k) index[3 * i + k] = remap[scene.triangles[part.triangles[i]].v[k]];
     fillVertices(geom, part, scene);
-    bool passes = false;
-    for (uint32_t t : part.triangles) passes = passes || lookup->letsLightThrough(t);
-    if (passes) {
-        part.passThrough = std::make_unique<PassThrough>(PassThrough{lookup, part.triangles});
+    bool passes = false, twoSided = false;
+    for (uint32_t t : part.triangles) {
+        passes = passes || lookup->letsLightThrough(t);
+        twoSided = twoSided || scene.twoSided(t);
+    }
+    if (passes || twoSided) {
+        part.passThrough = std::make_unique<PassThrough>(PassThrough{lookup, part.triangles, {}});
+        if (twoSided) orientTwoSided(*part.passThrough, scene);
         rtcSetGeometryUserData(geom, part.passThrough.get());
         rtcSetGeometryIntersectFilterFunction(geom, passThroughThenLowestPrimitive);
         rtcSetGeometryOccludedFilterFunction(geom, passThroughOccluded);
@@ -178,6 +190,19 @@ SceneBvh::Part SceneBvh::addPart(RTCScene target, const Scene& scene, bool dynam
     part.geomId = rtcAttachGeometry(target, geom);
     rtcReleaseGeometry(geom);  // the scene holds its own reference
     return part;
+}
+
+void SceneBvh::orientTwoSided(PassThrough& pass, const Scene& scene) {
+    pass.frontAlongNg.resize(pass.sceneTriangle.size());
+    for (size_t i = 0; i < pass.sceneTriangle.size(); ++i) {
+        const uint32_t t = pass.sceneTriangle[i];
+        if (!scene.twoSided(t)) continue;
+        // Embree's Ng points out of the CCW side, as the geometric normal does; the front is the
+        // side the vertex normals face (a skinned mesh may turn it: re-read each pose).
+        const Triangle& tri = scene.triangles[t];
+        const Vec3f n = scene.normals[tri.v[0]] + scene.normals[tri.v[1]] + scene.normals[tri.v[2]];
+        pass.frontAlongNg[i] = dot(scene.geometricNormal(t), n) < 0 ? -1 : 1;
+    }
 }
 
 void SceneBvh::fillVertices(RTCGeometry geom, const Part& part, const Scene& scene) {
@@ -194,6 +219,7 @@ void SceneBvh::updateDynamic(const Scene& scene) {
     if (dynamic_.empty()) return;
     RTCGeometry geom = rtcGetGeometry(dynamicScene_.get(), dynamic_.geomId);
     fillVertices(geom, dynamic_, scene);
+    if (dynamic_.passThrough && !dynamic_.passThrough->frontAlongNg.empty()) orientTwoSided(*dynamic_.passThrough, scene);
     rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
     rtcCommitGeometry(geom);
     rtcCommitScene(dynamicScene_.get());

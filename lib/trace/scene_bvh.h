@@ -44,9 +44,16 @@ void lowestPrimitiveOnTies(const RTCFilterFunctionNArguments* args);
 // and a retrace and a first trace, see the same surfaces. A BLEND's choice is a hash of the
 // ray's origin, direction and triangle: each ray decides once and for all, independently of the
 // next.
+//
+// The back side of a doubleSided surface (lib/scene/back_sides.h) is a triangle of its own where
+// its front is: a ray passes the one of the two that turns its back to it, and meets the other.
 struct PassThrough {
     std::shared_ptr<const SurfaceLookup> lookup;
     std::vector<uint32_t> sceneTriangle;  // Embree primID -> scene triangle (the part's)
+    // Per primID: +1 when a two-sided triangle's front (Scene::frontFaceNormals) is the side
+    // Embree's Ng points out of, −1 when it is the other, 0 for a one-sided triangle; empty when
+    // the part has no two-sided triangle.
+    std::vector<int8_t> frontAlongNg;
 };
 // A ray's own choice in [0, 1) at a scene triangle, for one `purpose` (BLEND's, a pane's: two
 // independent numbers for a surface that is both).
@@ -135,6 +142,7 @@ private:
     Part addPart(RTCScene target, const Scene& scene, bool dynamic, RTCBuildQuality quality,
                  const std::shared_ptr<const SurfaceLookup>& lookup);
     void fillVertices(RTCGeometry geom, const Part& part, const Scene& scene);
+    static void orientTwoSided(PassThrough& pass, const Scene& scene);
     void boundDynamic(const Scene& scene);
     std::optional<SurfaceHit> intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
                                             const Vec3f& direction, float tnear, float tfar, bool blendStops) const;

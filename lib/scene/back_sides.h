@@ -1,0 +1,21 @@
+// Both sides of a doubleSided surface (issue 57). glTF's doubleSided says a surface's back is lit
+// and shown as its front with the normal reversed. qsgi gives each such instance a copy with
+// reversed winding and negated normals, its back side, so that every stage — photons, start
+// points, disc regions, direct light, the estimators, the gather, the camera — lights it as a
+// surface of its own, with no rule of its own. Where the two coincide a ray meets the one that
+// faces it (SceneBvh's filters); the mesh topology keeps the two apart (MeshTopology(const
+// Scene&)); and the cover test stays geometric: a ray that meets a back side has met the back of
+// the surface (FinalGather), so the inside of a closed doubleSided mesh is covered and dark.
+#pragma once
+
+#include "scene/scene.h"
+
+namespace qsgi {
+
+// Appends the back sides of every instance whose material is doubleSided, after every instance
+// there is, and sets scene.backSides (left empty when there are none: the scene is unchanged).
+// Called once, after any refinement and before the scene is solved. An emissive material's back
+// emits nothing: glTF's emission, as qsgi's, is the front's (docs/inputs.md).
+void addBackSides(Scene& scene);
+
+}  // namespace qsgi
