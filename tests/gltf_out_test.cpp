@@ -149,6 +149,10 @@ json withoutTheBake(json out, const json& in, int colourSet, bool refined = fals
             const json& before = original["primitives"][p];
             std::vector<std::string> added = {"_RADIANCE", "_IRRADIANCE"};
             if (colourSet >= 0) added.push_back("COLOR_" + std::to_string(colourSet));
+            // A doubleSided material's primitive also carries its back side's values.
+            const bool twoSided = before.contains("material") && in.contains("materials") &&
+                                  in["materials"][before["material"].get<size_t>()].value("doubleSided", false);
+            if (twoSided) added.insert(added.end(), {"_BACK_RADIANCE", "_BACK_IRRADIANCE"});
             for (const std::string& name : added) {
                 EXPECT_TRUE(primitive["attributes"].contains(name)) << name;
                 primitive["attributes"].erase(name);
@@ -266,8 +270,15 @@ size_t expectFramesReadBack(const fs::path& scene, const fs::path& folder, int f
                 const json& attributes = primitive["attributes"];
                 const std::vector<double> radiance = attributes["_RADIANCE"][k].get<std::vector<double>>();
                 const std::vector<double> irradiance = attributes["_IRRADIANCE"][k].get<std::vector<double>>();
-                std::vector<double> colour;
+                std::vector<double> colour, backRadiance, backIrradiance;
                 if (colourSet >= 0) colour = attributes["COLOR_" + std::to_string(colourSet)][k].get<std::vector<double>>();
+                const bool back = attributes.contains("_BACK_RADIANCE");
+                if (back) {
+                    backRadiance = attributes["_BACK_RADIANCE"][k].get<std::vector<double>>();
+                    backIrradiance = attributes["_BACK_IRRADIANCE"][k].get<std::vector<double>>();
+                    EXPECT_EQ(backRadiance.size(), radiance.size());
+                    EXPECT_EQ(ply.backRadiosity.size(), ply.radiosity.size()) << "the PLY has no back columns";
+                }
                 EXPECT_EQ(radiance.size(), 3 * size_t(block->second.count));
                 for (uint32_t v = 0; v < block->second.count && 3 * v + 2 < radiance.size(); ++v)
                     for (int c = 0; c < 3; ++c) {
@@ -284,6 +295,15 @@ size_t expectFramesReadBack(const fs::path& scene, const fs::path& folder, int f
                             EXPECT_NEAR(colour[3 * v + size_t(c)], expected, 1e-6) << "vertex " << i;
                         }
                         compared += 2;
+                        if (back && 3 * v + 2 < backRadiance.size() && i < ply.backRadiosity.size()) {
+                            const double bb = double(ply.backRadiosity[i][c]) / M_PI, bb0 = double(first.backRadiosity[i][c]) / M_PI;
+                            const double be = ply.backIrradiance[i][c], be0 = first.backIrradiance[i][c];
+                            EXPECT_LE(std::fabs(backRadiance[3 * v + size_t(c)] - bb), 0x1p-21 * (std::fabs(bb) + std::fabs(bb0)) + 1e-35)
+                                << "back of vertex " << i;
+                            EXPECT_LE(std::fabs(backIrradiance[3 * v + size_t(c)] - be), 0x1p-21 * (std::fabs(be) + std::fabs(be0)) + 1e-35)
+                                << "back of vertex " << i;
+                            compared += 2;
+                        }
                     }
             }
         EXPECT_EQ(seen.size(), blocks.size()) << "every rendered primitive is read back";

@@ -24,6 +24,9 @@ void AssetSink::finish(OutputDirectory& out, WholeRunReport& report) {
         baked.radiance.resize(ply.radiosity.size());
         for (size_t v = 0; v < ply.radiosity.size(); ++v) baked.radiance[v] = bakedRadiance(ply.radiosity[v]);
         baked.irradiance = std::move(ply.irradiance);
+        baked.backRadiance.resize(ply.backRadiosity.size());
+        for (size_t v = 0; v < ply.backRadiosity.size(); ++v) baked.backRadiance[v] = bakedRadiance(ply.backRadiosity[v]);
+        baked.backIrradiance = std::move(ply.backIrradiance);
         return baked;
     };
     BakedAssetSettings asset = settings_.asset;

@@ -15,8 +15,11 @@ namespace {
 bool sameBake(const BakedFrame& x, const MeshInstance& a, const BakedFrame& y, const MeshInstance& b) {
     if (a.vertexCount != b.vertexCount) return false;
     const size_t bytes = size_t(a.vertexCount) * sizeof(Vec3f);
+    const bool backs = !x.backRadiance.empty() && !y.backRadiance.empty();
     return std::memcmp(&x.radiance[a.firstVertex], &y.radiance[b.firstVertex], bytes) == 0 &&
-           std::memcmp(&x.irradiance[a.firstVertex], &y.irradiance[b.firstVertex], bytes) == 0;
+           std::memcmp(&x.irradiance[a.firstVertex], &y.irradiance[b.firstVertex], bytes) == 0 &&
+           (!backs || (std::memcmp(&x.backRadiance[a.firstVertex], &y.backRadiance[b.firstVertex], bytes) == 0 &&
+                       std::memcmp(&x.backIrradiance[a.firstVertex], &y.backIrradiance[b.firstVertex], bytes) == 0));
 }
 
 size_t primitiveCount(const json& doc, int mesh) { return doc["meshes"][size_t(mesh)]["primitives"].size(); }

@@ -47,6 +47,11 @@ BakeTargets addBakedAttributes(json& doc, BinaryBuilder& bin, const GltfDocument
     size_t& animatedPrimitives = result.animatedPrimitives;
     const AccessorReader reader(document, scene.sourcePath);
     const bool anyAnimated = groups.anyAnimated();
+    // A doubleSided primitive's back values (every vertex of an instance has a back side or none).
+    auto hasBack = [&](const MeshInstance& instance) {
+        return scene.backSides && !first.backRadiance.empty() && instance.vertexCount > 0 &&
+               scene.backSides->backVertex[instance.firstVertex] != Scene::BackSides::kNone;
+    };
     for (size_t k = 0; k < (anyAnimated ? frameCount : 1); ++k) {
         const BakedFrame frame = k == 0 ? first : frameAt(k);
         for (const auto& [mesh, list] : groups.groups)
@@ -75,6 +80,10 @@ BakeTargets addBakedAttributes(json& doc, BinaryBuilder& bin, const GltfDocument
                         }
                         attributes["_RADIANCE"] = bin.addVec3(&frame.radiance[instance->firstVertex], count);
                         attributes["_IRRADIANCE"] = bin.addVec3(&frame.irradiance[instance->firstVertex], count);
+                        if (hasBack(*instance)) {
+                            attributes["_BACK_RADIANCE"] = bin.addVec3(&frame.backRadiance[instance->firstVertex], count);
+                            attributes["_BACK_IRRADIANCE"] = bin.addVec3(&frame.backIrradiance[instance->firstVertex], count);
+                        }
                         if (colour) {
                             std::vector<Vec3f> c(count);
                             for (size_t v = 0; v < count; ++v) c[v] = colourOf(frame.radiance[instance->firstVertex + v]);
@@ -89,19 +98,31 @@ BakeTargets addBakedAttributes(json& doc, BinaryBuilder& bin, const GltfDocument
                         target.irradiance = bin.addZeroVec3(count);
                     } else {
                         std::vector<uint32_t> changed;
-                        std::vector<Vec3f> dRadiance, dIrradiance, dColour;
+                        std::vector<Vec3f> dRadiance, dIrradiance, dColour, dBackRadiance, dBackIrradiance;
+                        const bool back = hasBack(*instance);
                         for (size_t v = 0; v < count; ++v) {
                             const size_t i = instance->firstVertex + v;
-                            if (frame.radiance[i] == first.radiance[i] && frame.irradiance[i] == first.irradiance[i]) continue;
+                            if (frame.radiance[i] == first.radiance[i] && frame.irradiance[i] == first.irradiance[i] &&
+                                (!back || (frame.backRadiance[i] == first.backRadiance[i] &&
+                                           frame.backIrradiance[i] == first.backIrradiance[i])))
+                                continue;
                             changed.push_back(uint32_t(v));
                             dRadiance.push_back(frame.radiance[i] - first.radiance[i]);
                             dIrradiance.push_back(frame.irradiance[i] - first.irradiance[i]);
                             if (colour) dColour.push_back(colourOf(frame.radiance[i]) - colourOf(first.radiance[i]));
+                            if (back) {
+                                dBackRadiance.push_back(frame.backRadiance[i] - first.backRadiance[i]);
+                                dBackIrradiance.push_back(frame.backIrradiance[i] - first.backIrradiance[i]);
+                            }
                         }
                         const int indexView = changed.empty() ? -1 : bin.addView(changed.data(), changed.size() * 4);
                         target.radiance = bin.addSparseVec3(count, changed, dRadiance, indexView);
                         target.irradiance = bin.addSparseVec3(count, changed, dIrradiance, indexView);
                         target.colour = colour ? bin.addSparseVec3(count, changed, dColour, indexView) : -1;
+                        if (back) {
+                            target.backRadiance = bin.addSparseVec3(count, changed, dBackRadiance, indexView);
+                            target.backIrradiance = bin.addSparseVec3(count, changed, dBackIrradiance, indexView);
+                        }
                     }
                     targets[{g.mesh, p}].push_back(target);
                 }
@@ -131,6 +152,7 @@ MorphedMeshes attachTargets(json& doc, const MeshGroups& groups, const BakeTarge
                 for (const BakeTarget& t : made->second) {
                     json target = {{"_RADIANCE", t.radiance}, {"_IRRADIANCE", t.irradiance}};
                     if (t.colour >= 0) target[colourName(colourSet)] = t.colour;
+                    if (t.backRadiance >= 0) target["_BACK_RADIANCE"] = t.backRadiance, target["_BACK_IRRADIANCE"] = t.backIrradiance;
                     if (t.position >= 0) target["POSITION"] = t.position;
                     primitive["targets"].push_back(std::move(target));
                 }

@@ -24,6 +24,7 @@ namespace qsgi {
 // One later frame's target of one primitive, before it is attached to its mesh.
 struct BakeTarget {
     int radiance, irradiance, colour, position;  // accessors (-1: none)
+    int backRadiance = -1, backIrradiance = -1;  // a doubleSided primitive's (lib/scene/back_sides.h)
 };
 
 struct BakeTargets {

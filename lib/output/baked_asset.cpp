@@ -46,7 +46,7 @@ void checkAssetTakesBake(const GltfDocument& document, const Scene& scene, const
     for (const int mesh : meshes) {
         const json& primitives = doc["meshes"][size_t(mesh)]["primitives"];
         for (size_t p = 0; p < primitives.size(); ++p)
-            for (const char* name : {"_RADIANCE", "_IRRADIANCE"})
+            for (const char* name : {"_RADIANCE", "_IRRADIANCE", "_BACK_RADIANCE", "_BACK_IRRADIANCE"})
                 if (primitives[p].contains("attributes") && primitives[p]["attributes"].contains(name))
                     throw InputError(sceneFile, "meshes[" + std::to_string(mesh) + "].primitives[" + std::to_string(p) + "].attributes." + name,
                                      "is already there (a baked asset?): --gltf-out adds it, so bake the original asset");
@@ -109,7 +109,8 @@ std::string encodeBakedAsset(const GltfDocument& document, const Scene& scene, s
     if (doc.contains("extras") && !doc["extras"].is_object())
         warnings.add(file + ": the root's extras is no object, so asset.glb does not record the bake's units and exposure there");
     else
-        doc["extras"]["qsgi"] = {{"units", "_RADIANCE: W m^-2 sr^-1 (B/pi); _IRRADIANCE: W m^-2 (before the albedo)"},
+        doc["extras"]["qsgi"] = {{"units", scene.backSides ? "_RADIANCE, _BACK_RADIANCE: W m^-2 sr^-1 (B/pi); _IRRADIANCE, _BACK_IRRADIANCE: W m^-2 (before the albedo)"
+                                                           : "_RADIANCE: W m^-2 sr^-1 (B/pi); _IRRADIANCE: W m^-2 (before the albedo)"},
                                  {"frames", frameCount},
                                  {"color", settings.colourSet >= 0 ? colourName(settings.colourSet) + " = min(1, exposure * _RADIANCE)" : ""},
                                  {"exposure", settings.exposure}};

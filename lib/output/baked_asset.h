@@ -40,6 +40,9 @@ struct BakedFrame {
     double seconds = 0;             // the animation time the frame shows
     std::vector<Vec3f> radiance;    // B/π
     std::vector<Vec3f> irradiance;  // E
+    // The back sides' (lib/scene/back_sides.h), beside the front vertex: empty when no surface is
+    // doubleSided, 0 at a vertex of a single-sided one.
+    std::vector<Vec3f> backRadiance, backIrradiance;
 };
 
 // A transform file's motion of one node: its local transform at every frame.

@@ -101,6 +101,7 @@ struct NodePlan {
 // A mesh's frames, as one pass over the PLYs reads them: frame-major, the mesh's vertices each.
 struct MeshFrames {
     std::vector<Vec3f> radiance, irradiance;
+    std::vector<Vec3f> backRadiance, backIrradiance;  // a doubleSided mesh's back side (lib/scene/back_sides.h)
     std::vector<Vec3f> points, normals;  // Placement::World only
     std::vector<Transform> transforms;   // Placement::Object only: the node's world transform
 };
@@ -207,6 +208,10 @@ void writeMesh(UsdText& text, const Scene& scene, const MeshPlan& plan, const Me
         writeVertexArray(text, "point3f[]", "points", false, data.points, n, settings, pointsMove);
     else
         writeVertexArray(text, "point3f[]", "points", false, inst.objectPositions, n, settings, false);
+    if (!data.backRadiance.empty()) {
+        writeVertexArray(text, "color3f[]", "primvars:backIrradiance", true, data.backIrradiance, n, settings, true);
+        writeVertexArray(text, "color3f[]", "primvars:backRadiance", true, data.backRadiance, n, settings, true);
+    }
     writeVertexArray(text, "color3f[]", "primvars:irradiance", true, data.irradiance, n, settings, true);
     writeVertexArray(text, "color3f[]", "primvars:radiance", true, data.radiance, n, settings, true);
     text << "            custom int qsgi:firstVertex = " << (long long)inst.firstVertex << "\n";
@@ -311,8 +316,11 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
         for (size_t m = 0; m < nodes[n].meshes.size(); ++m) order.push_back(Ref{n, m});
     auto heldBytes = [&](const Ref& r) {
         const MeshPlan& plan = nodes[r.node].meshes[r.mesh];
-        const uint64_t perFrame = uint64_t(scene.instances[plan.instance].vertexCount) * sizeof(Vec3f) *
-                                  (plan.placement == Placement::World ? 4 : 2) + sizeof(Transform);
+        const MeshInstance& inst = scene.instances[plan.instance];
+        const bool back = scene.backSides && inst.vertexCount > 0 &&
+                          scene.backSides->backVertex[inst.firstVertex] != Scene::BackSides::kNone;
+        const uint64_t perFrame = uint64_t(inst.vertexCount) * sizeof(Vec3f) *
+                                  ((plan.placement == Placement::World ? 4 : 2) + (back ? 2 : 0)) + sizeof(Transform);
         return perFrame * frames;
     };
     size_t passes = 0, points = 0;
@@ -339,6 +347,12 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
                 }
                 for (size_t v = first; v < first + n; ++v) d.radiance.push_back(bakedRadiance(ply.radiosity[v]));
                 d.irradiance.insert(d.irradiance.end(), ply.irradiance.begin() + long(first), ply.irradiance.begin() + long(first + n));
+                if (scene.backSides && !ply.backRadiosity.empty() && n > 0 &&
+                    scene.backSides->backVertex[first] != Scene::BackSides::kNone) {
+                    for (size_t v = first; v < first + n; ++v) d.backRadiance.push_back(bakedRadiance(ply.backRadiosity[v]));
+                    d.backIrradiance.insert(d.backIrradiance.end(), ply.backIrradiance.begin() + long(first),
+                                            ply.backIrradiance.begin() + long(first + n));
+                }
                 if (plan.placement == Placement::World) {
                     d.points.insert(d.points.end(), ply.positions.begin() + long(first), ply.positions.begin() + long(first + n));
                     d.normals.insert(d.normals.end(), ply.normals.begin() + long(first), ply.normals.begin() + long(first + n));

@@ -495,6 +495,7 @@ CHEAP = ["--photons", "20000", "--gather", "16", "--direct-samples", "4", "--no-
 WALKER = os.path.join(REPOSITORY, "data", "walker", "walker.gltf")
 CORNELL = os.path.join(REPOSITORY, "data", "cornell", "cornell.gltf")
 CORNELL_ANIMATION = os.path.join(REPOSITORY, "data", "cornell", "animation.json")
+MATERIALS_ROOM = os.path.join(REPOSITORY, "tests", "data", "materials_room", "materials_room.gltf")
 
 
 def mesh_nodes(gltf):
@@ -569,6 +570,18 @@ class QsgiAssetsReadBack(unittest.TestCase):
         # Time code = frame number, not the frame's index in the run.
         self.render_and_check("cornell-2-4", [CORNELL, "--animation", CORNELL_ANIMATION], (2, 4), rigid=["Block"],
                               nodes=mesh_nodes(CORNELL))
+
+    def test_a_double_sided_card_carries_its_back(self):
+        # The materials room's MASK card is doubleSided: its mesh alone has the back primvars, which
+        # the checker reads against the PLY's back columns as it reads the front's.
+        self.render_and_check("materials-room", [MATERIALS_ROOM, "--sky", "1,1,1"], (0, 0), nodes=mesh_nodes(MATERIALS_ROOM))
+        from pxr import Usd, UsdGeom
+        stage = Usd.Stage.Open(os.path.join(self.scratch, "materials-room", "asset.usda"))
+        with_back = sorted(str(p.GetPath()) for p in stage.Traverse()
+                           if p.IsA(UsdGeom.Mesh) and UsdGeom.PrimvarsAPI(p).GetPrimvar("backRadiance").IsDefined())
+        self.assertEqual(with_back, ["/Scene/MaskCard/MaskCard"])
+        back = UsdGeom.PrimvarsAPI(stage.GetPrimAtPath("/Scene/MaskCard/MaskCard")).GetPrimvar("backIrradiance").Get(0)
+        self.assertGreater(max(max(c) for c in back), 0, "the card's back faces the ceiling panel: it is lit")
 
 
 def main():
