@@ -28,5 +28,5 @@ statistical='DetpBoundary\.(InsideCorner|OpenEdgeOfAFloor|OutsideOfASphere|Floor
 statistical+='|Estimators\.(PaperRuleMatches|PlaneUnderPointLight|ClosedSphereGives|DetpAndPhotonMapAreIndependentOfTessellation)'
 statistical+='|Incremental\.(NoDriftOverTenThousandFrames|RememberedCrossingsLeaveNoTraceAfterAThousandFrames)|Sweep\.TinyGrid|ReferenceAccuracy|GatherAccuracy|FinalGather\.ClosedSphere'
 statistical+='|Sobol\.AgreesWith'
-statistical+='|Materials\.(AClosedSphereWithATexturedAlbedo|TheMaterialsRoomAgreesWith)'
+statistical+='|Materials\.(AClosedSphereWithATexturedAlbedo|TheMaterialsRoomAgreesWith|EachFeatureAgreesWith)'
 ctest --output-on-failure -j 2 -E "$statistical|ValidatorCorpus" "$@"

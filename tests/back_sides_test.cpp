@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "output/ply_reader.h"
+#include "output/ply_writer.h"
 #include "pipeline/frame_solver.h"
 #include "scene/back_sides.h"
 #include "test_support.h"
@@ -134,35 +135,50 @@ TEST(BackSides, ADoubleSidedSheetLitFromBehindEqualsItsMirror) {
 }
 
 // A closed doubleSided sphere (exporters mark materials doubleSided by default) under a point
-// light: its inside is its back, which no light reaches. Every back vertex is covered (the cover
-// test is geometric: a ray meeting a back side meets the back of the surface) and reads 0; the
-// front is lit as it is without its back sides.
+// light: its inside is its back, which no light reaches.
+//  - Opaque, it closes a volume no light enters: no back side is made (it would cost as much as the
+//    front and be 0), and the outputs' back values are 0.
+//  - Cut out by an alpha MASK that happens to keep every point (so light could pass in general),
+//    its back sides are made: every one is covered (the cover test is geometric: a ray meeting a
+//    back side meets the back of the surface) and reads 0.
+// Either way the front is lit as the single-sided sphere's, to the bit: the light reaches it by
+// the same rays, and the photons' bounces off its outside go to infinity alike.
 TEST(BackSides, TheInsideOfAClosedDoubleSidedMeshIsCoveredAndDark) {
-    Scene s = testscenes::closedSphere(0.5f, 3, Vec3f(0.7f), false);
-    giveMaterial(s, 0, Vec3f(0.7f), true);
-    testscenes::addPointLight(s, Vec3f(2.0f, 0.5f, 0.0f), Vec3f(4.0f));
-    Scene single = s;
-    addBackSides(s);
-    ASSERT_TRUE(s.backSides.has_value());
-    const EmbreeDevice device;
-    FrameSolver solver(s, device, twoPassSettings(3));
-    FrameTiming stats;
-    const VertexRadiosity r = solver.solve(s.restPose(), stats);
-    const std::vector<uint8_t> covered = solver.coveredVertices();
-    ASSERT_EQ(covered.size(), s.vertexCount());
-    size_t lit = 0;
-    for (uint32_t v = 0; v < s.frontVertexCount(); ++v) {
-        const uint32_t back = s.backSides->backVertex[v];
-        ASSERT_NE(back, Scene::BackSides::kNone);
-        EXPECT_TRUE(covered[back]) << "back vertex " << back;
-        EXPECT_EQ(r.irradiance[back], Vec3f(0.0f)) << "back vertex " << back;
-        EXPECT_FALSE(covered[v]) << "front vertex " << v;
-        lit += r.irradiance[v].x > 0;
+    for (const bool cutOut : {false, true}) {
+        SCOPED_TRACE(cutOut ? "an alpha-MASK sphere" : "an opaque sphere");
+        Scene s = testscenes::closedSphere(0.5f, 3, Vec3f(0.7f), false);
+        giveMaterial(s, 0, Vec3f(0.7f), true);
+        if (cutOut) s.materials.back().alphaMode = AlphaMode::Mask;  // alpha 1 everywhere: nothing is cut
+        testscenes::addPointLight(s, Vec3f(2.0f, 0.5f, 0.0f), Vec3f(4.0f));
+        Scene single = s;
+        single.materials.back().doubleSided = false;
+        addBackSides(s);
+        ASSERT_TRUE(s.backSides.has_value());
+        const EmbreeDevice device;
+        FrameSolver solver(s, device, twoPassSettings(3));
+        FrameTiming stats;
+        const VertexRadiosity r = solver.solve(s.restPose(), stats);
+        const VertexRadiosity alone = solve(single, 3);
+        ASSERT_EQ(s.frontVertexCount(), single.vertexCount());
+        for (uint32_t v = 0; v < s.frontVertexCount(); ++v) EXPECT_EQ(r.irradiance[v], alone.irradiance[v]) << "vertex " << v;
+        if (!cutOut) {
+            EXPECT_EQ(s.vertexCount(), single.vertexCount()) << "no back side is made for a sealed inside";
+            for (uint32_t back : s.backSides->backVertex) EXPECT_EQ(back, Scene::BackSides::kNone);
+            const std::string ply = encodeVertexRadiosityPly(s, r, PreviewTonemap{});
+            EXPECT_NE(ply.find("property float back_radiosity_r"), std::string::npos) << "the outputs carry the back values";
+            continue;
+        }
+        const std::vector<uint8_t> covered = solver.coveredVertices();
+        ASSERT_EQ(covered.size(), s.vertexCount());
+        size_t lit = 0;
+        for (uint32_t v = 0; v < s.frontVertexCount(); ++v) {
+            const uint32_t back = s.backSides->backVertex[v];
+            ASSERT_NE(back, Scene::BackSides::kNone);
+            EXPECT_TRUE(covered[back]) << "back vertex " << back;
+            EXPECT_EQ(r.irradiance[back], Vec3f(0.0f)) << "back vertex " << back;
+            EXPECT_FALSE(covered[v]) << "front vertex " << v;
+            lit += r.irradiance[v].x > 0;
+        }
+        EXPECT_GT(lit, s.frontVertexCount() / 3);
     }
-    EXPECT_GT(lit, s.frontVertexCount() / 3);
-    // The front is the single-sided sphere's: the light reaches it by the same rays, so the direct
-    // light at every front vertex is the same to the bit (the photons' bounces off the sphere's
-    // outside go to infinity alike).
-    const VertexRadiosity alone = solve(single, 3);
-    for (uint32_t v = 0; v < s.frontVertexCount(); ++v) EXPECT_EQ(r.irradiance[v], alone.irradiance[v]) << "vertex " << v;
 }

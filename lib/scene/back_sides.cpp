@@ -1,10 +1,39 @@
 #include "scene/back_sides.h"
 
+#include <algorithm>
+#include <map>
 #include <stdexcept>
+#include <tuple>
 
 namespace qsgi {
 
 namespace {
+// An instance whose triangles close a volume, each edge (vertices welded by exact position) met by
+// exactly two triangles that run along it in opposite directions, and whose material lets no
+// light through (no cut-out, blend or transmission): no light reaches its inside, whose every
+// cover ray meets a back face there. Its back sides would be 0 by the cover rule; they are not
+// made at all, so they cost nothing.
+bool sealedInside(const Scene& scene, const MeshInstance& inst, const Material& material) {
+    if (material.letsLightThrough() || material.transmission > 0 || inst.triangleCount == 0) return false;
+    std::map<std::tuple<float, float, float>, uint32_t> weld;
+    auto id = [&](uint32_t v) {
+        const Vec3f& p = scene.positions[v];
+        return weld.emplace(std::make_tuple(p.x + 0.0f, p.y + 0.0f, p.z + 0.0f), uint32_t(weld.size())).first->second;
+    };
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;  // directed edge -> how often
+    for (uint32_t t = inst.firstTriangle; t < inst.firstTriangle + inst.triangleCount; ++t) {
+        const Triangle& tri = scene.triangles[t];
+        const uint32_t c[3] = {id(tri.v[0]), id(tri.v[1]), id(tri.v[2])};
+        if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) return false;  // degenerate: not a clean surface
+        for (int k = 0; k < 3; ++k) ++edges[{c[k], c[(k + 1) % 3]}];
+    }
+    for (const auto& [edge, count] : edges) {
+        const auto reverse = edges.find({edge.second, edge.first});
+        if (count != 1 || reverse == edges.end() || reverse->second != 1) return false;
+    }
+    return true;
+}
+
 // The back side's material: the front's, emitting nothing.
 uint32_t backMaterial(Scene& scene, uint32_t front, std::vector<int64_t>& backOf) {
     if (backOf[front] >= 0) return uint32_t(backOf[front]);
@@ -33,7 +62,8 @@ void addBackSides(Scene& scene) {
         if (scene.instances[i].triangleCount == 0) continue;
         const uint32_t frontMaterial = scene.triangleMaterial[scene.instances[i].firstTriangle];
         if (!scene.materials[frontMaterial].doubleSided) continue;
-        any = true;
+        any = true;  // the outputs carry back values, 0 where no back side is made
+        if (sealedInside(scene, scene.instances[i], scene.materials[frontMaterial])) continue;
         const uint32_t material = backMaterial(scene, frontMaterial, materialBack);
         MeshInstance back = scene.instances[i];
         const uint32_t firstFront = back.firstVertex;

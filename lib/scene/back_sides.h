@@ -15,7 +15,9 @@ namespace qsgi {
 // Appends the back sides of every instance whose material is doubleSided, after every instance
 // there is, and sets scene.backSides (left empty when there are none: the scene is unchanged).
 // Called once, after any refinement and before the scene is solved. An emissive material's back
-// emits nothing: glTF's emission, as qsgi's, is the front's (docs/inputs.md).
+// emits nothing: glTF's emission, as qsgi's, is the front's (docs/inputs.md). An instance that
+// closes a volume with an opaque material gets none: its inside, which no light reaches, would
+// be covered and 0 (its outputs' back values are 0 all the same), and costs nothing.
 void addBackSides(Scene& scene);
 
 }  // namespace qsgi

@@ -204,8 +204,10 @@ struct Scene {
     size_t frontVertexCount() const { return backSides ? backSides->firstVertex : positions.size(); }
     size_t frontTriangleCount() const { return backSides ? backSides->firstTriangle : triangles.size(); }
     size_t frontInstanceCount() const { return backSides ? backSides->firstInstance : instances.size(); }
-    // A ray meets the one of a two-sided pair (a doubleSided triangle and its back side) that faces it.
-    bool twoSided(uint32_t tri) const { return backSides && materials[triangleMaterial[tri]].doubleSided; }
+    // One of a two-sided pair (a doubleSided triangle and its back side): a ray meets the one that faces it.
+    bool twoSided(uint32_t tri) const {
+        return backSides && (tri >= backSides->firstTriangle || backSides->backVertex[triangles[tri].v[0]] != BackSides::kNone);
+    }
     bool isBackTriangle(uint32_t tri) const { return backSides && tri >= backSides->firstTriangle; }
 
     // Dynamic = under a node the animation moves (docs/design.md §2). Filled by markDynamic.
