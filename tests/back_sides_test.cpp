@@ -182,3 +182,46 @@ TEST(BackSides, TheInsideOfAClosedDoubleSidedMeshIsCoveredAndDark) {
         EXPECT_GT(lit, s.frontVertexCount() / 3);
     }
 }
+
+// A doubleSided tube open at both ends (testscenes::cubeBesideTube) under a point light: deep
+// inside, its back sides' cover rays meet only its back faces, so they are dark — exactly 0 (they
+// cast no shadow ray, and no gather ray beyond their cover rays: Incremental.ACubeSlidingInto…
+// checks that an update finds the same). Near the open ends rays leave the tube: lit. With the
+// cube slid inside, some cover rays meet its faces: fewer are dark.
+TEST(BackSides, TheDarkInsideOfATubeCastsItsCoverRaysAlone) {
+    Scene s = testscenes::cubeBesideTube(Vec3f(0.7f));
+    testscenes::addPointLight(s, Vec3f(0.4f, 2.0f, 0.3f), Vec3f(20.0f));
+    addBackSides(s);
+    ASSERT_TRUE(s.backSides.has_value());
+    const int cube = 1;  // node "Cube"
+    ASSERT_EQ(s.nodes[size_t(cube)].name, "Cube");
+    s.markDynamic({cube});
+    FrameSolverSettings settings = twoPassSettings(5);
+    settings.lighting.gatherRays = 64;
+    const EmbreeDevice device;
+    size_t darkOutside = 0;
+    for (const double slide : {0.0, 0.9}) {
+        SCOPED_TRACE(slide == 0 ? "the cube outside" : "the cube inside");
+        FrameSolver solver(s, device, settings);
+        std::vector<Transform> locals = s.restLocals();
+        locals[size_t(cube)] = Transform::fromTRS(Vec3d(slide, 0, 0), {0, 0, 0, 1}, Vec3d(1.0)) * locals[size_t(cube)];
+        FrameTiming stats;
+        const VertexRadiosity r = solver.solve(Pose(locals), stats);
+        const std::vector<uint8_t> covered = solver.coveredVertices();
+        size_t dark = 0, litBack = 0;
+        for (uint32_t v = uint32_t(s.frontVertexCount()); v < s.vertexCount(); ++v) {
+            if (covered[v]) {
+                ++dark;
+                EXPECT_EQ(r.irradiance[v], Vec3f(0.0f)) << "dark back vertex " << v;
+            } else {
+                litBack += r.irradiance[v].x > 0;
+            }
+        }
+        EXPECT_GT(dark, (s.vertexCount() - s.frontVertexCount()) / 8) << "the inside is dark (its middle: 123 of 588 measured)";
+        EXPECT_GT(litBack, 0u) << "the open ends are lit";
+        if (slide == 0) darkOutside = dark;
+        else EXPECT_LT(dark, darkOutside) << "the cube's faces meet cover rays inside the tube";
+        std::printf("%s: %zu of %zu back vertices dark, %zu lit\n", slide == 0 ? "cube outside" : "cube inside", dark,
+                    s.vertexCount() - s.frontVertexCount(), litBack);
+    }
+}

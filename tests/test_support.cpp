@@ -304,6 +304,24 @@ Scene boxOnFloor(int floorCells, int cubeCells, Vec3f albedo, float floorHalf) {
     return s;
 }
 
+Scene cubeBesideTube(Vec3f albedo) {
+    Scene s;
+    const uint32_t m = addMaterial(s, albedo);
+    Material tube("tube", albedo);
+    tube.doubleSided = true;
+    s.materials.push_back(tube);
+    const uint32_t t = uint32_t(s.materials.size() - 1);
+    addGrid(s, s.addNode("Floor", Transform()), {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, 16, m);
+    addBoxOnFloor(s, s.addNode("Cube", Transform()), 0.3f, 0.6f, 3, m);
+    const int node = s.addNode("Tube", Transform());
+    addGrid(s, node, {0.5f, 0.85f, 0.4f}, {3, 0, 0}, {0, 0, -0.8f}, 20, 6, t);   // top, +y
+    addGrid(s, node, {0.5f, 0.05f, -0.4f}, {3, 0, 0}, {0, 0, 0.8f}, 20, 6, t);  // bottom, −y
+    addGrid(s, node, {0.5f, 0.05f, 0.4f}, {3, 0, 0}, {0, 0.8f, 0}, 20, 6, t);   // +z
+    addGrid(s, node, {0.5f, 0.85f, -0.4f}, {3, 0, 0}, {0, -0.8f, 0}, 20, 6, t); // −z
+    s.finalize();
+    return s;
+}
+
 Scene slabOnFloor(int floorCells, float half, float height, Vec3f albedo) { return blockOnFloor(floorCells, 1.0f, half, height, 1, albedo); }
 
 Scene blockOnFloor(int floorCells, float floorHalf, float blockHalf, float height, int blockCells, Vec3f albedo) {

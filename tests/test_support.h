@@ -120,6 +120,11 @@ qsgi::Scene plateAndSliver(float half, int cells, float width, float offset, qsg
 // floor, placed by `placement` (a tilt makes every height rounding noise), with a 0.1 m box of
 // 8 cells a face standing on it off-centre.
 qsgi::Scene tiledFloor(int tiles, int cells, const qsgi::Transform& placement, qsgi::Vec3f albedo);
+// boxOnFloor(16, 3, albedo) ("Floor", "Cube") and a static square tube ("Tube") along x, open at
+// both ends, doubleSided (its back sides not yet made): x in [0.5, 3.5], y in [0.05, 0.85], z in
+// [−0.4, 0.4], four walls facing out, 20 x 6 cells each. The cube slid by +0.9 along x stands
+// inside it, through its bottom wall.
+qsgi::Scene cubeBesideTube(qsgi::Vec3f albedo);
 void addPointLight(qsgi::Scene& s, qsgi::Vec3f position, qsgi::Vec3f intensity);
 // Materials as an asset gives them (issue 57), for scenes built in code: `material` reading a
 // texture of `width` x `height` RGBA8 pixels (`rgba`, top row first) through TEXCOORD_0, added

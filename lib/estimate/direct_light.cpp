@@ -166,14 +166,16 @@ Vec3f DirectLight::vertexIrradiance(const Scene& scene, const SceneBvh& bvh, con
     return Vec3f(sum);
 }
 
-void DirectLight::computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
+void DirectLight::computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress,
+                             const std::vector<uint8_t>* dark) {
     readEmitters(scene);
     irradiance_.assign(scene.vertexCount(), Vec3f(0.0f));
     if (progress) progress->setTotal(scene.vertexCount());
     std::atomic<uint64_t> rays{0};
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
         uint64_t cast = 0;
-        for (uint32_t v = r.begin(); v != r.end(); ++v) irradiance_[v] = vertexIrradiance(scene, bvh, starts, v, cast);
+        for (uint32_t v = r.begin(); v != r.end(); ++v)
+            irradiance_[v] = dark && (*dark)[v] ? Vec3f(0.0f) : vertexIrradiance(scene, bvh, starts, v, cast);
         rays += cast;
         if (progress) progress->add(r.size());
     });
@@ -181,12 +183,15 @@ void DirectLight::computeAll(const Scene& scene, const SceneBvh& bvh, const Vert
 }
 
 void DirectLight::recompute(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
-                            const std::vector<uint32_t>& vertices) {
+                            const std::vector<uint32_t>& vertices, const std::vector<uint8_t>* dark) {
     irradiance_.resize(scene.vertexCount(), Vec3f(0.0f));
     std::atomic<uint64_t> rays{0};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, vertices.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
         uint64_t cast = 0;
-        for (size_t i = r.begin(); i != r.end(); ++i) irradiance_[vertices[i]] = vertexIrradiance(scene, bvh, starts, vertices[i], cast);
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            const uint32_t v = vertices[i];
+            irradiance_[v] = dark && (*dark)[v] ? Vec3f(0.0f) : vertexIrradiance(scene, bvh, starts, v, cast);
+        }
         rays += cast;
     });
     raysCast_ = rays.load();

@@ -38,10 +38,14 @@ class DirectLight {
 public:
     DirectLight(uint32_t samples, uint64_t seed) : samples_(samples), seed_(seed) {}
 
-    // Every vertex, for the scene's current pose (bvh holds it). Reads the emitters anew.
-    void computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress = nullptr);
+    // Every vertex, for the scene's current pose (bvh holds it). Reads the emitters anew. Vertices
+    // flagged in `dark` (if given: the dark back sides, FinalGather::darkBackSides) get 0 and cast
+    // nothing, as hidden ones.
+    void computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress = nullptr,
+                    const std::vector<uint8_t>* dark = nullptr);
     // The given vertices only, with the emitters as computeAll() last read them.
-    void recompute(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint32_t>& vertices);
+    void recompute(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const std::vector<uint32_t>& vertices,
+                   const std::vector<uint8_t>* dark = nullptr);
     // Vertices (increasing) one of whose shadow segments meets one of `boxes`.
     std::vector<uint32_t> raysMeeting(const Scene& scene, const VertexStarts& starts, const std::vector<Bounds3f>& boxes) const;
 

@@ -68,6 +68,23 @@ private:
 
 Vec3f FinalGather::rayDirection(const GatherHit& hit) { return decodeOctahedral(hit.octU, hit.octV); }
 
+namespace {
+// The covered-vertex rule on v's cover rays: each meets a back face, or a front face lower above
+// v's tangent plane than the start's cover height (VertexStart::coverHeight). The rule is
+// geometric: the back side of a doubleSided surface (lib/scene/back_sides.h) is its back face,
+// so the inside of a closed doubleSided mesh is covered, as it is without its back sides.
+bool coveredBy(const Scene& scene, const GatherHit* hits, uint32_t count, const Vec3f& normal, float coverHeight) {
+    if (count == 0) return false;
+    for (uint32_t j = 0; j < count; ++j) {
+        if (hits[j].triangle == GatherHit::kMiss) return false;
+        if (hits[j].triangle == GatherHit::kBackFace || scene.isBackTriangle(hits[j].triangle)) continue;
+        const float height = hits[j].t * dot(FinalGather::rayDirection(hits[j]), normal);
+        if (!(height < coverHeight)) return false;
+    }
+    return true;
+}
+}  // namespace
+
 GatherHit FinalGather::castRay(const SceneBvh& bvh, const std::vector<Vec3f>& frontNormals, const Vec3f& origin,
                                const Vec3f& direction) const {
     GatherHit out;
@@ -95,13 +112,35 @@ void FinalGather::castVertexInto(const Scene& scene, const SceneBvh& bvh, const 
     }
     const Directions direction(starts, v, seed_);
     const Vec3f origin = starts.point(v);
+    // A dark back side casts its cover rays alone (darkBackSide): the rest are left as misses.
+    const uint32_t cover = coverRays();
+    const bool back = scene.isBackVertex(v) && cover > 0;
+    bool dark = back && first >= cover && darkBackSide(scene, starts, v, &probeHits_[size_t(v) * probes_]);
     for (uint32_t j = 0; j < count; ++j) {
+        if (dark) {
+            hits[j] = GatherHit{};
+            continue;
+        }
         uint16_t u, w;
         encodeOctahedral(direction(first + j), u, w);
         hits[j] = castRay(bvh, frontNormals, origin, decodeOctahedral(u, w));
         hits[j].octU = u;
         hits[j].octV = w;
+        if (back && first == 0 && j + 1 == cover) dark = darkBackSide(scene, starts, v, hits);
     }
+}
+
+bool FinalGather::darkBackSide(const Scene& scene, const VertexStarts& starts, uint32_t v, const GatherHit* cover) const {
+    return scene.isBackVertex(v) && coveredBy(scene, cover, coverRays(), starts.normal(v), starts.coverHeight(v));
+}
+
+std::vector<uint8_t> FinalGather::darkBackSides(const Scene& scene, const VertexStarts& starts,
+                                                const std::vector<uint8_t>& covered) const {
+    std::vector<uint8_t> dark(scene.vertexCount(), 0);
+    if (!scene.backSides || rays_ == 0) return dark;
+    for (uint32_t v = uint32_t(scene.frontVertexCount()); v < dark.size(); ++v)
+        dark[v] = covered.empty() ? darkBackSide(scene, starts, v, &probeHits_[size_t(v) * probes_]) : covered[v];
+    return dark;
 }
 
 void FinalGather::castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
@@ -180,22 +219,6 @@ void FinalGather::setRecords(const Scene& scene, const SceneBvh& bvh, const Vert
     raysCast_ += uint64_t(added.size()) * rest;
 }
 
-namespace {
-// The covered-vertex rule on v's cover rays: each meets a back face, or a front face lower above
-// v's tangent plane than the start's cover height (VertexStart::coverHeight). The rule is
-// geometric: the back side of a doubleSided surface (lib/scene/back_sides.h) is its back face,
-// so the inside of a closed doubleSided mesh is covered, as it is without its back sides.
-bool coveredBy(const Scene& scene, const GatherHit* hits, uint32_t count, const Vec3f& normal, float coverHeight) {
-    if (count == 0) return false;
-    for (uint32_t j = 0; j < count; ++j) {
-        if (hits[j].triangle == GatherHit::kMiss) return false;
-        if (hits[j].triangle == GatherHit::kBackFace || scene.isBackTriangle(hits[j].triangle)) continue;
-        const float height = hits[j].t * dot(FinalGather::rayDirection(hits[j]), normal);
-        if (!(height < coverHeight)) return false;
-    }
-    return true;
-}
-}  // namespace
 
 std::vector<uint8_t> FinalGather::coveredFromKept(const Scene& scene, const VertexStarts& starts) const {
     std::vector<uint8_t> covered(scene.vertexCount(), 0);
@@ -248,6 +271,27 @@ struct BoxAhead {
     }
 };
 
+// Whether the kept ray `hit` (leaving `origin` along its kept direction) meets one of `ahead`.
+bool meetsAhead(const Vec3f& origin, const std::vector<BoxAhead>& ahead, const GatherHit& hit) {
+    const Vec3f along = octahedralUnnormalised(hit.octU, hit.octV);
+    bool mayMeet = false;
+    for (const BoxAhead& box : ahead)
+        if ((mayMeet = box.mayMeet(along, hit.t))) break;
+    if (!mayMeet) return false;
+    const Vec3f d = FinalGather::rayDirection(hit);
+    for (const BoxAhead& box : ahead) {
+        double t0 = 0, t1 = double(hit.t);
+        if (box.box->clip(origin, d, t0, t1)) return true;
+    }
+    return false;
+}
+
+bool anyMeetsAhead(const Vec3f& origin, const std::vector<BoxAhead>& ahead, const GatherHit* hits, size_t count) {
+    for (size_t j = 0; j < count; ++j)
+        if (meetsAhead(origin, ahead, hits[j])) return true;
+    return false;
+}
+
 // Re-casts the rays of `hits` (leaving `origin`, each along its kept direction) whose segment
 // meets one of `ahead`; returns how many.
 template <typename Cast>
@@ -255,18 +299,8 @@ uint64_t recastSpanMeeting(const Vec3f& origin, const std::vector<BoxAhead>& ahe
                            Cast&& castRay) {
     uint64_t recast = 0;
     for (size_t j = 0; j < count; ++j) {
-        const Vec3f along = octahedralUnnormalised(hits[j].octU, hits[j].octV);
-        bool mayMeet = false;
-        for (const BoxAhead& box : ahead)
-            if ((mayMeet = box.mayMeet(along, hits[j].t))) break;
-        if (!mayMeet) continue;
+        if (!meetsAhead(origin, ahead, hits[j])) continue;
         const Vec3f d = FinalGather::rayDirection(hits[j]);
-        bool meets = false;
-        for (const BoxAhead& box : ahead) {
-            double t0 = 0, t1 = double(hits[j].t);
-            if ((meets = box.box->clip(origin, d, t0, t1))) break;
-        }
-        if (!meets) continue;
         const uint16_t u = hits[j].octU, w = hits[j].octV;
         hits[j] = castRay(d);
         hits[j].octU = u;
@@ -301,6 +335,17 @@ uint64_t FinalGather::recastMeeting(const Scene& scene, const SceneBvh& bvh, con
                     if (reach >= 0) ahead.emplace_back(&box, origin);
                 }
                 if (ahead.empty()) continue;
+                if (scene.isBackVertex(v)) {
+                    // A back side's darkness rests on its cover rays (darkBackSide): one whose rays
+                    // meet a mover is cast again whole, as castAll would cast it.
+                    const bool rest = cached() && restSlot_[v] != kNoSlot;
+                    if (anyMeetsAhead(origin, ahead, &probeHits_[size_t(v) * probes_], probes_) ||
+                        (rest && anyMeetsAhead(origin, ahead, restOf(v), rays_ - probes_))) {
+                        castVertex(scene, bvh, starts, frontNormals, v);
+                        count += rest ? rays_ : probes_;
+                    }
+                    continue;
+                }
                 auto recastAlong = [&](const Vec3f& d) { return castRay(bvh, frontNormals, origin, d); };
                 count += recastSpanMeeting(origin, ahead, &probeHits_[size_t(v) * probes_], probes_, recastAlong);
                 if (cached() && restSlot_[v] != kNoSlot)

@@ -113,6 +113,13 @@ public:
     uint32_t coverRays() const { return std::min({rays_, probes_, kCoverRays}); }
     std::vector<uint8_t> coveredFromKept(const Scene& scene, const VertexStarts& starts) const;
     std::vector<uint8_t> castCovered(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts) const;
+    // The dark back sides (lib/scene/back_sides.h): back vertices that are covered — the inside of
+    // a closed or tube-like doubleSided mesh, whose cover rays meet its back faces. They are 0:
+    // a dark one casts its cover rays alone (its other rays are kept as misses, and a re-cast
+    // that reaches it casts it whole), and direct light skips it. From the kept probes, or, given
+    // `covered` (castCovered's, for castAndGather), from that.
+    std::vector<uint8_t> darkBackSides(const Scene& scene, const VertexStarts& starts,
+                                       const std::vector<uint8_t>& covered = {}) const;
 
     uint32_t raysPerVertex() const { return rays_; }
     uint32_t probeRays() const { return probes_; }
@@ -148,6 +155,7 @@ private:
                         const std::vector<Vec3f>& frontNormals, uint32_t v, uint32_t first, uint32_t count,
                         GatherHit* hits) const;
     // Every kept ray of v.
+    bool darkBackSide(const Scene& scene, const VertexStarts& starts, uint32_t v, const GatherHit* cover) const;
     void castVertex(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
                     const std::vector<Vec3f>& frontNormals, uint32_t v);
     // A record's hits after its probes.

@@ -29,31 +29,48 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const Verte
                             VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress, bool keepForUpdates) {
     Stopwatch clock;
     starts_.computeAll(scene, bvh);
-    if (progress) progress->start("direct", scene.vertexCount());
-    direct_.computeAll(scene, bvh, starts_, progress);
-    stats.directSeconds = clock.seconds();
-    stats.shadowRays = direct_.raysCast();
-    clock.restart();
+    double startsSeconds = clock.seconds();
+    // The gather's rays first: their cover rays tell the dark back sides, which direct light skips.
+    auto direct = [&] {
+        Stopwatch directClock;
+        if (progress) progress->start("direct", scene.vertexCount());
+        direct_.computeAll(scene, bvh, starts_, progress, dark_.empty() ? nullptr : &dark_);
+        stats.directSeconds = startsSeconds + directClock.seconds();
+        stats.shadowRays = direct_.raysCast();
+    };
+    dark_.clear();
     if (settings_.gathers() && !keepForUpdates && !cache_) {
+        clock.restart();
         if (progress) progress->start("gathering", scene.vertexCount());
         // castAndGather keeps no hit: the rays that tell covered vertices are cast first.
         covered_ = gather_.castCovered(scene, bvh, starts_);
+        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts_, covered_);
+        double gatherSeconds = clock.seconds();
+        direct();
+        clock.restart();
         const FirstPassValues first = firstPass(scene, photons);
         gather_.castAndGather(scene, bvh, starts_, first.view(covered_), out.irradiance, progress);
+        zeroDark(out.irradiance);
         stats.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
         addDirect(scene, out);
-        stats.gatherSeconds = clock.seconds();
+        stats.gatherSeconds = gatherSeconds + clock.seconds();
         solved_ = false;  // nothing kept to update
         return;
     }
+    double gatherSeconds = 0;
     if (settings_.gathers()) {
+        clock.restart();
         if (progress) progress->start("gathering", scene.vertexCount());
         gather_.castAll(scene, bvh, starts_, progress);
         placeRecords(scene, bvh, stats, progress);
         stats.gatherRays = gather_.raysCast();
+        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts_);
+        gatherSeconds = clock.seconds();
     }
+    direct();
+    clock.restart();
     combine(scene, photons, out);
-    stats.gatherSeconds = clock.seconds();
+    stats.gatherSeconds = gatherSeconds + clock.seconds();
     // Without a gather nothing grows with M: the state stays for updates either way.
     solved_ = keepForUpdates || !settings_.gathers();
     if (!solved_) gather_.clear();
@@ -69,16 +86,10 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Move
     for (const Bounds3f& b : moved.bounds)
         if (!b.empty()) boxes.push_back(b.expanded(margin));
     const std::vector<uint32_t> newStarts = starts_.update(scene, bvh, moved.bounds, moved.vertexMoved);
-    // Lights are static (an emissive mover is refused, docs/design.md §2): the emitters read at the
-    // first solve stand.
-    std::vector<uint32_t> vertices = direct_.raysMeeting(scene, starts_, boxes);
-    vertices.insert(vertices.end(), newStarts.begin(), newStarts.end());
-    std::sort(vertices.begin(), vertices.end());
-    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-    direct_.recompute(scene, bvh, starts_, vertices);
-    stats.directSeconds = clock.seconds();
-    stats.shadowRays = direct_.raysCast();
+    const double startsSeconds = clock.seconds();
     clock.restart();
+    // The gather first, as solve(): which back sides are dark may change with the move.
+    const std::vector<uint8_t> darkBefore = dark_;
     if (settings_.gathers()) {
         gather_.resetRayCount();
         gather_.cast(scene, bvh, starts_, newStarts);
@@ -87,9 +98,24 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Move
         gather_.recastMeeting(scene, bvh, starts_, boxes, skip);
         placeRecords(scene, bvh, stats);
         stats.gatherRays = gather_.raysCast();
+        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts_);
     }
+    const double gatherSeconds = clock.seconds();
+    clock.restart();
+    // Lights are static (an emissive mover is refused, docs/design.md §2): the emitters read at the
+    // first solve stand.
+    std::vector<uint32_t> vertices = direct_.raysMeeting(scene, starts_, boxes);
+    vertices.insert(vertices.end(), newStarts.begin(), newStarts.end());
+    for (uint32_t v = 0; v < dark_.size(); ++v)
+        if ((darkBefore.empty() ? 0 : darkBefore[v]) != dark_[v]) vertices.push_back(v);
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    direct_.recompute(scene, bvh, starts_, vertices, dark_.empty() ? nullptr : &dark_);
+    stats.directSeconds = startsSeconds + clock.seconds();
+    stats.shadowRays = direct_.raysCast();
+    clock.restart();
     combine(scene, photons, out);
-    stats.gatherSeconds = clock.seconds();
+    stats.gatherSeconds = gatherSeconds + clock.seconds();
 }
 
 TwoPassLighting::FirstPassValues TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons) {
@@ -116,6 +142,14 @@ TwoPassLighting::FirstPassValues TwoPassLighting::firstPass(const Scene& scene, 
     return first;
 }
 
+void TwoPassLighting::zeroDark(std::vector<Vec3f>& gathered) const {
+    // A dark back side is 0 by the cover rule, though its cover rays may meet back sides that
+    // photons reached (through a tube's open ends), and the cache would interpolate it from its
+    // lit neighbours.
+    for (uint32_t v = 0; v < dark_.size(); ++v)
+        if (dark_[v]) gathered[v] = Vec3f(0.0f);
+}
+
 void TwoPassLighting::addDirect(const Scene& scene, VertexRadiosity& out) const {
     const std::vector<Vec3f>& direct = direct_.irradiance();
     for (size_t v = 0; v < scene.vertexCount(); ++v) out.irradiance[v] = direct[v] + out.irradiance[v];
@@ -131,6 +165,7 @@ void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons
         const FirstPassValues first = firstPass(scene, photons);
         gather_.gather(scene, first.view(covered_), out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);
+        zeroDark(out.irradiance);
         addDirect(scene, out);
         return;
     }

@@ -69,6 +69,8 @@ private:
         }
     };
     FirstPassValues firstPass(const Scene& scene, const VertexRadiosity& photons);
+    // The gathered mean at the dark back sides (dark_) set to 0.
+    void zeroDark(std::vector<Vec3f>& gathered) const;
     // E = D + the gathered mean, and B.
     void addDirect(const Scene& scene, VertexRadiosity& out) const;
     // With the cache: the records for the current pose, and the rest of their rays.
@@ -80,6 +82,7 @@ private:
     FinalGather gather_;
     std::optional<GatherCache> cache_;  // with --gather-cache A
     std::vector<uint8_t> covered_;
+    std::vector<uint8_t> dark_;  // the dark back sides (FinalGather::darkBackSides); empty without back sides
     std::optional<SurfaceLookup> surfaces_;  // made at the first solve (materials never change)
     bool solved_ = false;
 };

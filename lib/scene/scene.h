@@ -209,6 +209,7 @@ struct Scene {
         return backSides && (tri >= backSides->firstTriangle || backSides->backVertex[triangles[tri].v[0]] != BackSides::kNone);
     }
     bool isBackTriangle(uint32_t tri) const { return backSides && tri >= backSides->firstTriangle; }
+    bool isBackVertex(uint32_t v) const { return backSides && v >= backSides->firstVertex; }
 
     // Dynamic = under a node the animation moves (docs/design.md §2). Filled by markDynamic.
     std::vector<uint8_t> vertexDynamic;
