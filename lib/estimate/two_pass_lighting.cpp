@@ -48,7 +48,7 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const Verte
         double gatherSeconds = clock.seconds();
         direct();
         clock.restart();
-        const FirstPassValues first = firstPass(scene, photons);
+        const FirstPassValues first = firstPass(scene, bvh, photons);
         gather_.castAndGather(scene, bvh, starts_, first.view(covered_), out.irradiance, progress);
         zeroDark(out.irradiance);
         stats.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
@@ -69,7 +69,7 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const Verte
     }
     direct();
     clock.restart();
-    combine(scene, photons, out);
+    combine(scene, bvh, photons, out);
     stats.gatherSeconds = gatherSeconds + clock.seconds();
     // Without a gather nothing grows with M: the state stays for updates either way.
     solved_ = keepForUpdates || !settings_.gathers();
@@ -114,18 +114,18 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Move
     stats.directSeconds = startsSeconds + clock.seconds();
     stats.shadowRays = direct_.raysCast();
     clock.restart();
-    combine(scene, photons, out);
+    combine(scene, bvh, photons, out);
     stats.gatherSeconds = gatherSeconds + clock.seconds();
 }
 
-TwoPassLighting::FirstPassValues TwoPassLighting::firstPass(const Scene& scene, const VertexRadiosity& photons) {
-    if (!surfaces_) surfaces_.emplace(scene);
+TwoPassLighting::FirstPassValues TwoPassLighting::firstPass(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons) {
+    const SurfaceLookup& surfaces = bvh.surfaces();
     const std::vector<Vec3f>& direct = direct_.irradiance();
     FirstPassValues first;
     first.solved.resize(scene.vertexCount());
-    const bool varies = surfaces_->any();
+    const bool varies = surfaces.any();
     if (varies) {
-        first.surfaces = &*surfaces_;
+        first.surfaces = &surfaces;
         first.solvedIrradiance.resize(scene.vertexCount());
     }
     for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
@@ -156,13 +156,13 @@ void TwoPassLighting::addDirect(const Scene& scene, VertexRadiosity& out) const 
     computeRadiosity(scene, out);
 }
 
-void TwoPassLighting::combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out) {
+void TwoPassLighting::combine(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons, VertexRadiosity& out) {
     const std::vector<Vec3f>& direct = direct_.irradiance();
     const size_t n = scene.vertexCount();
     out.irradiance.resize(n);
     if (settings_.gathers()) {
         covered_ = gather_.coveredFromKept(scene, starts_);
-        const FirstPassValues first = firstPass(scene, photons);
+        const FirstPassValues first = firstPass(scene, bvh, photons);
         gather_.gather(scene, first.view(covered_), out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);
         zeroDark(out.irradiance);

@@ -57,7 +57,7 @@ public:
     const std::vector<uint8_t>& covered() const { return covered_; }
 
 private:
-    void combine(const Scene& scene, const VertexRadiosity& photons, VertexRadiosity& out);
+    void combine(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons, VertexRadiosity& out);
     // What the gather reads of the first pass: F_u = ρ_u (D_u + I_u), 0 at hidden vertices, as
     // solved and with the covered vertices' (covered_) stand-ins (fillCoveredFirstPass), which
     // the rays of every other vertex read; where an albedo varies over a triangle, D + I alike.
@@ -68,7 +68,7 @@ private:
             return {filled, solved, covered, surfaces, &filledIrradiance, &solvedIrradiance};
         }
     };
-    FirstPassValues firstPass(const Scene& scene, const VertexRadiosity& photons);
+    FirstPassValues firstPass(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons);
     // The gathered mean at the dark back sides (dark_) set to 0.
     void zeroDark(std::vector<Vec3f>& gathered) const;
     // E = D + the gathered mean, and B.
@@ -83,7 +83,6 @@ private:
     std::optional<GatherCache> cache_;  // with --gather-cache A
     std::vector<uint8_t> covered_;
     std::vector<uint8_t> dark_;  // the dark back sides (FinalGather::darkBackSides); empty without back sides
-    std::optional<SurfaceLookup> surfaces_;  // made at the first solve (materials never change)
     bool solved_ = false;
 };
 

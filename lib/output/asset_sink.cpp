@@ -18,7 +18,7 @@ void AssetSink::finish(OutputDirectory& out, WholeRunReport& report) {
     auto frameAt = [&](size_t k) {
         if (k == 0 && firstFrame) return *firstFrame;
         const int frame = settings_.first + int(k);
-        VertexRadiosityPly ply = readFramePly(out, frame, scene_.frontVertexCount());
+        VertexRadiosityPly ply = readFramePly(out, frame, scene_);
         BakedFrame baked;
         baked.seconds = fps > 0 ? frame / fps : 0;
         baked.radiance.resize(ply.radiosity.size());

@@ -47,11 +47,8 @@ BakeTargets addBakedAttributes(json& doc, BinaryBuilder& bin, const GltfDocument
     size_t& animatedPrimitives = result.animatedPrimitives;
     const AccessorReader reader(document, scene.sourcePath);
     const bool anyAnimated = groups.anyAnimated();
-    // A doubleSided primitive's back values (every vertex of an instance has a back side or none).
-    auto hasBack = [&](const MeshInstance& instance) {
-        return scene.backSides && !first.backRadiance.empty() && instance.vertexCount > 0 &&
-               scene.backSides->backVertex[instance.firstVertex] != Scene::BackSides::kNone;
-    };
+    // A doubleSided primitive's back values.
+    auto hasBack = [&](const MeshInstance& instance) { return !first.backRadiance.empty() && scene.showsBack(instance); };
     for (size_t k = 0; k < (anyAnimated ? frameCount : 1); ++k) {
         const BakedFrame frame = k == 0 ? first : frameAt(k);
         for (const auto& [mesh, list] : groups.groups)

@@ -17,8 +17,9 @@ inline Vec3f bakedRadiance(const Vec3f& radiosity) { return radiosity * float(1 
 
 class OutputDirectory;
 
-// Frame `frame`'s PLY in the folder. Throws InputError naming it unless it holds `vertexCount`
-// vertices with irradiance (an older qsgi wrote none).
-VertexRadiosityPly readFramePly(const OutputDirectory& folder, int frame, size_t vertexCount);
+// Frame `frame`'s PLY in the folder. Throws InputError naming it unless it holds the scene's
+// (front) vertices with irradiance (an older qsgi wrote none), and back-side values exactly when
+// the scene has back sides (lib/scene/back_sides.h; an older qsgi wrote none).
+VertexRadiosityPly readFramePly(const OutputDirectory& folder, int frame, const Scene& scene);
 
 }  // namespace qsgi

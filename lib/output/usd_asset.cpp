@@ -317,8 +317,7 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
     auto heldBytes = [&](const Ref& r) {
         const MeshPlan& plan = nodes[r.node].meshes[r.mesh];
         const MeshInstance& inst = scene.instances[plan.instance];
-        const bool back = scene.backSides && inst.vertexCount > 0 &&
-                          scene.backSides->backVertex[inst.firstVertex] != Scene::BackSides::kNone;
+        const bool back = scene.showsBack(inst);
         const uint64_t perFrame = uint64_t(inst.vertexCount) * sizeof(Vec3f) *
                                   ((plan.placement == Placement::World ? 4 : 2) + (back ? 2 : 0)) + sizeof(Transform);
         return perFrame * frames;
@@ -347,8 +346,7 @@ void writeUsdAsset(const Scene& scene, const UsdAssetSettings& settings,
                 }
                 for (size_t v = first; v < first + n; ++v) d.radiance.push_back(bakedRadiance(ply.radiosity[v]));
                 d.irradiance.insert(d.irradiance.end(), ply.irradiance.begin() + long(first), ply.irradiance.begin() + long(first + n));
-                if (scene.backSides && !ply.backRadiosity.empty() && n > 0 &&
-                    scene.backSides->backVertex[first] != Scene::BackSides::kNone) {
+                if (!ply.backRadiosity.empty() && scene.showsBack(inst)) {
                     for (size_t v = first; v < first + n; ++v) d.backRadiance.push_back(bakedRadiance(ply.backRadiosity[v]));
                     d.backIrradiance.insert(d.backIrradiance.end(), ply.backIrradiance.begin() + long(first),
                                             ply.backIrradiance.begin() + long(first + n));

@@ -13,7 +13,7 @@ namespace qsgi {
 void UsdSink::finish(OutputDirectory& out, WholeRunReport& report) {
     Stopwatch clock;
     UsdAssetSummary summary;
-    auto frameAt = [&](int frame) { return readFramePly(out, frame, scene_.frontVertexCount()); };
+    auto frameAt = [&](int frame) { return readFramePly(out, frame, scene_); };
     out.writeStreamed(kUsdAssetName, [&](const OutputDirectory::PieceWriter& put) {
         writeUsdAsset(scene_, settings_, frameAt, put, &summary);
     });

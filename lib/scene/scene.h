@@ -210,6 +210,11 @@ struct Scene {
     }
     bool isBackTriangle(uint32_t tri) const { return backSides && tri >= backSides->firstTriangle; }
     bool isBackVertex(uint32_t v) const { return backSides && v >= backSides->firstVertex; }
+    // A front instance whose material is doubleSided: the outputs carry its back values (0 where
+    // no back side was made: a sealed inside, back_sides.h).
+    bool showsBack(const MeshInstance& inst) const {
+        return backSides && inst.backOf < 0 && inst.triangleCount > 0 && materials[triangleMaterial[inst.firstTriangle]].doubleSided;
+    }
 
     // Dynamic = under a node the animation moves (docs/design.md §2). Filled by markDynamic.
     std::vector<uint8_t> vertexDynamic;

@@ -8,12 +8,12 @@
 namespace qsgi {
 
 PhotonSource::PhotonSource(const Scene& scene, uint64_t photons, uint64_t seed, float rayEpsilon, const EmissionAim& aim,
-                           const PhotonSampling& sampling)
+                           const PhotonSampling& sampling, std::shared_ptr<const SurfaceLookup> surfaces)
     : seed_(seed), sampling_(sampling),
       lights_(scene, photons, rayEpsilon, aim,
               sampling.kind == SamplerKind::Sobol ? std::optional<uint64_t>(seed) : std::nullopt) {
-    auto lookup = std::make_shared<const SurfaceLookup>(scene);
-    if (lookup->any()) lookup_ = std::move(lookup);
+    if (!surfaces) surfaces = std::make_shared<const SurfaceLookup>(scene);
+    if (surfaces->any()) lookup_ = std::move(surfaces);
     surfaceOf_.resize(scene.triangleCount());
     std::map<std::tuple<uint32_t, uint8_t, uint8_t>, uint32_t> index;  // (material, dynamic, varies) -> surface
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {

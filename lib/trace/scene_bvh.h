@@ -153,6 +153,8 @@ public:
     std::optional<SurfaceHit> closestHit(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
                                          bool blendStops) const;
     const SurfaceLookup& surfaces() const { return *surfaces_; }
+    // The one lookup of the scene's surfaces, which the photon source and the gather read too.
+    const std::shared_ptr<const SurfaceLookup>& sharedSurfaces() const { return surfaces_; }
 
 private:
 
