@@ -225,3 +225,19 @@ TEST(BackSides, TheDarkInsideOfATubeCastsItsCoverRaysAlone) {
                     s.vertexCount() - s.frontVertexCount(), litBack);
     }
 }
+
+// The command keeps the back sides through the least-squares vertex fit, whose sampling mesh is a
+// refined copy of the output mesh: both get back sides on the same instances (the fit pairs them),
+// and the frame's PLY carries the doubleSided card's back, which faces the ceiling panel: lit.
+TEST(BackSides, TheVertexFitSolvesAndWritesTheBackSides) {
+    const std::filesystem::path out = testScratchDir("back-sides-fit");
+    const CommandResult run = runQsgi("render " + (sourceDir() / "tests/data/materials_room/materials_room.gltf").string() +
+                                      " --sky 1,1,1 --vertex-fit least-squares --photons 20000" + kCheapSecondPass +
+                                      " --quiet --no-exr --out " + out.string());
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const VertexRadiosityPly ply = readVertexRadiosityPly((out / "frame_0000.ply").string());
+    ASSERT_EQ(ply.backRadiosity.size(), ply.radiosity.size());
+    size_t lit = 0;
+    for (const Vec3f& b : ply.backRadiosity) lit += maxComponent(b) > 0;
+    EXPECT_GT(lit, 50u) << "the card's back (13 x 13 cells, half of them cut out) is lit";
+}

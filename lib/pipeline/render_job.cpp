@@ -174,6 +174,9 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     }
     scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
+    // Which doubleSided surfaces get a back side (lib/scene/back_sides.h), decided on the output
+    // mesh: the sampling mesh takes the same, so that the fit pairs their instances.
+    const std::vector<uint8_t> backSided = instancesWithBackSides(scene_);
     if (settings_.vertexFit == VertexFitKind::LeastSquares) {
         // The sampling mesh: the output's, refined where surfaces touch as --refine-contacts R
         // refines (R the default radius, 1.5 % of the animation's diagonal: the score's contact
@@ -185,12 +188,12 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         if (!sampled)
             refuseRefinement("vertex_fit (--vertex-fit): its samples, edges within R of a contact split to R/2 with R", defaultRadius(scene_),
                              "use --vertex-fit point");
-        addBackSides(*samplingScene_);
+        addBackSides(*samplingScene_, backSided);
         samplingScene_->markDynamic(animation_.movedNodes(), animation_.morphedNodes());
         sweepAnimationBounds(*samplingScene_, animation_);
     }
     // Last, after every refinement (which would take a back side for a surface touching its front).
-    addBackSides(scene_);
+    addBackSides(scene_, backSided);
     checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
     if (!settings_.animationPath.empty())
         checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");

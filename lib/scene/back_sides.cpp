@@ -48,8 +48,22 @@ uint32_t backMaterial(Scene& scene, uint32_t front, std::vector<int64_t>& backOf
 }
 }  // namespace
 
-void addBackSides(Scene& scene) {
+std::vector<uint8_t> instancesWithBackSides(const Scene& scene) {
+    std::vector<uint8_t> which(scene.instances.size(), 0);
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const MeshInstance& inst = scene.instances[i];
+        if (inst.backOf >= 0 || inst.triangleCount == 0) continue;
+        const Material& material = scene.materials[scene.triangleMaterial[inst.firstTriangle]];
+        which[i] = material.doubleSided && !sealedInside(scene, inst, material);
+    }
+    return which;
+}
+
+void addBackSides(Scene& scene) { addBackSides(scene, instancesWithBackSides(scene)); }
+
+void addBackSides(Scene& scene, const std::vector<uint8_t>& which) {
     if (scene.backSides) throw std::logic_error("addBackSides: the scene has its back sides already");
+    if (which.size() != scene.instances.size()) throw std::logic_error("addBackSides: one choice per instance");
     const size_t fronts = scene.instances.size();
     Scene::BackSides sides;
     sides.firstVertex = uint32_t(scene.vertexCount());
@@ -63,7 +77,7 @@ void addBackSides(Scene& scene) {
         const uint32_t frontMaterial = scene.triangleMaterial[scene.instances[i].firstTriangle];
         if (!scene.materials[frontMaterial].doubleSided) continue;
         any = true;  // the outputs carry back values, 0 where no back side is made
-        if (sealedInside(scene, scene.instances[i], scene.materials[frontMaterial])) continue;
+        if (!which[i]) continue;
         const uint32_t material = backMaterial(scene, frontMaterial, materialBack);
         MeshInstance back = scene.instances[i];
         const uint32_t firstFront = back.firstVertex;

@@ -8,6 +8,9 @@
 // the surface (FinalGather), so the inside of a closed doubleSided mesh is covered and dark.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "scene/scene.h"
 
 namespace qsgi {
@@ -19,5 +22,10 @@ namespace qsgi {
 // closes a volume with an opaque material gets none: its inside, which no light reaches, would
 // be covered and 0 (its outputs' back values are 0 all the same), and costs nothing.
 void addBackSides(Scene& scene);
+// The instances addBackSides gives a back side: doubleSided, not sealed.
+std::vector<uint8_t> instancesWithBackSides(const Scene& scene);
+// The same with the choice given, one per instance: a refined copy of a scene (the vertex fit's
+// sampling mesh) takes its original's, so that the two keep matching instances.
+void addBackSides(Scene& scene, const std::vector<uint8_t>& which);
 
 }  // namespace qsgi
