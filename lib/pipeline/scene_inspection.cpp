@@ -5,6 +5,7 @@
 #include <set>
 
 #include "output/folder_survey.h"
+#include "scene/back_sides.h"
 #include "util/json_file.h"
 #include "pipeline/render_options.h"
 #include "trace/light_sampler.h"
@@ -132,6 +133,11 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
         transmissive += material.transmission > 0;
         emissionTextured += material.isEmissive() && material.emissive.used();
     }
+    // The vertices a render lights twice (lib/scene/back_sides.h): the cost of the back sides.
+    uint64_t backSideVertices = 0;
+    const std::vector<uint8_t> backSided = instancesWithBackSides(scene);
+    for (size_t i = 0; i < backSided.size(); ++i)
+        if (backSided[i]) backSideVertices += scene.instances[i].vertexCount;
     uint64_t textureBytes = 0;
     if (scene.textures)
         for (const Texture& t : *scene.textures) textureBytes += t.bytes();
@@ -145,6 +151,7 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
                       {"alpha_mask", mask},
                       {"alpha_blend", blend},
                       {"double_sided", doubleSided},
+                      {"back_side_vertices", backSideVertices},
                       {"transmissive", transmissive},
                       {"emission_textured", emissionTextured},
                       {"vertex_colours", !scene.vertexColours.empty()},
@@ -270,7 +277,8 @@ std::string inspectionText(const nlohmann::json& r) {
     line("  base colour textured " + std::to_string(m["base_colour_textured"].get<uint64_t>()) + " (" +
          number(double(m["texture_bytes"].get<uint64_t>()) / (1 << 20), "%.1f") + " MiB decoded), alpha MASK " +
          std::to_string(m["alpha_mask"].get<uint64_t>()) + ", BLEND " + std::to_string(m["alpha_blend"].get<uint64_t>()) +
-         ", double-sided " + std::to_string(m["double_sided"].get<uint64_t>()) + ", transmissive " +
+         ", double-sided " + std::to_string(m["double_sided"].get<uint64_t>()) + " (" +
+         std::to_string(m["back_side_vertices"].get<uint64_t>()) + " back-side vertices), transmissive " +
          std::to_string(m["transmissive"].get<uint64_t>()) + ", emission textured " +
          std::to_string(m["emission_textured"].get<uint64_t>()) + "; vertex colours " +
          (m["vertex_colours"].get<bool>() ? "yes" : "no"));
