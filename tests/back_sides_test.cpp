@@ -10,6 +10,7 @@
 
 #include "output/ply_reader.h"
 #include "output/ply_writer.h"
+#include "output/radiosity_image.h"
 #include "pipeline/frame_solver.h"
 #include "scene/back_sides.h"
 #include "test_support.h"
@@ -240,4 +241,34 @@ TEST(BackSides, TheVertexFitSolvesAndWritesTheBackSides) {
     size_t lit = 0;
     for (const Vec3f& b : ply.backRadiosity) lit += maxComponent(b) > 0;
     EXPECT_GT(lit, 50u) << "the card's back (13 x 13 cells, half of them cut out) is lit";
+}
+
+// The camera shows the side it sees: looking up at the doubleSided sheet from under it, the back
+// side's values; looking down on it, the front's (an irradiance of 3 on every back vertex and 1
+// on every front one, so B/π is ρ·3/π and ρ/π, exactly).
+TEST(BackSides, TheCameraShowsTheSideItSees) {
+    const Vec3f albedo(0.6f, 0.5f, 0.4f);
+    Scene s = testscenes::plateUnderSheet(1.0f, 4, 0.5f, 4, 0.6f, true, Vec3f(0.5f));
+    giveMaterial(s, 1, albedo, true);
+    addBackSides(s);
+    const EmbreeDevice device;
+    const SceneBvh bvh(device, s);
+    VertexRadiosity solution;
+    solution.irradiance.assign(s.vertexCount(), Vec3f(1.0f));
+    for (uint32_t v = uint32_t(s.frontVertexCount()); v < s.vertexCount(); ++v) solution.irradiance[v] = Vec3f(3.0f);
+    computeRadiosity(s, solution);
+    for (const bool fromBelow : {true, false}) {
+        Camera camera;
+        camera.projection = Projection::Orthographic;
+        camera.position = Vec3f(Vec3d(0, fromBelow ? 0.3 : 2.0, 0) - s.worldOrigin);  // scene space is re-centred
+        camera.forward = Vec3f(0, fromBelow ? 1.0f : -1.0f, 0);
+        camera.up = Vec3f(0, 0, -1);
+        camera.ymag = 0.4f;  // inside the sheet's 1 m
+        ImageSettings settings;
+        settings.width = settings.height = 8;
+        const RgbImage image = renderRadiosityImage(s, bvh, solution, camera, settings);
+        const float expected = albedo.x * (fromBelow ? 3.0f : 1.0f) / float(M_PI);
+        for (int p = 0; p < settings.width * settings.height; ++p)
+            EXPECT_NEAR(image.pixels[3 * size_t(p)], expected, 1e-6f) << (fromBelow ? "from below" : "from above") << ", pixel " << p;
+    }
 }
