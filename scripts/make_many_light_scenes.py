@@ -45,8 +45,9 @@ import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_cornell import GltfBuilder, grid  # noqa: E402
-from make_test_scenes import look_at  # noqa: E402
+from make_cornell import grid  # noqa: E402
+from make_material_scenes import SceneBuilder as MaterialSceneBuilder  # noqa: E402
+from make_walker import merged  # noqa: E402
 
 CELL = 0.2  # metres: the quads of every surface but the lamps
 
@@ -72,37 +73,23 @@ SCENES = ["corridor"] + ["box_lights_%d" % n for n in sorted(LIGHT_GRIDS)]
 
 
 # ---------------------------------------------------------------------------------------------
-# A builder: make_cornell's GltfBuilder (buffer, accessors, materials), named nodes and lights
+# A builder: make_material_scenes' (buffer, materials, camera, writing), with point lights, and
+# meshes without texture coordinates
 
-class SceneBuilder:
+class SceneBuilder(MaterialSceneBuilder):
     def __init__(self, folder, name):
-        self.folder, self.name = folder, name
-        self.g = GltfBuilder()
-        self.doc = self.g.doc
+        super().__init__(folder, name)
         self.doc["asset"]["generator"] = "qsgi scripts/make_many_light_scenes.py"
-        self.doc["scenes"][0]["name"] = name
-        self.doc["extensionsUsed"] = []
         self.lights = 0   # point lights
         self.lamps = 0    # emissive quads
 
-    def use(self, extension):
-        if extension not in self.doc["extensionsUsed"]:
-            self.doc["extensionsUsed"].append(extension)
-
     def material(self, name, grey, strength=None):
-        if strength is not None:
-            self.use("KHR_materials_emissive_strength")
-            return self.g.material(name, [grey] * 3, emission=[1.0, 1.0, 1.0], strength=strength)
-        return self.g.material(name, [grey] * 3)
+        emission = [1.0, 1.0, 1.0] if strength is not None else None
+        return super().material(name, [grey] * 3, emission=emission, strength=strength)
 
     def mesh(self, name, parts, material):
         """A node with one primitive from `parts`: [(positions, normals, indices)] concatenated."""
-        positions, normals, indices = [], [], []
-        for p, n, i in parts:
-            base = len(positions)
-            positions += p
-            normals += n
-            indices += [base + k for k in i]
+        positions, normals, indices = merged(parts)
         mesh = self.g.mesh(name, positions, normals, indices, material)
         self.g.node({"name": name, "mesh": mesh})
         return len(positions)
@@ -122,19 +109,9 @@ class SceneBuilder:
         self.g.node({"name": group, "children": children})
         self.lights += len(positions)
 
-    def camera(self, eye, target):
-        self.doc["cameras"].append({"type": "perspective", "perspective": {"yfov": 1.0, "aspectRatio": 4 / 3,
-                                                                            "znear": 0.01}})
-        self.g.node(dict(look_at(eye, target), camera=len(self.doc["cameras"]) - 1, name="Camera"))
-
     def vertices(self):
         return sum(self.doc["accessors"][p["attributes"]["POSITION"]]["count"]
                    for m in self.doc["meshes"] for p in m["primitives"])
-
-    def write(self):
-        if not self.doc["extensionsUsed"]:
-            del self.doc["extensionsUsed"]
-        self.g.write(self.folder, self.name)
 
 
 def cells_for(length):

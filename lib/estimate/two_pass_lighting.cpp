@@ -29,7 +29,7 @@ void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const Verte
                             VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress, bool keepForUpdates) {
     Stopwatch clock;
     starts_.computeAll(scene, bvh);
-    double startsSeconds = clock.seconds();
+    const double startsSeconds = clock.seconds();
     // The gather's rays first: their cover rays tell the dark back sides, which direct light skips.
     auto direct = [&] {
         Stopwatch directClock;

@@ -192,8 +192,6 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         samplingScene_->markDynamic(animation_.movedNodes(), animation_.morphedNodes());
         sweepAnimationBounds(*samplingScene_, animation_);
     }
-    // Last, after every refinement (which would take a back side for a surface touching its front).
-    addBackSides(scene_, backSided);
     checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
     if (!settings_.animationPath.empty())
         checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");
@@ -211,6 +209,9 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
                       100 * resolution_.coarseAreaShare(), resolution_.coarseVertices, resolution_.edgeLimit / 2);
         warnings.add(settings_.scenePath + ": " + text);
     }
+    // Last, after every refinement (which would take a back side for a surface touching its front)
+    // and after the mesh's resolution, which describes the file's mesh.
+    addBackSides(scene_, backSided);
 
     first_ = 0;
     last_ = animation_.lastFrame();

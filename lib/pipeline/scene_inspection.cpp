@@ -5,7 +5,6 @@
 #include <set>
 
 #include "output/folder_survey.h"
-#include "scene/back_sides.h"
 #include "util/json_file.h"
 #include "pipeline/render_options.h"
 #include "trace/light_sampler.h"
@@ -96,18 +95,21 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
     nlohmann::json r;
 
     const Bounds3f bounds = scene.bounds();
+    // The scene as the file gives it: the back sides of doubleSided surfaces (lib/scene/back_sides.h),
+    // which the job has added, are counted apart.
+    const uint32_t triangles = uint32_t(scene.frontTriangleCount());
     r["scene"] = {{"file", pathJson(settings.scenePath)},
-                  {"mesh_instances", scene.instances.size()},
+                  {"mesh_instances", scene.frontInstanceCount()},
                   {"nodes", scene.nodes.size()},
-                  {"triangles", scene.triangleCount()},
-                  {"vertices", scene.vertexCount()},
+                  {"triangles", triangles},
+                  {"vertices", scene.frontVertexCount()},
                   {"bounds", {{"min", world(bounds.lower, scene)}, {"max", world(bounds.upper, scene)}}},
                   {"diagonal", bounds.extent()}};
 
     // Materials as the render uses them: albedo range and emitters, over triangles that have area.
     std::set<uint32_t> used, emissive;
     uint64_t emissiveTriangles = 0;
-    for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
+    for (uint32_t t = 0; t < triangles; ++t) {
         const uint32_t m = scene.triangleMaterial[t];
         used.insert(m);
         if (scene.materials[m].isEmissive() && scene.triangleArea(t) > 0) {
@@ -133,15 +135,10 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
         transmissive += material.transmission > 0;
         emissionTextured += material.isEmissive() && material.emissive.used();
     }
-    // The vertices a render lights twice (lib/scene/back_sides.h): the cost of the back sides.
-    uint64_t backSideVertices = 0;
-    const std::vector<uint8_t> backSided = instancesWithBackSides(scene);
-    for (size_t i = 0; i < backSided.size(); ++i)
-        if (backSided[i]) backSideVertices += scene.instances[i].vertexCount;
     uint64_t textureBytes = 0;
     if (scene.textures)
         for (const Texture& t : *scene.textures) textureBytes += t.bytes();
-    r["materials"] = {{"count", scene.materials.size()},
+    r["materials"] = {{"count", scene.frontMaterialCount()},
                       {"used", used.size()},
                       {"albedo_min", vec(lowest)},
                       {"albedo_max", vec(highest)},
@@ -151,7 +148,8 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
                       {"alpha_mask", mask},
                       {"alpha_blend", blend},
                       {"double_sided", doubleSided},
-                      {"back_side_vertices", backSideVertices},
+                      // the vertices a render lights twice: the cost of the back sides
+                      {"back_side_vertices", scene.vertexCount() - scene.frontVertexCount()},
                       {"transmissive", transmissive},
                       {"emission_textured", emissionTextured},
                       {"vertex_colours", !scene.vertexColours.empty()},
@@ -205,7 +203,7 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
     for (const KeyframeAnimation& a : scene.animations)
         files.push_back({{"name", a.name}, {"seconds", a.endTime}, {"frames", int64_t(Animation::lastFrameAt(a.endTime, fps)) + 1}});
     uint64_t dynamicTriangles = 0;
-    for (uint8_t d : scene.triangleDynamic) dynamicTriangles += d;
+    for (uint32_t t = 0; t < triangles; ++t) dynamicTriangles += scene.triangleDynamic[t];
     nlohmann::json moved = nlohmann::json::array(), morphed = nlohmann::json::array();
     for (int n : animation.movedNodes()) moved.push_back(scene.nodes[size_t(n)].name);
     for (int n : animation.morphedNodes()) morphed.push_back(scene.nodes[size_t(n)].name);
@@ -217,7 +215,7 @@ nlohmann::json inspectRender(const RenderJob& job, const Warnings& warnings) {
                       {"moved_nodes", moved},
                       {"morphed_nodes", morphed},
                       {"dynamic_triangles", dynamicTriangles},
-                      {"dynamic_fraction", scene.triangleCount() ? double(dynamicTriangles) / scene.triangleCount() : 0.0},
+                      {"dynamic_fraction", triangles ? double(dynamicTriangles) / triangles : 0.0},
                       {"bounds", {{"min", world(scene.animationBounds.lower, scene)}, {"max", world(scene.animationBounds.upper, scene)}}},
                       {"diagonal", scene.animationBounds.extent()}};
     const MeshResolution& mesh = job.meshResolution();

@@ -35,16 +35,16 @@ bool sealedInside(const Scene& scene, const MeshInstance& inst, const Material& 
 }
 
 // The back side's material: the front's, emitting nothing.
-uint32_t backMaterial(Scene& scene, uint32_t front, std::vector<int64_t>& backOf) {
-    if (backOf[front] >= 0) return uint32_t(backOf[front]);
+uint32_t backMaterial(Scene& scene, uint32_t front, std::vector<int64_t>& copyOf) {
+    if (copyOf[front] >= 0) return uint32_t(copyOf[front]);
     const Material& m = scene.materials[front];
-    if (!m.isEmissive()) return uint32_t(backOf[front] = front);
+    if (!m.isEmissive()) return uint32_t(copyOf[front] = front);
     Material back = m;
     back.name += " (back)";
     back.emission = Vec3f(0.0f);
     back.emissive = TextureSlot{};
     scene.materials.push_back(std::move(back));
-    return uint32_t(backOf[front] = int64_t(scene.materials.size() - 1));
+    return uint32_t(copyOf[front] = int64_t(scene.materials.size() - 1));
 }
 }  // namespace
 
@@ -69,6 +69,7 @@ void addBackSides(Scene& scene, const std::vector<uint8_t>& which) {
     sides.firstVertex = uint32_t(scene.vertexCount());
     sides.firstTriangle = uint32_t(scene.triangleCount());
     sides.firstInstance = uint32_t(fronts);
+    sides.firstMaterial = uint32_t(scene.materials.size());
     sides.backVertex.assign(scene.vertexCount(), Scene::BackSides::kNone);
     std::vector<int64_t> materialBack(scene.materials.size(), -1);
     bool any = false;

@@ -196,6 +196,7 @@ struct Scene {
     // front vertices and carry the back values beside them. Absent when no surface is doubleSided.
     struct BackSides {
         uint32_t firstVertex = 0, firstTriangle = 0, firstInstance = 0;
+        uint32_t firstMaterial = 0;  // the non-emitting copies of emissive doubleSided materials follow
         std::vector<uint32_t> backVertex;  // per front vertex: its back side's vertex, or kNone
         static constexpr uint32_t kNone = 0xFFFFFFFFu;
     };
@@ -204,6 +205,7 @@ struct Scene {
     size_t frontVertexCount() const { return backSides ? backSides->firstVertex : positions.size(); }
     size_t frontTriangleCount() const { return backSides ? backSides->firstTriangle : triangles.size(); }
     size_t frontInstanceCount() const { return backSides ? backSides->firstInstance : instances.size(); }
+    size_t frontMaterialCount() const { return backSides ? backSides->firstMaterial : materials.size(); }
     // One of a two-sided pair (a doubleSided triangle and its back side): a ray meets the one that faces it.
     bool twoSided(uint32_t tri) const {
         return backSides && (tri >= backSides->firstTriangle || backSides->backVertex[triangles[tri].v[0]] != BackSides::kNone);

@@ -46,22 +46,25 @@ namespace {
 
 // Drops the hits where the surface lets the ray through (PassThrough); true if lane i survives.
 // blendStops: BLEND surfaces stop it (transmittance() weighs them itself).
+Vec3f rayDirection(const RTCFilterFunctionNArguments* args, unsigned i) {
+    return Vec3f(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i));
+}
+
 bool stopsRay(const RTCFilterFunctionNArguments* args, unsigned i, bool blendStops) {
     const auto* pass = static_cast<const PassThrough*>(args->geometryUserPtr);
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const uint32_t triangle = pass->sceneTriangle[prim];
-    const Vec3f direction(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
-                          RTCRayN_dir_z(args->ray, args->N, i));
     if (!pass->frontAlongNg.empty() && pass->frontAlongNg[prim] != 0) {
         // One of a two-sided pair: the ray meets the one whose front faces it (at exactly
         // grazing incidence both, and the tie rule picks).
         const Vec3f ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
                        RTCHitN_Ng_z(args->hit, args->N, i));
-        if (float(pass->frontAlongNg[prim]) * dot(direction, ng) > 0) return false;
+        if (float(pass->frontAlongNg[prim]) * dot(rayDirection(args, i), ng) > 0) return false;
     }
     if (!pass->lookup->letsLightThrough(triangle) || (blendStops && pass->lookup->blends(triangle))) return true;
     const Vec3f origin(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
                        RTCRayN_org_z(args->ray, args->N, i));
+    const Vec3f direction = rayDirection(args, i);
     return pass->lookup->stops(triangle, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i),
                                rayChoice(origin, direction, triangle, RayChoice::Blend));
 }
@@ -197,11 +200,10 @@ void SceneBvh::orientTwoSided(PassThrough& pass, const Scene& scene) {
     for (size_t i = 0; i < pass.sceneTriangle.size(); ++i) {
         const uint32_t t = pass.sceneTriangle[i];
         if (!scene.twoSided(t)) continue;
-        // Embree's Ng points out of the CCW side, as the geometric normal does; the front is the
-        // side the vertex normals face (a skinned mesh may turn it: re-read each pose).
-        const Triangle& tri = scene.triangles[t];
-        const Vec3f n = scene.normals[tri.v[0]] + scene.normals[tri.v[1]] + scene.normals[tri.v[2]];
-        pass.frontAlongNg[i] = dot(scene.geometricNormal(t), n) < 0 ? -1 : 1;
+        // Embree's Ng points out of the CCW side, as the geometric normal does; the front is
+        // frontFaceNormal's (a skinned mesh may turn it: re-read each pose).
+        const Vec3f front = frontFaceNormal(scene.positions, scene.normals, scene.triangles[t]);
+        pass.frontAlongNg[i] = dot(scene.geometricNormal(t), front) < 0 ? -1 : 1;
     }
 }
 

@@ -75,6 +75,10 @@ public:
     void updateDynamic(const Scene& scene);
 
     std::optional<SurfaceHit> intersect(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar) const;
+    // intersect(), BLEND surfaces stopping the ray when `blendStops` (the camera composites them
+    // by their alpha; transmittance() weighs them).
+    std::optional<SurfaceHit> closestHit(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
+                                         bool blendStops) const;
     // The closest hit, passing straight through a pane (KHR_materials_transmission) where the
     // ray's own choice says so: with probability T at the pane (rayChoice of the ray and the
     // pane's triangle; at most kMostPanes panes). The final gather's rays.
@@ -128,6 +132,10 @@ public:
 
     // Offset that lifts spawned rays off surfaces: scaled with the scene, never with metres.
     float rayEpsilon() const { return rayEpsilon_; }
+    // What the materials say at a point (lib/scene/surface_lookup.h): the one lookup of the scene's
+    // surfaces, which the filters, the photon source, the gather and the camera read.
+    const SurfaceLookup& surfaces() const { return *surfaces_; }
+    const std::shared_ptr<const SurfaceLookup>& sharedSurfaces() const { return surfaces_; }
 
 private:
     struct Part {
@@ -146,17 +154,6 @@ private:
     void boundDynamic(const Scene& scene);
     std::optional<SurfaceHit> intersectPart(const EmbreeScene& embree, const Part& part, const Vec3f& origin,
                                             const Vec3f& direction, float tnear, float tfar, bool blendStops) const;
-
-public:
-    // intersect(), BLEND surfaces stopping the ray when `blendStops` (the camera composites them
-    // by their alpha; transmittance() weighs them).
-    std::optional<SurfaceHit> closestHit(const Vec3f& origin, const Vec3f& direction, float tnear, float tfar,
-                                         bool blendStops) const;
-    const SurfaceLookup& surfaces() const { return *surfaces_; }
-    // The one lookup of the scene's surfaces, which the photon source and the gather read too.
-    const std::shared_ptr<const SurfaceLookup>& sharedSurfaces() const { return surfaces_; }
-
-private:
 
     const EmbreeDevice& device_;
     std::shared_ptr<const SurfaceLookup> surfaces_;  // what the filters and the panes read
