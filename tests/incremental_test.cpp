@@ -15,6 +15,7 @@
 #include "scene/animation.h"
 #include "estimate/final_gather.h"
 #include "scene/back_sides.h"
+#include "estimate/direct_light.h"
 #include "test_support.h"
 
 using namespace qsgi;
@@ -314,6 +315,21 @@ TEST(Incremental, ACubeSlidingIntoADoubleSidedTubeEqualsFull) {
         // 64 rays: a dark back side casts its 16 cover rays and leaves the other 48.
         expectIncrementalEqualsFull(a, e, 2, true, 6000, 0.12f, TrackedPaths::kGenerations, exactDirect(64));
         expectIncrementalEqualsFull(a, e, 2, true, 6000, 0.12f, TrackedPaths::kGenerations, cached);
+        if (HasFatalFailure()) return;
+    }
+}
+
+// Many lights (issue 58): a block sliding among three under 30 lamps and 40 point and spot lights,
+// direct light at S = 4, so that the lights join the lamps in the light tree; a later frame
+// recasts only the shadow rays the block's old or new bounds meet, and equals a full
+// recomputation to the bit. One estimator of each kind, with a gather.
+TEST(Incremental, AMoverAmongManyLightsEqualsFull) {
+    const AnimatedScene a{"a block among many lights", [] { return testscenes::lampsOverBlocks(12, 30, 40, 3); }, "Block1",
+                          [](int f) { return slide(f, 0.15, 0.1); }, 4};
+    ASSERT_TRUE(DirectLight::samplesLights(40, exactDirect(16).directSamples));
+    for (const EstimatorCase& e : kEstimators) {
+        if (!e.index || e.rule != DetpBoundary::Clip) continue;
+        expectIncrementalEqualsFull(a, e, 2, true, 6000, 0.12f, TrackedPaths::kGenerations, exactDirect(16));
         if (HasFatalFailure()) return;
     }
 }

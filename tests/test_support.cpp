@@ -10,6 +10,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <random>
 #include <sstream>
 
 #include <unistd.h>
@@ -523,6 +524,41 @@ Scene floorUnderEmitter(int cells, Vec3f centre, float halfX, float halfZ, Vec3f
     // cross(+x, +z) = −y: the front faces the floor.
     addGrid(s, s.addNode("Lamp", Transform()), centre - Vec3f(halfX, 0, halfZ), {2 * halfX, 0, 0}, {0, 0, 2 * halfZ}, 1, lamp);
     s.finalize();
+    return s;
+}
+
+Scene lampsOverBlocks(int cells, int lamps, int lights, uint64_t seed) {
+    Scene s;
+    const uint32_t grey = addMaterial(s, Vec3f(0.6f));
+    addGrid(s, s.addNode("Floor", Transform()), {-2, 0, 2}, {4, 0, 0}, {0, 0, -4}, cells, grey);
+    // Three blocks that shade parts of the floor from parts of the lights.
+    for (int k = 0; k < 3; ++k) {
+        const int node = s.addNode("Block" + std::to_string(k), Transform::fromTRS(Vec3d(-1.2 + 1.2 * k, 0, 0.3 * (k - 1)), {0, 0, 0, 1}, Vec3d(1, 1, 1)));
+        addBoxOnFloor(s, node, 0.25f, 0.5f, 2, grey);
+    }
+    std::mt19937_64 random(seed);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    auto between = [&](float a, float b) { return a + (b - a) * unit(random); };
+    for (int k = 0; k < lamps; ++k) {
+        // A small square lamp facing down (cross(+x, +z) = −y), its emission varied tenfold.
+        const Vec3f centre(between(-2.5f, 2.5f), between(0.8f, 2.0f), between(-2.5f, 2.5f));
+        const float half = between(0.03f, 0.12f);
+        const uint32_t lamp = addMaterial(s, Vec3f(0.5f), Vec3f(between(0.5f, 5.0f), between(0.5f, 5.0f), between(0.5f, 5.0f)));
+        addGrid(s, s.addNode("Lamp" + std::to_string(k), Transform()), centre - Vec3f(half, 0, half), {2 * half, 0, 0},
+                {0, 0, 2 * half}, 1, lamp);
+    }
+    s.finalize();
+    for (int k = 0; k < lights; ++k) {
+        PunctualLight l;
+        l.name = "light " + std::to_string(k);
+        // Some below the floor (they light nothing above it), a third spot lights aimed down.
+        l.position = Vec3f(Vec3d(between(-3.0f, 3.0f), between(-0.5f, 2.5f), between(-3.0f, 3.0f)) - s.worldOrigin);
+        l.intensity = Vec3f(between(0.05f, 0.5f), between(0.05f, 0.5f), between(0.05f, 0.5f));
+        l.type = k % 3 == 2 ? LightType::Spot : LightType::Point;
+        l.direction = normalize(Vec3f(between(-0.5f, 0.5f), -1.0f, between(-0.5f, 0.5f)));
+        l.cosOuterCone = std::cos(between(0.2f, 1.2f));
+        s.lights.push_back(l);
+    }
     return s;
 }
 

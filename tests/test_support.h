@@ -160,6 +160,11 @@ namespace testscenes {
 // the floor, half sizes `halfX` and `halfZ`, its front (CCW) side facing down.
 qsgi::Scene floorUnderEmitter(int cells, qsgi::Vec3f centre, float halfX, float halfZ, qsgi::Vec3f emission,
                               qsgi::Vec3f albedo);
+// Many lights (issue 58): a 4 m floor (`cells` per side) with three 0.5 m blocks on it, under
+// `lamps` small emissive squares facing down at random heights and sizes, and `lights` point and
+// spot lights (every third a spot aimed down) at random places, some under the floor; all drawn
+// from `seed`.
+qsgi::Scene lampsOverBlocks(int cells, int lamps, int lights, uint64_t seed);
 // A plate y = 0 (half size `plateHalf`, facing up) under a single-sided sheet y = `gap` (half size
 // `sheetHalf`), both centred on the y axis. sheetFacesUp: the sheet's front (winding and vertex
 // normals) faces +y, away from the plate, else −y, toward it. The plate is instance 0, the sheet

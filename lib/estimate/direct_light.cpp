@@ -10,13 +10,14 @@
 #include "estimate/vertex_samples.h"
 #include "scene/emission_pieces.h"
 #include "trace/sampling.h"
+#include "util/stopwatch.h"
 
 namespace qsgi {
 
 void DirectLight::readEmitters(const Scene& scene) {
+    const Stopwatch clock;
     emitters_.clear();
-    cdf_.clear();
-    double total = 0;
+    std::vector<LightBounds> bounds;
     for (uint32_t t = 0; t < scene.triangleCount(); ++t) {
         const Material& m = scene.materials[scene.triangleMaterial[t]];
         const float area = scene.triangleArea(t);
@@ -24,12 +25,13 @@ void DirectLight::readEmitters(const Scene& scene) {
         const Triangle& tri = scene.triangles[t];
         const std::array<Vec3d, 3> corners = {Vec3d(scene.positions[tri.v[0]]), Vec3d(scene.positions[tri.v[1]]),
                                               Vec3d(scene.positions[tri.v[2]])};
-        // A textured emitter piece by piece (emission_pieces.h), each chosen by its own power.
+        const Vec3d normal(scene.geometricNormal(t));
+        // A textured emitter piece by piece (emission_pieces.h), each an emitter of its own.
         for (const EmissionPiece& piece : emissionPieces(scene, t)) {
             const float pieceArea = area * piece.areaShare;
-            // Chosen by power, as photons are (LightSampler): luminance of π L_e A.
-            const double power = double(luminance(piece.radiance)) * double(pieceArea);
-            if (!(power > 0)) continue;
+            // Its intensity along its normal, L_e A, by which the tree weighs it (light_tree.h).
+            const double intensity = double(luminance(piece.radiance)) * double(pieceArea);
+            if (!(intensity > 0)) continue;
             std::array<Vec3d, 3> at = corners;
             const bool whole = piece.areaShare == 1 && piece.corner[1][0] == 1 && piece.corner[2][1] == 1;
             if (!whole)
@@ -37,17 +39,31 @@ void DirectLight::readEmitters(const Scene& scene) {
                     const double b1 = piece.corner[k][0], b2 = piece.corner[k][1];
                     at[k] = corners[0] * (1 - b1 - b2) + corners[1] * b1 + corners[2] * b2;
                 }
-            emitters_.push_back({t, piece.radiance, pieceArea, power, at, Vec3d(scene.geometricNormal(t))});
-            total += power;
+            emitters_.push_back({Emitter::Kind::Triangle, piece.radiance, pieceArea, at, normal});
+            const Vec3f box[3] = {Vec3f(at[0]), Vec3f(at[1]), Vec3f(at[2])};
+            bounds.push_back(LightBounds::triangle(box, normal, intensity));
         }
     }
-    double running = 0;
-    for (Emitter& e : emitters_) {
-        e.probability /= total;
-        running += e.probability;
-        cdf_.push_back(running);
-    }
-    if (!cdf_.empty()) cdf_.back() = 1.0;
+    size_t pointAndSpot = 0;
+    for (const PunctualLight& l : scene.lights) pointAndSpot += l.type != LightType::Directional;
+    lightsSampled_ = samplesLights(pointAndSpot, samples_);
+    if (lightsSampled_)
+        for (const PunctualLight& l : scene.lights) {
+            if (l.type == LightType::Directional) continue;
+            const Vec3d at(l.position);
+            // Weighed by its intensity I (light_tree.h): a narrow spot lights what it reaches as
+            // strongly as a point light of the same I.
+            const bool spot = l.type == LightType::Spot;
+            const double intensity = double(luminance(l.intensity));
+            if (!(intensity > 0) || (spot && !(l.cosOuterCone < 1))) continue;
+            emitters_.push_back({spot ? Emitter::Kind::Spot : Emitter::Kind::Point, l.intensity, 0.0f, {at, at, at},
+                                 Vec3d(l.direction), double(l.cosOuterCone)});
+            bounds.push_back(spot ? LightBounds::spot(l.position, normalize(Vec3d(l.direction)), double(l.cosOuterCone), intensity)
+                                  : LightBounds::point(l.position, intensity));
+        }
+    tree_ = LightTree(bounds);
+    emittersRead_ = true;
+    treeSeconds_ = clock.seconds();
 }
 
 template <class Visit>
@@ -76,6 +92,7 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
             if (cosV > 0) visit(Vec3f(w), kInfinity, Vec3d(l.intensity) * cosV);
             continue;
         }
+        if (lightsSampled_) continue;  // through the tree below
         const Vec3d d = Vec3d(l.position) - p;
         const double d2 = dot(d, d);
         if (!(d2 > 0)) continue;
@@ -87,13 +104,30 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
         if (shadowTo(Vec3d(l.position), direction, tfar)) visit(direction, tfar, Vec3d(l.intensity) * (cosV / d2));
     }
     if (scene.environment && samples_ > 0) environmentRays(*scene.environment, n, v, visit);
-    if (emitters_.empty() || samples_ == 0) return;
+    if (tree_.empty() || samples_ == 0) return;
     const VertexSamples numbers(seed_, v, VertexStream::Direct);
+    const VertexSamples::Dimension choose = numbers.dimension(0), fine = numbers.dimension(3);
     const double perSample = 1.0 / double(samples_);
     for (uint32_t i = 0; i < samples_; ++i) {
-        const float u0 = numbers.uniform(i, 0);
-        const size_t e = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), double(u0)) - cdf_.begin());
-        const Emitter& emitter = emitters_[std::min(e, emitters_.size() - 1)];
+        // Dimension 0 descends the tree, stratified; dimension 3 adds the bits below its 24, so
+        // that an emitter whose probability is below 2^-24 can still be drawn.
+        const double u = double(choose.uniform(i)) + double(fine.uniform(i)) * 0x1p-24;
+        LightTree::Choice choice;
+        if (!tree_.sample(p, n, u, choice)) continue;
+        const Emitter& emitter = emitters_[choice.emitter];
+        if (emitter.kind != Emitter::Kind::Triangle) {
+            // A point or spot light: I cosθ_v / (d² P), as its exact ray would bring, over P.
+            const Vec3d d = emitter.corner[0] - p;
+            const double d2 = dot(d, d);
+            if (!(d2 > 0)) continue;
+            const Vec3d w = d / std::sqrt(d2);
+            const double cosV = dot(n, w);
+            if (!(cosV > 0)) continue;
+            if (emitter.kind == Emitter::Kind::Spot && dot(-w, emitter.normal) < emitter.cosOuter) continue;
+            if (shadowTo(emitter.corner[0], direction, tfar))
+                visit(direction, tfar, Vec3d(emitter.radiance) * (cosV / d2 / choice.probability * perSample));
+            continue;
+        }
         float b1, b2;
         uniformTriangle(numbers.uniform(i, 1), numbers.uniform(i, 2), b1, b2);
         const Vec3d x = emitter.corner[0] * double(1 - b1 - b2) + emitter.corner[1] * double(b1) + emitter.corner[2] * double(b2);
@@ -104,8 +138,8 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
         const double cosV = dot(n, w);
         const double cosE = -dot(emitter.normal, w);
         if (!(cosV > 0) || !(cosE > 0)) continue;
-        // L_e cosθ_v cosθ_e / (d² p), p = P(emitter) / area.
-        const double weight = cosV * cosE / d2 * double(emitter.area) / emitter.probability * perSample;
+        // L_e cosθ_v cosθ_e / (d² p), p = P(emitter at v) / area.
+        const double weight = cosV * cosE / d2 * double(emitter.area) / choice.probability * perSample;
         if (shadowTo(x, direction, tfar)) visit(direction, tfar, Vec3d(emitter.radiance) * weight);
     }
 }
@@ -168,7 +202,7 @@ Vec3f DirectLight::vertexIrradiance(const Scene& scene, const SceneBvh& bvh, con
 
 void DirectLight::computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress,
                              const std::vector<uint8_t>* dark) {
-    readEmitters(scene);
+    if (!emittersRead_) readEmitters(scene);
     irradiance_.assign(scene.vertexCount(), Vec3f(0.0f));
     if (progress) progress->setTotal(scene.vertexCount());
     std::atomic<uint64_t> rays{0};

@@ -4,23 +4,27 @@
 //   point light   I · cosθ_v / d²   when the segment s_v → light is clear (spot lights only inside
 //                 their cone, as their photons are);
 //   directional   E · cosθ_v        when the ray from s_v against the light's direction is clear;
-//   emissive      (1/S) Σ_i L_e · cosθ_v · cosθ_e / (d² · p(x_i)) over S points x_i, each chosen by
-//   triangles     the emitter's power and uniformly on it (p = P(triangle) / area), from v's own
-//                 scrambled Sobol points: stratified over the emitters by power, with the cosine
-//                 and distance terms exact. Only the front (CCW) side emits, as for photons.
+//   emissive      (1/S) Σ_i L_e · cosθ_v · cosθ_e / (d² · p(x_i)) over S points x_i, each chosen
+//   triangles     through the light tree (light_tree.h) by what its emitters can send to v, and
+//                 uniformly on the chosen triangle (p = P(triangle at v) / area), from v's own
+//                 scrambled Sobol points: stratified over the emitters, with the cosine and
+//                 distance terms exact. Only the front (CCW) side emits, as for photons.
 //   environment   a uniform sky: (1/S) Σ π L V(ω_i) over S cosine-distributed directions (π L
 //                 exactly where nothing is in the way); a map: S cosine-distributed and S
 //                 map-distributed directions, each L cosθ / (p_cos + p_map) / S (balance heuristic),
 //                 shadow rays to infinity.
-// One ray per punctual light; S for all emissive triangles together; S (sky) or 2S (map) for the
-// environment. Each vertex's sum runs in a
-// fixed order in one thread, so the bits depend on nothing but the geometry and the seed.
+// One ray per punctual light while there are at most S point and spot lights (exact, and no more
+// rays than sampling them would cast); past S, point and spot lights join the emissive triangles
+// in the tree and share their S samples, each I cosθ_v / (d² P(light at v)) — a thousand lamps
+// then cost S rays a vertex, not a thousand. Directional lights are always exact. S (sky) or 2S
+// (map) rays for the environment. Each vertex's sum runs in a fixed order in one thread, so the
+// bits depend on nothing but the geometry and the seed.
 //
 // After a move only vertices whose start moved, or one of whose shadow segments meets a mover's old
 // or new bounds, can change (a segment that meets neither saw the same geometry before and after):
 // raysMeeting() finds them from the segments alone, without tracing, and recompute() gives them
-// exactly what computeAll() would. Lights are static (docs/design.md §2): the emitters stay as
-// computeAll() read them.
+// exactly what computeAll() would. Lights are static (docs/design.md §2): the emitters and their
+// tree are read once, by the first computeAll().
 #pragma once
 
 #include <array>
@@ -29,6 +33,7 @@
 
 #include "estimate/vertex_starts.h"
 #include "scene/scene.h"
+#include "trace/light_tree.h"
 #include "trace/scene_bvh.h"
 #include "util/work_counter.h"
 
@@ -38,7 +43,7 @@ class DirectLight {
 public:
     DirectLight(uint32_t samples, uint64_t seed) : samples_(samples), seed_(seed) {}
 
-    // Every vertex, for the scene's current pose (bvh holds it). Reads the emitters anew. Vertices
+    // Every vertex, for the scene's current pose (bvh holds it). Reads the emitters the first time. Vertices
     // flagged in `dark` (if given: the dark back sides, FinalGather::darkBackSides) get 0 and cast
     // nothing, as hidden ones.
     void computeAll(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress = nullptr,
@@ -52,18 +57,28 @@ public:
     const std::vector<Vec3f>& irradiance() const { return irradiance_; }
     // Shadow rays cast by the last computeAll() or recompute().
     uint64_t raysCast() const { return raysCast_; }
+    // The emitters sampled through the tree (emissive triangles or their pieces, and the point and
+    // spot lights past S), the tree's bytes and the seconds its build took.
+    size_t sampledEmitters() const { return emitters_.size(); }
+    size_t treeBytes() const { return tree_.bytes() + emitters_.capacity() * sizeof(Emitter); }
+    double treeSeconds() const { return treeSeconds_; }
+    // Whether point and spot lights are sampled through the tree (more of them than S) rather than
+    // each given a ray.
+    static bool samplesLights(size_t pointAndSpotLights, uint32_t samples) { return samples > 0 && pointAndSpotLights > samples; }
 
 private:
+    // An emissive triangle (or a piece of one) or, past S, a point or spot light.
     struct Emitter {
-        uint32_t triangle;
-        Vec3f radiance;  // L_e
-        float area;
-        double probability;  // of being chosen
-        // Its corners and unit normal (Scene::geometricNormal), read once: emitters never move,
-        // and a sample then touches no scene array (a refined light panel's thousands of
-        // triangles made these reads a fifth of the direct light's time).
+        enum class Kind : uint8_t { Triangle, Point, Spot } kind;
+        Vec3f radiance;  // a triangle's L_e, a light's intensity I
+        float area;      // a triangle's; 0 for a light
+        // A triangle's corners and unit normal (Scene::geometricNormal), read once: emitters never
+        // move, and a sample then touches no scene array (a refined light panel's thousands of
+        // triangles made these reads a fifth of the direct light's time). A light's position is
+        // corner[0], a spot light's direction `normal` and its cos outer cone `cosOuter`.
         std::array<Vec3d, 3> corner;
         Vec3d normal;
+        double cosOuter = -1;
     };
     void readEmitters(const Scene& scene);
     // Calls visit(direction, tfar, irradianceIfClear) for each shadow ray of vertex v: the segment
@@ -81,7 +96,10 @@ private:
     uint32_t samples_;
     uint64_t seed_;
     std::vector<Emitter> emitters_;
-    std::vector<double> cdf_;  // emitters_' cumulative probabilities, last = 1
+    LightTree tree_;  // over emitters_
+    bool emittersRead_ = false;
+    bool lightsSampled_ = false;  // point and spot lights are in the tree, not given a ray each
+    double treeSeconds_ = 0;
     std::vector<Vec3f> irradiance_;
     uint64_t raysCast_ = 0;
 };

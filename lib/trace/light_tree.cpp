@@ -1,0 +1,278 @@
+#include "trace/light_tree.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace qsgi {
+
+namespace {
+
+constexpr double kPiD = 3.14159265358979323846;
+
+// A spot light's cone is sharp (θe = 0): the slack keeps a point on its very edge, which the
+// direct light's own test lets through, from being bounded out by an angle's rounding.
+constexpr double kSpotEdgeSlack = 1e-4;
+// A united cone is widened by this much (radians): its half-angle comes from acos and a rotation,
+// each a rounding off, and it must contain both cones it unites.
+constexpr double kConeSlack = 1e-7;
+// The cosine bounds are floored here once a point may be lit: a grazing emitter whose bound
+// rounds to 0 keeps a probability above 0, as the estimate's unbiasedness needs.
+constexpr double kLeastCosine = 1e-6;
+
+double safeSqrt(double x) { return std::sqrt(std::max(0.0, x)); }
+double safeAcos(double x) { return std::acos(std::clamp(x, -1.0, 1.0)); }
+
+// cos(max(0, θa − θb)) and sin(max(0, θa − θb)) from the angles' sines and cosines.
+double cosSubClamped(double sinA, double cosA, double sinB, double cosB) {
+    return cosA > cosB ? 1.0 : cosA * cosB + sinA * sinB;
+}
+double sinSubClamped(double sinA, double cosA, double sinB, double cosB) {
+    return cosA > cosB ? 0.0 : sinA * cosB - cosA * sinB;
+}
+
+// v rotated by `angle` about unit axis k (Rodrigues).
+Vec3d rotate(const Vec3d& v, const Vec3d& k, double angle) {
+    const double c = std::cos(angle), s = std::sin(angle);
+    return v * c + cross(k, v) * s + k * (dot(k, v) * (1 - c));
+}
+
+// The cost of a node with bounds b split along `axis` (pbrt-v4's surface area orientation
+// heuristic): power × the solid angle its cone may send into × its box's area, stretched for a
+// box thin along the split axis.
+double splitCost(const LightBounds& b, const Bounds3f& nodeBox, int axis) {
+    const double thetaO = safeAcos(b.cosTheta_o), thetaE = safeAcos(b.cosTheta_e);
+    const double thetaW = std::min(thetaO + thetaE, kPiD);
+    const double sinO = safeSqrt(1 - b.cosTheta_o * b.cosTheta_o);
+    const double solidAngle = 2 * kPiD * (1 - b.cosTheta_o) +
+                              kPiD / 2 * (2 * thetaW * sinO - std::cos(thetaO - 2 * thetaW) - 2 * thetaO * sinO + b.cosTheta_o);
+    const Vec3d d(b.box.diagonal());
+    const double area = 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
+    const Vec3d nodeDiagonal(nodeBox.diagonal());
+    const double stretch = nodeDiagonal[axis] > 0 ? maxComponent(nodeDiagonal) / nodeDiagonal[axis] : 1.0;
+    return b.phi * solidAngle * stretch * area;
+}
+
+}  // namespace
+
+LightBounds LightBounds::triangle(const Vec3f corner[3], const Vec3d& normal, double phi) {
+    LightBounds b;
+    for (int k = 0; k < 3; ++k) b.box.extend(corner[k]);
+    b.phi = phi;
+    b.axis = normal;
+    b.cosTheta_o = 1;
+    b.cosTheta_e = 0;  // Lambertian: light leaves up to π/2 from the normal
+    return b;
+}
+
+LightBounds LightBounds::point(const Vec3f& position, double phi) {
+    LightBounds b;
+    b.box.extend(position);
+    b.phi = phi;
+    b.cosTheta_o = -1;
+    b.cosTheta_e = 0;
+    return b;
+}
+
+LightBounds LightBounds::spot(const Vec3f& position, const Vec3d& direction, double cosOuter, double phi) {
+    LightBounds b;
+    b.box.extend(position);
+    b.phi = phi;
+    b.axis = direction;
+    b.cosTheta_o = std::clamp(cosOuter, -1.0, 1.0);
+    b.cosTheta_e = std::cos(kSpotEdgeSlack);
+    return b;
+}
+
+LightBounds LightBounds::unite(const LightBounds& a, const LightBounds& b) {
+    if (!(a.phi > 0)) return b;
+    if (!(b.phi > 0)) return a;
+    LightBounds u;
+    u.box = a.box;
+    u.box.extend(b.box);
+    u.phi = a.phi + b.phi;
+    u.cosTheta_e = std::min(a.cosTheta_e, b.cosTheta_e);
+    // The smallest cone about both cones (pbrt-v4's DirectionCone::Union).
+    const double thetaA = safeAcos(a.cosTheta_o), thetaB = safeAcos(b.cosTheta_o);
+    const double thetaD = safeAcos(dot(a.axis, b.axis));
+    if (std::min(thetaD + thetaB, kPiD) <= thetaA) {
+        u.axis = a.axis;
+        u.cosTheta_o = a.cosTheta_o;
+        return u;
+    }
+    if (std::min(thetaD + thetaA, kPiD) <= thetaB) {
+        u.axis = b.axis;
+        u.cosTheta_o = b.cosTheta_o;
+        return u;
+    }
+    const double thetaO = (thetaA + thetaD + thetaB) / 2 + kConeSlack;
+    const Vec3d k = cross(a.axis, b.axis);
+    const double kLength = length(k);
+    if (thetaO >= kPiD || !(kLength > 1e-12)) {
+        u.axis = Vec3d(0, 0, 1);
+        u.cosTheta_o = -1;
+        return u;
+    }
+    u.axis = normalize(rotate(a.axis, k / kLength, thetaO - kConeSlack - thetaA));
+    u.cosTheta_o = std::cos(thetaO);
+    return u;
+}
+
+double LightBounds::importance(const Vec3d& p, const Vec3d& n) const {
+    if (!(phi > 0)) return 0;
+    const Vec3d lower(box.lower), upper(box.upper);
+    const Vec3d centre = (lower + upper) * 0.5;
+    const double radius2 = dot(upper - lower, upper - lower) * 0.25;
+    const Vec3d toP = p - centre;
+    // Exact for the box: light reaches p only from a point of the box in front of n, and a group of
+    // emitters that all face one way (θo = 0, a lamp, a panel of lamps) lights only what lies in
+    // front of some point of the box. A vertex on an emitter's own plane gets 0 from it here.
+    const Vec3d half = (upper - lower) * 0.5;
+    auto reach = [&](const Vec3d& a) { return std::abs(a.x) * half.x + std::abs(a.y) * half.y + std::abs(a.z) * half.z; };
+    if (-dot(n, toP) + reach(n) <= 0) return 0;
+    if (cosTheta_o == 1 && dot(axis, toP) + reach(axis) <= 0) return 0;
+    const double d2 = dot(toP, toP);
+    // Inside the box's bounding sphere every direction may bring light: no angle bounds it.
+    if (d2 <= radius2) return phi / std::max(radius2, 1e-30);
+    const double distance = std::sqrt(d2);
+    const Vec3d wi = toP / distance;  // from the emitters toward p
+    const double sinB = std::sqrt(radius2 / d2), cosB = safeSqrt(1 - radius2 / d2);
+
+    // The emitters' side: the least angle between a direction they emit along and one toward p.
+    double emitterCosine = 1;
+    if (cosTheta_o > -1) {
+        const double cosW = dot(axis, wi), sinW = safeSqrt(1 - cosW * cosW);
+        const double sinO = safeSqrt(1 - cosTheta_o * cosTheta_o);
+        const double cosX = cosSubClamped(sinW, cosW, sinO, cosTheta_o);
+        const double sinX = sinSubClamped(sinW, cosW, sinO, cosTheta_o);
+        emitterCosine = cosSubClamped(sinX, cosX, sinB, cosB);
+        if (emitterCosine < cosTheta_e) return 0;
+    }
+    // p's side: the light must arrive from in front of n.
+    const double cosI = -dot(n, wi), sinI = safeSqrt(1 - cosI * cosI);
+    const double receiverCosine = cosSubClamped(sinI, cosI, sinB, cosB);
+    if (receiverCosine < 0) return 0;
+    return phi * std::max(emitterCosine, kLeastCosine) * std::max(receiverCosine, kLeastCosine) / d2;
+}
+
+LightTree::LightTree(const std::vector<LightBounds>& bounds) {
+    std::vector<uint32_t> emitters;
+    for (uint32_t i = 0; i < bounds.size(); ++i)
+        if (bounds[i].phi > 0) emitters.push_back(i);
+    leafOf_.assign(bounds.size(), std::numeric_limits<uint32_t>::max());
+    if (emitters.empty()) return;
+    nodes_.reserve(2 * emitters.size() - 1);
+    build(bounds, emitters, 0, emitters.size(), -1, 0);
+}
+
+int32_t LightTree::build(const std::vector<LightBounds>& bounds, std::vector<uint32_t>& emitters, size_t first, size_t last,
+                         int32_t parent, int depth) {
+    const int32_t index = int32_t(nodes_.size());
+    nodes_.push_back({});
+    nodes_[size_t(index)].parent = parent;
+    if (last - first == 1) {
+        const uint32_t e = emitters[first];
+        nodes_[size_t(index)].bounds = bounds[e];
+        nodes_[size_t(index)].emitter = e;
+        leafOf_[e] = uint32_t(index);
+        return index;
+    }
+    Bounds3f centroids, nodeBox;
+    for (size_t i = first; i < last; ++i) {
+        centroids.extend(bounds[emitters[i]].box.center());
+        nodeBox.extend(bounds[emitters[i]].box);
+    }
+    // Bucketed surface area orientation heuristic over the three axes; deep in a degenerate tree
+    // (coincident or exponentially spaced emitters) the count's median instead, which keeps the
+    // depth, and so a sample's descent, within ~64 + log2(emitters).
+    constexpr int kBuckets = 12;
+    constexpr int kSahDepth = 48;
+    double bestCost = std::numeric_limits<double>::infinity();
+    int bestAxis = -1, bestSplit = 0;
+    auto bucketOf = [&](uint32_t e, int axis) {
+        const double lo = centroids.lower[axis], hi = centroids.upper[axis];
+        const int b = int(double(kBuckets) * (double(bounds[e].box.center()[axis]) - lo) / (hi - lo));
+        return std::clamp(b, 0, kBuckets - 1);
+    };
+    if (depth < kSahDepth)
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!(centroids.upper[axis] > centroids.lower[axis])) continue;
+            std::array<LightBounds, kBuckets> bucket{};
+            for (size_t i = first; i < last; ++i) {
+                LightBounds& b = bucket[size_t(bucketOf(emitters[i], axis))];
+                b = LightBounds::unite(b, bounds[emitters[i]]);
+            }
+            for (int split = 0; split + 1 < kBuckets; ++split) {
+                LightBounds below, above;
+                for (int k = 0; k <= split; ++k) below = LightBounds::unite(below, bucket[size_t(k)]);
+                for (int k = split + 1; k < kBuckets; ++k) above = LightBounds::unite(above, bucket[size_t(k)]);
+                if (!(below.phi > 0) || !(above.phi > 0)) continue;
+                const double cost = splitCost(below, nodeBox, axis) + splitCost(above, nodeBox, axis);
+                if (cost < bestCost) bestCost = cost, bestAxis = axis, bestSplit = split;
+            }
+        }
+    size_t middle = first;
+    if (bestAxis >= 0)
+        middle = size_t(std::partition(emitters.begin() + long(first), emitters.begin() + long(last),
+                                       [&](uint32_t e) { return bucketOf(e, bestAxis) <= bestSplit; }) -
+                        emitters.begin());
+    if (middle == first || middle == last) {
+        // The count's median along the widest axis, ties broken by index: a fixed order.
+        const Vec3f extent = centroids.diagonal();
+        const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+        middle = (first + last) / 2;
+        std::nth_element(emitters.begin() + long(first), emitters.begin() + long(middle), emitters.begin() + long(last),
+                         [&](uint32_t a, uint32_t b) {
+                             const float ca = bounds[a].box.center()[axis], cb = bounds[b].box.center()[axis];
+                             return ca < cb || (ca == cb && a < b);
+                         });
+    }
+    build(bounds, emitters, first, middle, index, depth + 1);
+    const int32_t second = build(bounds, emitters, middle, last, index, depth + 1);
+    Node& node = nodes_[size_t(index)];
+    node.second = second;
+    node.bounds = LightBounds::unite(nodes_[size_t(index) + 1].bounds, nodes_[size_t(second)].bounds);
+    return index;
+}
+
+bool LightTree::sample(const Vec3d& p, const Vec3d& n, double u, Choice& choice) const {
+    if (nodes_.empty()) return false;
+    size_t i = 0;
+    double probability = 1;
+    while (!nodes_[i].leaf()) {
+        const size_t second = size_t(nodes_[i].second);
+        const double a = nodes_[i + 1].bounds.importance(p, n), b = nodes_[second].bounds.importance(p, n);
+        if (!(a + b > 0)) return false;
+        const double pa = a / (a + b), pb = b / (a + b);
+        if (u < pa) {
+            i = i + 1;
+            probability *= pa;
+            u = u / pa;
+        } else {
+            i = second;
+            probability *= pb;
+            u = (u - pa) / pb;
+        }
+        u = std::min(u, std::nextafter(1.0, 0.0));
+    }
+    choice = {nodes_[i].emitter, probability};
+    return true;
+}
+
+double LightTree::probability(const Vec3d& p, const Vec3d& n, uint32_t emitter) const {
+    if (emitter >= leafOf_.size() || leafOf_[emitter] == std::numeric_limits<uint32_t>::max()) return 0;
+    int32_t node = int32_t(leafOf_[emitter]);
+    double probability = 1;
+    while (nodes_[size_t(node)].parent >= 0) {
+        const int32_t parent = nodes_[size_t(node)].parent;
+        const size_t second = size_t(nodes_[size_t(parent)].second);
+        const double a = nodes_[size_t(parent) + 1].bounds.importance(p, n), b = nodes_[second].bounds.importance(p, n);
+        if (!(a + b > 0)) return 0;
+        probability *= (size_t(node) == second ? b : a) / (a + b);
+        node = parent;
+    }
+    return probability;
+}
+
+}  // namespace qsgi

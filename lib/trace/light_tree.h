@@ -1,0 +1,92 @@
+// A light tree (Conty Estevez & Kulla 2018, "Importance sampling of many lights with adaptive tree
+// splitting"; pbrt-v4's BVHLightSampler, Cycles' light tree): a binary tree over the emitters that
+// exact direct light samples (DirectLight), each node bounding its emitters' positions, power and
+// the directions they send light in. A shading point p with normal n descends from the root,
+// choosing each child in proportion to a conservative bound of what the child's emitters can send
+// to p (importance()), until it reaches one emitter. The probability of that emitter is the product
+// of the choices along its path, so dividing its contribution by it keeps the estimate unbiased; a
+// child that certainly sends nothing to p has importance 0 and is never chosen, and every emitter
+// that can light p has a probability above 0.
+//
+// The tree is built once (lights are static, docs/design.md §2), single-threaded, in a fixed
+// order: the same tree for any thread count, and a pure function of the emitters given.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "util/vecmath.h"
+
+namespace qsgi {
+
+// What bounds the light of one emitter or a group of them: where they are (box), how strongly
+// they send it (phi: the luminance of their intensity, W/sr — a light's I, a triangle's L_e A
+// along its normal — so that phi cosθ / d² bounds the irradiance each type brings alike; summed
+// over a group), and the directions of their surfaces' normals (the
+// cone about unit `axis` of half-angle θo, cosTheta_o) widened by how far from a normal they still
+// emit (θe, cosTheta_e: π/2 for a Lambertian surface, 0 for a spot light beyond its cone).
+struct LightBounds {
+    Bounds3f box;
+    double phi = 0;
+    Vec3d axis{0, 0, 1};
+    double cosTheta_o = 1;  // −1: every direction (a point light)
+    double cosTheta_e = 0;
+
+    // A one-sided Lambertian triangle with the given corners, unit front normal and L_e A.
+    static LightBounds triangle(const Vec3f corner[3], const Vec3d& normal, double phi);
+    // A point light (every direction) or a spot light that sends light within angle acos(cosOuter)
+    // of `direction` (unit), of intensity phi.
+    static LightBounds point(const Vec3f& position, double phi);
+    static LightBounds spot(const Vec3f& position, const Vec3d& direction, double cosOuter, double phi);
+
+    // Bounds of both (phi summed, the smallest cone found about both cones, the wider θe).
+    static LightBounds unite(const LightBounds& a, const LightBounds& b);
+
+    // A bound, up to a common factor, of the irradiance the emitters can send to a point p whose
+    // surface faces unit n (the light must arrive from n's side): phi · cosθ' / d² · cosθ'_i with
+    // the angles widened by the box's subtended cone and d² no less than the box's radius squared.
+    // 0 only where no emitter inside can send p anything.
+    double importance(const Vec3d& p, const Vec3d& n) const;
+};
+
+class LightTree {
+public:
+    LightTree() = default;
+    // One leaf per emitter, emitter i being bounds[i]; emitters with phi = 0 are left out.
+    explicit LightTree(const std::vector<LightBounds>& bounds);
+
+    bool empty() const { return nodes_.empty(); }
+    size_t nodeCount() const { return nodes_.size(); }
+    size_t bytes() const { return nodes_.capacity() * sizeof(Node) + leafOf_.capacity() * sizeof(uint32_t); }
+
+    struct Choice {
+        uint32_t emitter = 0;
+        double probability = 0;  // of choosing it at this point
+    };
+    // Descends from the root with u in [0, 1): false if nothing can light (p, n). A tree of one
+    // emitter returns it with probability 1 without asking its importance, which is exactly what
+    // sampling among one emitter by power did.
+    bool sample(const Vec3d& p, const Vec3d& n, double u, Choice& choice) const;
+    // The probability that sample() chooses `emitter` at (p, n): the product along its path.
+    double probability(const Vec3d& p, const Vec3d& n, uint32_t emitter) const;
+
+    // For tests: node i's bounds, its children (−1 for a leaf) and a leaf's emitter.
+    struct Node {
+        LightBounds bounds;
+        int32_t second = -1;   // an interior node's second child; its first is the next node
+        int32_t parent = -1;
+        uint32_t emitter = 0;  // a leaf's
+        bool leaf() const { return second < 0; }
+    };
+    const Node& node(size_t i) const { return nodes_[i]; }
+
+private:
+    // Builds the subtree over emitters[first, last) at nodes_.size(); returns its index.
+    int32_t build(const std::vector<LightBounds>& bounds, std::vector<uint32_t>& emitters, size_t first, size_t last,
+                  int32_t parent, int depth);
+
+    std::vector<Node> nodes_;
+    std::vector<uint32_t> leafOf_;  // per emitter, its leaf (UINT32_MAX if left out)
+};
+
+}  // namespace qsgi
