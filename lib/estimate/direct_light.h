@@ -62,6 +62,7 @@ public:
     size_t sampledEmitters() const { return emitters_.size(); }
     size_t treeBytes() const { return tree_.bytes() + emitters_.capacity() * sizeof(Emitter); }
     double treeSeconds() const { return treeSeconds_; }
+    bool lightsSampled() const { return lightsSampled_; }
     // Whether point and spot lights are sampled through the tree (more of them than S) rather than
     // each given a ray.
     static bool samplesLights(size_t pointAndSpotLights, uint32_t samples) { return samples > 0 && pointAndSpotLights > samples; }

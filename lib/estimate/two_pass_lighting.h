@@ -53,6 +53,8 @@ public:
     size_t stateBytes() const;
     // The gather cache of the last solve or update (nullptr without one).
     const GatherCache* gatherCache() const { return cache_ ? &*cache_ : nullptr; }
+    // Exact direct light (its light tree: DirectLight::sampledEmitters and the rest).
+    const DirectLight& directLight() const { return direct_; }
     // The covered vertices of the last solve or update (FinalGather's rule; empty without a gather).
     const std::vector<uint8_t>& covered() const { return covered_; }
 

@@ -40,6 +40,7 @@ std::string TimingLog::text() const {
     j["emission"] = {{"emitted_fraction", traced ? json(emittedFraction) : json(nullptr)},
                      {"first_segment_miss_rate",
                       traced ? json(double(photonsMissingScene) / double(std::max<uint64_t>(photons, 1))) : json(nullptr)}};
+    j["setup"] = setup;
     std::vector<double> updates, estimates;
     for (size_t i = 1; i < frames.size(); ++i) {
         updates.push_back(frames[i].photonSimulationSeconds);

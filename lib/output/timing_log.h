@@ -34,6 +34,9 @@ struct TimingLog {
     double animationDiagonal = 0;  // the diagonal of the whole animation's bounds (default radius = 1.5 % of it)
     // runFingerprint of the inputs and settings; --resume continues only a folder whose log has it.
     std::string inputsFingerprint;
+    // Set-up outside the frames (issue 58), from the run's first frame: the seconds from the
+    // job's start to its first frame, aimed emission's maps and probes, the direct light's tree.
+    nlohmann::json setup;
     // What the fingerprint is made of ("inputs": RunFingerprint::parts), for naming what differs.
     nlohmann::json inputs;
 

@@ -74,6 +74,8 @@ public:
     const SceneBvh& bvh() const { return bvh_; }
     // The share of the lights' power that emission sends toward the scene (LightSampler).
     double emittedFraction() const { return tracer_.lights().emittedFraction(); }
+    // Exact direct light, after the first solve (null with direct light from the photons).
+    const DirectLight* directLight() const { return lighting_ ? &lighting_->directLight() : nullptr; }
     const DiscRegions* regions() const { return geometry_.regions(); }
     // The paths an incremental frame keeps (null unless tracking): what tests compare with a
     // fresh trace of the same pose.

@@ -439,6 +439,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         if (observer.onStage) observer.onStage(StageReport{current, current - start, count, name, done, total});
     };
     solver.reportStagesTo(stage);
+    const double setupSeconds = started_.seconds();
     for (int frame = start; frame <= last_; ++frame) {
         current = frame;
         Stopwatch frameClock;
@@ -452,6 +453,15 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
             log.photonsMissingScene = timing.photonsMissingScene;
             log.emittedFraction = solver.emittedFraction();
             log.emissionMeasured = true;
+            const LightSampler& lights = solver.tracer().lights();
+            log.setup = {{"before_first_frame_s", setupSeconds},
+                         {"aimed_lights", lights.aimedLights()},
+                         {"aim_s", lights.aimSeconds()}};
+            if (const DirectLight* direct = solver.directLight())
+                log.setup["light_tree"] = {{"emitters", direct->sampledEmitters()},
+                                           {"lights_sampled", direct->lightsSampled()},
+                                           {"bytes", direct->treeBytes()},
+                                           {"build_s", direct->treeSeconds()}};
         }
         for (const std::unique_ptr<FrameSink>& sink : sinks)
             if (const char* preparing = sink->preparingStage()) {

@@ -16,6 +16,7 @@
 #include "scene/mesh_resolution.h"
 #include "scene/scene.h"
 #include "util/error.h"
+#include "util/stopwatch.h"
 
 namespace qsgi {
 
@@ -108,6 +109,7 @@ private:
     // made from the folder's PLYs.
     std::vector<std::unique_ptr<FrameSink>> makeSinks() const;
 
+    Stopwatch started_;  // first: the job's set-up is timed from its construction (timing.json's "setup")
     RenderSettings settings_;
     Scene scene_;
     // --vertex-fit least-squares: scene_ refined near contacts, which the frames are solved on;

@@ -4,6 +4,7 @@
 #include <cassert>
 
 #include "trace/sampling.h"
+#include "util/stopwatch.h"
 
 namespace qsgi {
 
@@ -30,8 +31,8 @@ int mapDepthFor(size_t aimedLights) {
 }  // namespace
 
 LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim,
-                           std::optional<uint64_t> dealSeed)
-    : scene_(scene), rayEpsilon_(rayEpsilon) {
+                           std::optional<uint64_t> dealSeed, const SceneBvh* probes)
+    : scene_(scene), rayEpsilon_(rayEpsilon), probes_(probes) {
     const Bounds3f b = scene.animationBounds;
     boundsCentre_ = b.center();
     boundsRadius_ = std::max(0.5f * b.extent(), 1e-6f);
@@ -77,6 +78,7 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
     size_t aimedLights = 0;
     for (const Emitter& e : emitters_) aimedLights += aim.enabled && aimable(e);
     mapDepth_ = mapDepthFor(aimedLights);
+    const Stopwatch aimClock;
     double unaimed = 0;
     for (Emitter& e : emitters_) {
         if (!aimable(e) || !aim.enabled) {
@@ -90,6 +92,7 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
                        : double(luminance(e.power));
         aimLight(e, aim);
     }
+    aimSeconds_ = aimClock.seconds();
     // Drop emitters that would never be chosen.
     emitters_.erase(std::remove_if(emitters_.begin(), emitters_.end(),
                                    [](const Emitter& e) { return !(luminance(e.power) > 0); }),
@@ -172,6 +175,8 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
                 a.cosSpot = cosSpot;
             }
         }
+        // A light inside the scene whose probes find (almost) nothing escaping emits unaimed.
+        if (!outside && probes_ && !aimPays(scene_, *probes_, apex, a.axis, a.cosMax)) return;
         targets = mapTargets(scene_, epsilon, settings.margin, [&](const Vec3d& q) { return normalize(q - apex); });
         a.map = directionMap(apex, a.axis, a.cosMax, spotAxis, a.spotAxis ? cosSpot : -1.0, targets, mapDepth_);
         // A light inside the scene whose every direction may reach something emits as unaimed.
@@ -181,6 +186,24 @@ void LightSampler::aimLight(Emitter& e, const EmissionAim& settings) {
     orthonormalBasis(a.axis, a.t, a.b);
     e.aim = int(aims_.size());
     aims_.push_back(std::move(a));
+}
+
+bool LightSampler::aimPays(const Scene& scene, const SceneBvh& bvh, const Vec3d& apex, const Vec3d& axis, double cosMax) {
+    Vec3d t, b;
+    orthonormalBasis(axis, t, b);
+    const Vec3f origin(apex);
+    constexpr double kGoldenAngle = 2.39996322972865332;  // π (3 − √5)
+    int escaped = 0;
+    for (int i = 0; i < kProbeRays; ++i) {
+        // Equal solid angles: cosθ evenly spaced over [cosMax, 1], the azimuth by the golden angle.
+        const double cosTheta = 1 - (1 - cosMax) * (double(i) + 0.5) / kProbeRays;
+        const double sinTheta = std::sqrt(std::max(0.0, 1 - cosTheta * cosTheta));
+        const Vec3f direction(coneDirection(axis, t, b, cosTheta, sinTheta, kGoldenAngle * double(i)));
+        constexpr float kFar = std::numeric_limits<float>::infinity();
+        if (bvh.staticOccludes(origin, direction, 0.0f, kFar) || rayMeetsAny(scene.sweptBoxes, origin, direction, kFar)) continue;
+        if (++escaped * kEscapeShare >= kProbeRays) return true;
+    }
+    return false;
 }
 
 std::vector<Vec3f> LightSampler::lightPowers(size_t lightCount) const {

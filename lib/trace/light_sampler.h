@@ -15,6 +15,7 @@
 #include "scene/scene.h"
 #include "trace/photon_numbers.h"
 #include "trace/projection_map.h"
+#include "trace/scene_bvh.h"
 #include "trace/trace_settings.h"
 
 namespace qsgi {
@@ -29,9 +30,26 @@ struct PhotonEmission {
 class LightSampler {
 public:
     // photonCount is the number of photons the power is shared among. With dealSeed, photons are
-    // dealt to the emitters (dealt()) instead of each choosing one by a random number.
+    // dealt to the emitters (dealt()) instead of each choosing one by a random number. With
+    // `probes` (the scene's BVH), a point or spot light inside the scene is aimed only where its
+    // map pays (aimPays()); without, every aimed light gets its map.
     LightSampler(const Scene& scene, uint64_t photonCount, float rayEpsilon, const EmissionAim& aim = {false, 0},
-                 std::optional<uint64_t> dealSeed = std::nullopt);
+                 std::optional<uint64_t> dealSeed = std::nullopt, const SceneBvh* probes = nullptr);
+
+    // Whether a map pays for a light at `apex` that emits into the cone about unit `axis` of cos
+    // half-angle cosMax: kProbeRays rays spread evenly over the cone (a Fibonacci spiral, the same
+    // for every run) are traced against the static geometry, and a map pays when at least
+    // 1/kEscapeShare of them escape — meet neither a static triangle nor a mover's swept box. A
+    // light inside a room (a lamp, a thousand lamps) then emits unaimed without building a map
+    // that would keep every cell, and wastes at most about that share of its photons where a gap
+    // the probes miss lets some out. Static geometry only: the answer is the same for every frame,
+    // so incremental and full recomputation emit the same photons.
+    static constexpr int kProbeRays = 256;
+    static constexpr int kEscapeShare = 64;
+    static bool aimPays(const Scene& scene, const SceneBvh& bvh, const Vec3d& apex, const Vec3d& axis, double cosMax);
+    // How many lights got a map, and the seconds the maps and probes took.
+    size_t aimedLights() const { return aims_.size(); }
+    double aimSeconds() const { return aimSeconds_; }
 
     bool empty() const { return emitters_.empty(); }
     // What each emitter sends toward the scene (W, RGB): punctual lights by index (zero for one
@@ -92,6 +110,8 @@ private:
     float boundsRadius_ = 0;
     float rayEpsilon_;
     int mapDepth_ = 0;  // of every light's projection map: finer for fewer lights (mapDepthFor)
+    const SceneBvh* probes_ = nullptr;
+    double aimSeconds_ = 0;
 };
 
 }  // namespace qsgi

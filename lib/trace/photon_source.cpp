@@ -8,10 +8,10 @@
 namespace qsgi {
 
 PhotonSource::PhotonSource(const Scene& scene, uint64_t photons, uint64_t seed, float rayEpsilon, const EmissionAim& aim,
-                           const PhotonSampling& sampling, std::shared_ptr<const SurfaceLookup> surfaces)
+                           const PhotonSampling& sampling, std::shared_ptr<const SurfaceLookup> surfaces, const SceneBvh* probes)
     : seed_(seed), sampling_(sampling),
-      lights_(scene, photons, rayEpsilon, aim,
-              sampling.kind == SamplerKind::Sobol ? std::optional<uint64_t>(seed) : std::nullopt) {
+      lights_(scene, photons, rayEpsilon, aim, sampling.kind == SamplerKind::Sobol ? std::optional<uint64_t>(seed) : std::nullopt,
+              probes) {
     if (!surfaces) surfaces = std::make_shared<const SurfaceLookup>(scene);
     if (surfaces->any()) lookup_ = std::move(surfaces);
     surfaceOf_.resize(scene.triangleCount());

@@ -19,8 +19,10 @@ namespace qsgi {
 class PhotonSource {
 public:
     // `surfaces`: the scene's lookup (SceneBvh::sharedSurfaces), or null to make one.
+    // `probes`: the scene's BVH, with which emission decides where aiming pays (LightSampler).
     PhotonSource(const Scene& scene, uint64_t photons, uint64_t seed, float rayEpsilon, const EmissionAim& aim,
-                 const PhotonSampling& sampling, std::shared_ptr<const SurfaceLookup> surfaces = nullptr);
+                 const PhotonSampling& sampling, std::shared_ptr<const SurfaceLookup> surfaces = nullptr,
+                 const SceneBvh* probes = nullptr);
 
     const LightSampler& lights() const { return lights_; }
     PathNumbers numbersFor(uint64_t path) const;

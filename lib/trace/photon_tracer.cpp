@@ -12,7 +12,7 @@ namespace qsgi {
 PhotonTracer::PhotonTracer(const Scene& scene, const SceneBvh& bvh, const TraceSettings& settings)
     : bvh_(bvh), settings_(settings),
       source_(std::make_shared<const PhotonSource>(scene, settings.photons, settings.seed, bvh.rayEpsilon(), settings.aim,
-                                                   settings.sampling, bvh.sharedSurfaces())),
+                                                   settings.sampling, bvh.sharedSurfaces(), &bvh)),
       bounds_(scene.animationBounds.expanded(bvh.rayEpsilon())) {}
 
 namespace {
