@@ -14,6 +14,7 @@
 #include "estimate/vertex_samples.h"
 #include "scene/emission_pieces.h"
 #include "test_support.h"
+#include "trace/light_sampler.h"
 #include "trace/light_tree.h"
 #include "trace/sampling.h"
 #include "trace/scene_bvh.h"
@@ -384,4 +385,52 @@ TEST(ManyLights, OneEmissiveTriangleOrOneLightGivesTheAnswerBeforeTheTreeToTheBi
     one.computeAll(plane, planeRig.bvh, planeRig.starts);
     EXPECT_EQ(one.sampledEmitters(), 0u) << "one light is given its ray, not sampled";
     EXPECT_EQ(one.raysCast(), plane.vertexCount());
+}
+
+// Extreme light counts (issue 58) render finitely, with set-up that does not grow with the count
+// as a map per light did: a million point lights over a small floor — a third of them at one
+// point, a tenth of no power — and 200 directional lights; with a 1024-triangle emitter besides.
+// Photon emission aims none of them (each light's share of the photons is below a probe's rays),
+// direct light samples them all through the tree and the directional lights by their irradiance,
+// and every vertex's light is finite and, on the lit floor, above 0.
+TEST(ManyLights, AMillionLightsCoincidentAndPowerlessOnesRenderFinitely) {
+    Scene scene = testscenes::floorUnderEmitter(8, Vec3f(0.0f, 1.5f, 0.0f), 0.4f, 0.4f, Vec3f(2.0f), Vec3f(0.5f));
+    std::mt19937_64 random(11);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    constexpr size_t kLights = 1000000;
+    scene.lights.reserve(kLights + 200);
+    for (size_t k = 0; k < kLights; ++k) {
+        PunctualLight l;
+        l.type = k % 7 == 3 ? LightType::Spot : LightType::Point;
+        l.position = k % 3 == 0 ? Vec3f(0.1f, 0.7f, 0.2f) : Vec3f(2 * unit(random), 0.3f + unit(random) + 1.0f, 2 * unit(random));
+        l.position = Vec3f(Vec3d(l.position) - scene.worldOrigin);
+        l.intensity = k % 10 == 9 ? Vec3f(0.0f) : Vec3f(1e-4f);
+        l.direction = Vec3f(0, -1, 0);
+        l.cosOuterCone = 0.5f;
+        scene.lights.push_back(l);
+    }
+    for (int k = 0; k < 200; ++k) {
+        PunctualLight l;
+        l.type = LightType::Directional;
+        l.direction = normalize(Vec3f(unit(random), -1.0f, unit(random)));
+        l.intensity = Vec3f(k % 4 == 0 ? 0.0f : 0.01f);
+        scene.lights.push_back(l);
+    }
+    const SecondPassRig rig(scene);
+    const LightSampler photons(scene, 100000, rig.bvh.rayEpsilon(), EmissionAim{true, 0.05f}, uint64_t(1), &rig.bvh);
+    EXPECT_EQ(photons.aimedLights(), 0u) << "no light has 256 photons to aim";
+    DirectLight direct(16, 3);
+    direct.computeAll(scene, rig.bvh, rig.starts);
+    EXPECT_TRUE(direct.lightsSampled());
+    EXPECT_EQ(direct.sampledEmitters(), 2 + kLights - kLights / 10) << "the lamp's two triangles and every light with power";
+    // S = 16 samples each for the tree and the directional lights: never a ray per light.
+    EXPECT_LE(direct.raysCast(), uint64_t(scene.vertexCount()) * 32);
+    size_t lit = 0;
+    for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
+        ASSERT_TRUE(isFinite(direct.irradiance()[v])) << "vertex " << v;
+        lit += direct.irradiance()[v].y > 0;
+    }
+    EXPECT_GT(lit, scene.vertexCount() / 2);
+    std::printf("a million lights: tree of %zu emitters, %.1f MiB, built in %.2f s\n", direct.sampledEmitters(),
+                double(direct.treeBytes()) / (1 << 20), direct.treeSeconds());
 }

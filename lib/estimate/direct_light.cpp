@@ -47,6 +47,20 @@ void DirectLight::readEmitters(const Scene& scene) {
     size_t pointAndSpot = 0;
     for (const PunctualLight& l : scene.lights) pointAndSpot += l.type != LightType::Directional;
     lightsSampled_ = samplesLights(pointAndSpot, samples_);
+    // Directional lights past S: S samples of their own, each chosen by its irradiance E.
+    directionalCdf_.clear();
+    directional_.clear();
+    if (samplesLights(scene.lights.size() - pointAndSpot, samples_)) {
+        double running = 0;
+        for (uint32_t i = 0; i < scene.lights.size(); ++i) {
+            const PunctualLight& l = scene.lights[i];
+            const double e = double(luminance(l.intensity));
+            if (l.type != LightType::Directional || !(e > 0)) continue;
+            running += e;
+            directional_.push_back(i);
+            directionalCdf_.push_back(running);
+        }
+    }
     if (lightsSampled_)
         for (const PunctualLight& l : scene.lights) {
             if (l.type == LightType::Directional) continue;
@@ -87,6 +101,7 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
     float tfar;
     for (const PunctualLight& l : scene.lights) {
         if (l.type == LightType::Directional) {
+            if (!directionalCdf_.empty()) continue;  // sampled below
             const Vec3d w = -Vec3d(l.direction);
             const double cosV = dot(n, w);
             if (cosV > 0) visit(Vec3f(w), kInfinity, Vec3d(l.intensity) * cosV);
@@ -104,8 +119,25 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
         if (shadowTo(Vec3d(l.position), direction, tfar)) visit(direction, tfar, Vec3d(l.intensity) * (cosV / d2));
     }
     if (scene.environment && samples_ > 0) environmentRays(*scene.environment, n, v, visit);
-    if (tree_.empty() || samples_ == 0) return;
+    if (samples_ == 0) return;
     const VertexSamples numbers(seed_, v, VertexStream::Direct);
+    if (!directionalCdf_.empty()) {
+        // E cosθ_v / P(light) with P = E over all the directional lights' E (luminance).
+        const VertexSamples::Dimension pick = numbers.dimension(4);
+        const double total = directionalCdf_.back();
+        for (uint32_t i = 0; i < samples_; ++i) {
+            const double target = double(pick.uniform(i)) * total;
+            const size_t k = std::min(size_t(std::upper_bound(directionalCdf_.begin(), directionalCdf_.end(), target) -
+                                             directionalCdf_.begin()),
+                                      directional_.size() - 1);
+            const PunctualLight& l = scene.lights[directional_[k]];
+            const Vec3d w = -Vec3d(l.direction);
+            const double cosV = dot(n, w);
+            const double probability = double(luminance(l.intensity)) / total;
+            if (cosV > 0) visit(Vec3f(w), kInfinity, Vec3d(l.intensity) * (cosV / probability / double(samples_)));
+        }
+    }
+    if (tree_.empty()) return;
     const VertexSamples::Dimension choose = numbers.dimension(0), fine = numbers.dimension(3);
     const double perSample = 1.0 / double(samples_);
     for (uint32_t i = 0; i < samples_; ++i) {

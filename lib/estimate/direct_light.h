@@ -16,7 +16,8 @@
 // One ray per punctual light while there are at most S point and spot lights (exact, and no more
 // rays than sampling them would cast); past S, point and spot lights join the emissive triangles
 // in the tree and share their S samples, each I cosθ_v / (d² P(light at v)) — a thousand lamps
-// then cost S rays a vertex, not a thousand. Directional lights are always exact. S (sky) or 2S
+// then cost S rays a vertex, not a thousand. Directional lights likewise: exact up to S of them,
+// past S S samples of their own, each chosen by its irradiance E. S (sky) or 2S
 // (map) rays for the environment. Each vertex's sum runs in a fixed order in one thread, so the
 // bits depend on nothing but the geometry and the seed.
 //
@@ -100,6 +101,10 @@ private:
     LightTree tree_;  // over emitters_
     bool emittersRead_ = false;
     bool lightsSampled_ = false;  // point and spot lights are in the tree, not given a ray each
+    // Past S directional lights: their indices and the cumulative luminance of their irradiance
+    // (empty while each has its ray).
+    std::vector<uint32_t> directional_;
+    std::vector<double> directionalCdf_;
     double treeSeconds_ = 0;
     std::vector<Vec3f> irradiance_;
     uint64_t raysCast_ = 0;

@@ -73,8 +73,15 @@ LightSampler::LightSampler(const Scene& scene, uint64_t photonCount, float rayEp
         const Vec3d power = scene.environment->integral() * (M_PI * double(boundsRadius_) * double(boundsRadius_));
         emitters_.push_back({Emitter::Environment, 0, Vec3f(power), Vec3f(0.0f)});
     }
-    // Emissive triangles and the environment are never aimed.
-    auto aimable = [](const Emitter& e) { return e.kind != Emitter::Triangle && e.kind != Emitter::Environment; };
+    // Emissive triangles and the environment are never aimed, nor a light whose share of the
+    // photons is below kProbeRays: its map, or even its probes, would cost more rays than all its
+    // photons (a million lights under 10^6 photons get about one each).
+    double allPower = 0;
+    for (const Emitter& e : emitters_) allPower += luminance(e.power);
+    auto aimable = [&](const Emitter& e) {
+        return e.kind != Emitter::Triangle && e.kind != Emitter::Environment &&
+               double(photonCount) * (double(luminance(e.power)) / allPower) >= double(kProbeRays);
+    };
     size_t aimedLights = 0;
     for (const Emitter& e : emitters_) aimedLights += aim.enabled && aimable(e);
     mapDepth_ = mapDepthFor(aimedLights);

@@ -44,6 +44,7 @@ public:
     // that would keep every cell, and wastes at most about that share of its photons where a gap
     // the probes miss lets some out. Static geometry only: the answer is the same for every frame,
     // so incremental and full recomputation emit the same photons.
+    // A light whose share of the photons is below kProbeRays is never aimed (nor probed).
     static constexpr int kProbeRays = 256;
     static constexpr int kEscapeShare = 64;
     static bool aimPays(const Scene& scene, const SceneBvh& bvh, const Vec3d& apex, const Vec3d& axis, double cosMax);

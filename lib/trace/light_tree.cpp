@@ -42,15 +42,19 @@ Vec3d rotate(const Vec3d& v, const Vec3d& k, double angle) {
 // heuristic): power × the solid angle its cone may send into × its box's area, stretched for a
 // box thin along the split axis.
 double splitCost(const LightBounds& b, const Bounds3f& nodeBox, int axis) {
+    const Vec3d d(b.box.diagonal());
+    const double area = 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
+    const Vec3d nodeDiagonal(nodeBox.diagonal());
+    const double stretch = nodeDiagonal[axis] > 0 ? maxComponent(nodeDiagonal) / nodeDiagonal[axis] : 1.0;
+    // The two cones most nodes have, without trigonometry: every direction (point lights), 4π;
+    // one normal, Lambertian (a panel of lamps), π.
+    if (b.cosTheta_o == -1) return b.phi * 4 * kPiD * stretch * area;
+    if (b.cosTheta_o == 1 && b.cosTheta_e == 0) return b.phi * kPiD * stretch * area;
     const double thetaO = safeAcos(b.cosTheta_o), thetaE = safeAcos(b.cosTheta_e);
     const double thetaW = std::min(thetaO + thetaE, kPiD);
     const double sinO = safeSqrt(1 - b.cosTheta_o * b.cosTheta_o);
     const double solidAngle = 2 * kPiD * (1 - b.cosTheta_o) +
                               kPiD / 2 * (2 * thetaW * sinO - std::cos(thetaO - 2 * thetaW) - 2 * thetaO * sinO + b.cosTheta_o);
-    const Vec3d d(b.box.diagonal());
-    const double area = 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
-    const Vec3d nodeDiagonal(nodeBox.diagonal());
-    const double stretch = nodeDiagonal[axis] > 0 ? maxComponent(nodeDiagonal) / nodeDiagonal[axis] : 1.0;
     return b.phi * solidAngle * stretch * area;
 }
 
@@ -93,7 +97,19 @@ LightBounds LightBounds::unite(const LightBounds& a, const LightBounds& b) {
     u.box.extend(b.box);
     u.phi = a.phi + b.phi;
     u.cosTheta_e = std::min(a.cosTheta_e, b.cosTheta_e);
-    // The smallest cone about both cones (pbrt-v4's DirectionCone::Union).
+    // The smallest cone about both cones (pbrt-v4's DirectionCone::Union). Without a trigonometric
+    // call where one cone is every direction (point lights) or both share an axis (a panel of
+    // lamps): the tree's build unites every emitter into a bucket once per axis and level.
+    if (a.cosTheta_o == -1 || b.cosTheta_o == -1) {
+        u.axis = Vec3d(0, 0, 1);
+        u.cosTheta_o = -1;
+        return u;
+    }
+    if (a.axis == b.axis) {
+        u.axis = a.axis;
+        u.cosTheta_o = std::min(a.cosTheta_o, b.cosTheta_o);
+        return u;
+    }
     const double thetaA = safeAcos(a.cosTheta_o), thetaB = safeAcos(b.cosTheta_o);
     const double thetaD = safeAcos(dot(a.axis, b.axis));
     if (std::min(thetaD + thetaB, kPiD) <= thetaA) {
@@ -157,31 +173,30 @@ double LightBounds::importance(const Vec3d& p, const Vec3d& n) const {
 }
 
 LightTree::LightTree(const std::vector<LightBounds>& bounds) {
-    std::vector<uint32_t> emitters;
+    std::vector<Item> items;
     for (uint32_t i = 0; i < bounds.size(); ++i)
-        if (bounds[i].phi > 0) emitters.push_back(i);
+        if (bounds[i].phi > 0) items.push_back({bounds[i], bounds[i].box.center(), i});
     leafOf_.assign(bounds.size(), std::numeric_limits<uint32_t>::max());
-    if (emitters.empty()) return;
-    nodes_.reserve(2 * emitters.size() - 1);
-    build(bounds, emitters, 0, emitters.size(), -1, 0);
+    if (items.empty()) return;
+    nodes_.reserve(2 * items.size() - 1);
+    build(items, 0, items.size(), -1, 0);
 }
 
-int32_t LightTree::build(const std::vector<LightBounds>& bounds, std::vector<uint32_t>& emitters, size_t first, size_t last,
-                         int32_t parent, int depth) {
+int32_t LightTree::build(std::vector<Item>& items, size_t first, size_t last, int32_t parent, int depth) {
     const int32_t index = int32_t(nodes_.size());
     nodes_.push_back({});
     nodes_[size_t(index)].parent = parent;
     if (last - first == 1) {
-        const uint32_t e = emitters[first];
-        nodes_[size_t(index)].bounds = bounds[e];
-        nodes_[size_t(index)].emitter = e;
-        leafOf_[e] = uint32_t(index);
+        const Item& item = items[first];
+        nodes_[size_t(index)].bounds = item.bounds;
+        nodes_[size_t(index)].emitter = item.emitter;
+        leafOf_[item.emitter] = uint32_t(index);
         return index;
     }
     Bounds3f centroids, nodeBox;
     for (size_t i = first; i < last; ++i) {
-        centroids.extend(bounds[emitters[i]].box.center());
-        nodeBox.extend(bounds[emitters[i]].box);
+        centroids.extend(items[i].centre);
+        nodeBox.extend(items[i].bounds.box);
     }
     // Bucketed surface area orientation heuristic over the three axes; deep in a degenerate tree
     // (coincident or exponentially spaced emitters) the count's median instead, which keeps the
@@ -190,9 +205,9 @@ int32_t LightTree::build(const std::vector<LightBounds>& bounds, std::vector<uin
     constexpr int kSahDepth = 48;
     double bestCost = std::numeric_limits<double>::infinity();
     int bestAxis = -1, bestSplit = 0;
-    auto bucketOf = [&](uint32_t e, int axis) {
+    auto bucketOf = [&](const Item& item, int axis) {
         const double lo = centroids.lower[axis], hi = centroids.upper[axis];
-        const int b = int(double(kBuckets) * (double(bounds[e].box.center()[axis]) - lo) / (hi - lo));
+        const int b = int(double(kBuckets) * (double(item.centre[axis]) - lo) / (hi - lo));
         return std::clamp(b, 0, kBuckets - 1);
     };
     if (depth < kSahDepth)
@@ -200,36 +215,39 @@ int32_t LightTree::build(const std::vector<LightBounds>& bounds, std::vector<uin
             if (!(centroids.upper[axis] > centroids.lower[axis])) continue;
             std::array<LightBounds, kBuckets> bucket{};
             for (size_t i = first; i < last; ++i) {
-                LightBounds& b = bucket[size_t(bucketOf(emitters[i], axis))];
-                b = LightBounds::unite(b, bounds[emitters[i]]);
+                LightBounds& b = bucket[size_t(bucketOf(items[i], axis))];
+                b = LightBounds::unite(b, items[i].bounds);
             }
+            // The buckets up to each split and from it on, in one sweep each way.
+            std::array<LightBounds, kBuckets> below{}, above{};
+            below[0] = bucket[0];
+            for (size_t k = 1; k < kBuckets; ++k) below[k] = LightBounds::unite(below[k - 1], bucket[k]);
+            above[kBuckets - 1] = bucket[kBuckets - 1];
+            for (size_t k = kBuckets - 1; k-- > 0;) above[k] = LightBounds::unite(bucket[k], above[k + 1]);
             for (int split = 0; split + 1 < kBuckets; ++split) {
-                LightBounds below, above;
-                for (int k = 0; k <= split; ++k) below = LightBounds::unite(below, bucket[size_t(k)]);
-                for (int k = split + 1; k < kBuckets; ++k) above = LightBounds::unite(above, bucket[size_t(k)]);
-                if (!(below.phi > 0) || !(above.phi > 0)) continue;
-                const double cost = splitCost(below, nodeBox, axis) + splitCost(above, nodeBox, axis);
+                const LightBounds& b = below[size_t(split)];
+                const LightBounds& a = above[size_t(split) + 1];
+                if (!(b.phi > 0) || !(a.phi > 0)) continue;
+                const double cost = splitCost(b, nodeBox, axis) + splitCost(a, nodeBox, axis);
                 if (cost < bestCost) bestCost = cost, bestAxis = axis, bestSplit = split;
             }
         }
+    const auto begin = items.begin() + long(first), end = items.begin() + long(last);
     size_t middle = first;
     if (bestAxis >= 0)
-        middle = size_t(std::partition(emitters.begin() + long(first), emitters.begin() + long(last),
-                                       [&](uint32_t e) { return bucketOf(e, bestAxis) <= bestSplit; }) -
-                        emitters.begin());
+        middle = size_t(std::partition(begin, end, [&](const Item& item) { return bucketOf(item, bestAxis) <= bestSplit; }) -
+                        items.begin());
     if (middle == first || middle == last) {
         // The count's median along the widest axis, ties broken by index: a fixed order.
         const Vec3f extent = centroids.diagonal();
         const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
         middle = (first + last) / 2;
-        std::nth_element(emitters.begin() + long(first), emitters.begin() + long(middle), emitters.begin() + long(last),
-                         [&](uint32_t a, uint32_t b) {
-                             const float ca = bounds[a].box.center()[axis], cb = bounds[b].box.center()[axis];
-                             return ca < cb || (ca == cb && a < b);
-                         });
+        std::nth_element(begin, items.begin() + long(middle), end, [&](const Item& a, const Item& b) {
+            return a.centre[axis] < b.centre[axis] || (a.centre[axis] == b.centre[axis] && a.emitter < b.emitter);
+        });
     }
-    build(bounds, emitters, first, middle, index, depth + 1);
-    const int32_t second = build(bounds, emitters, middle, last, index, depth + 1);
+    build(items, first, middle, index, depth + 1);
+    const int32_t second = build(items, middle, last, index, depth + 1);
     Node& node = nodes_[size_t(index)];
     node.second = second;
     node.bounds = LightBounds::unite(nodes_[size_t(index) + 1].bounds, nodes_[size_t(second)].bounds);

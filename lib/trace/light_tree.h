@@ -81,9 +81,16 @@ public:
     const Node& node(size_t i) const { return nodes_[i]; }
 
 private:
-    // Builds the subtree over emitters[first, last) at nodes_.size(); returns its index.
-    int32_t build(const std::vector<LightBounds>& bounds, std::vector<uint32_t>& emitters, size_t first, size_t last,
-                  int32_t parent, int depth);
+    // An emitter as the build sorts it: its bounds beside its index, so that the build's passes
+    // over a node's emitters read memory in order (through an index they missed the cache on every
+    // emitter: a million lights took 11 s to build).
+    struct Item {
+        LightBounds bounds;
+        Vec3f centre;
+        uint32_t emitter;
+    };
+    // Builds the subtree over items[first, last) at nodes_.size(); returns its index.
+    int32_t build(std::vector<Item>& items, size_t first, size_t last, int32_t parent, int depth);
 
     std::vector<Node> nodes_;
     std::vector<uint32_t> leafOf_;  // per emitter, its leaf (UINT32_MAX if left out)
