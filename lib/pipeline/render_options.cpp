@@ -316,8 +316,9 @@ std::vector<RenderOption> declareOptions() {
                  },
                  [](const RenderSettings& s) { return json(directLightingName(s.lighting.direct)); }});
     o.push_back({"direct_samples", "--direct-samples", T::Integer, 1, double(kMaxDirectSamples), "", {}, true, "S", "64",
-                 "exact direct only: shadow rays per vertex toward the emissive triangles, chosen by power (one per "
-                 "point, spot and directional light besides)",
+                 "exact direct only: shadow rays per vertex toward the emissive triangles, chosen through a light "
+                 "tree (one per point, spot and directional light besides while there are at most S; past S they "
+                 "are sampled too)",
                  true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.lighting.directSamples = v.get<uint32_t>(); },
                  [](const RenderSettings& s) { return orNull(s.lighting.exactDirect(), json(s.lighting.directSamples)); }});

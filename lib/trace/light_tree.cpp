@@ -172,11 +172,12 @@ double LightBounds::importance(const Vec3d& p, const Vec3d& n) const {
     return phi * std::max(emitterCosine, kLeastCosine) * std::max(receiverCosine, kLeastCosine) / d2;
 }
 
-LightTree::LightTree(const std::vector<LightBounds>& bounds) {
+LightTree::LightTree(const std::vector<LightBounds>& bounds, size_t leafEmitters) : leafSize_(std::max<size_t>(leafEmitters, 1)) {
     std::vector<Item> items;
     for (uint32_t i = 0; i < bounds.size(); ++i)
         if (bounds[i].phi > 0) items.push_back({bounds[i], bounds[i].box.center(), i});
     leafOf_.assign(bounds.size(), std::numeric_limits<uint32_t>::max());
+    leafShare_.assign(bounds.size(), 0.0);
     if (items.empty()) return;
     nodes_.reserve(2 * items.size() - 1);
     build(items, 0, items.size(), -1, 0);
@@ -186,11 +187,27 @@ int32_t LightTree::build(std::vector<Item>& items, size_t first, size_t last, in
     const int32_t index = int32_t(nodes_.size());
     nodes_.push_back({});
     nodes_[size_t(index)].parent = parent;
-    if (last - first == 1) {
-        const Item& item = items[first];
-        nodes_[size_t(index)].bounds = item.bounds;
-        nodes_[size_t(index)].emitter = item.emitter;
-        leafOf_[item.emitter] = uint32_t(index);
+    if (last - first <= leafSize_) {
+        // Shares as direct light gave them before the tree: each intensity over the sum, the
+        // running sum's last set to 1.
+        Node& leaf = nodes_[size_t(index)];
+        leaf.first = uint32_t(leafEmitters_.size());
+        leaf.count = uint32_t(last - first);
+        double total = 0;
+        for (size_t i = first; i < last; ++i) {
+            leaf.bounds = LightBounds::unite(leaf.bounds, items[i].bounds);
+            total += items[i].bounds.phi;
+        }
+        double running = 0;
+        for (size_t i = first; i < last; ++i) {
+            const double share = items[i].bounds.phi / total;
+            running += share;
+            leafEmitters_.push_back(items[i].emitter);
+            leafCdf_.push_back(running);
+            leafShare_[items[i].emitter] = share;
+            leafOf_[items[i].emitter] = uint32_t(index);
+        }
+        leafCdf_.back() = 1.0;
         return index;
     }
     Bounds3f centroids, nodeBox;
@@ -274,14 +291,18 @@ bool LightTree::sample(const Vec3d& p, const Vec3d& n, double u, Choice& choice)
         }
         u = std::min(u, std::nextafter(1.0, 0.0));
     }
-    choice = {nodes_[i].emitter, probability};
+    const Node& leaf = nodes_[i];
+    const auto cdf = leafCdf_.begin() + long(leaf.first);
+    const size_t k = std::min(size_t(std::upper_bound(cdf, cdf + leaf.count, u) - cdf), size_t(leaf.count) - 1);
+    const uint32_t emitter = leafEmitters_[leaf.first + k];
+    choice = {emitter, probability * leafShare_[emitter]};
     return true;
 }
 
 double LightTree::probability(const Vec3d& p, const Vec3d& n, uint32_t emitter) const {
     if (emitter >= leafOf_.size() || leafOf_[emitter] == std::numeric_limits<uint32_t>::max()) return 0;
     int32_t node = int32_t(leafOf_[emitter]);
-    double probability = 1;
+    double probability = leafShare_[emitter];
     while (nodes_[size_t(node)].parent >= 0) {
         const int32_t parent = nodes_[size_t(node)].parent;
         const size_t second = size_t(nodes_[size_t(parent)].second);
