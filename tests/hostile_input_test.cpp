@@ -279,11 +279,15 @@ TEST(HostileInput, InputsBeyondTheMemoryBudgetAreRefusedBeforeTheyAreAllocated) 
                         (sourceDir() / "data" / "cornell" / "animation.json").string() + " --frames 0:1 --gather 65536 --gather-cache off",
          "gather (--gather): the gather's kept hits (65536 a vertex, at 16 bytes, for 21636 vertices) would need 21.1 GiB"},
     };
+    // The messages name ulimit -v as the limit that binds: not so where another is lower already
+    // (a container's or a Slurm job's control group). Such a case cannot be checked here; the
+    // others still are, and the test then ends as skipped, naming what it did not run, so that it
+    // never passes having checked less.
+    std::vector<std::string> notRun;
     for (const Case& c : cases) {
         SCOPED_TRACE(c.arguments);
-        // The messages name ulimit -v as the limit that binds: not so where another is lower already.
         if (!c.limit.empty() && usableMemory().bytes < uint64_t(std::stoull(c.limit)) * 1024) {
-            std::printf("skipped: this process may use only %s\n", formatBytes(usableMemory().bytes).c_str());
+            notRun.push_back("ulimit -v " + c.limit + ": " + c.arguments);
             continue;
         }
         fs::remove_all(out);
@@ -293,6 +297,12 @@ TEST(HostileInput, InputsBeyondTheMemoryBudgetAreRefusedBeforeTheyAreAllocated) 
         EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
         EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
         EXPECT_FALSE(fs::exists(out));
+    }
+    if (!notRun.empty()) {
+        std::string list;
+        for (const std::string& n : notRun) list += "\n  " + n;
+        GTEST_SKIP() << notRun.size() << " of " << cases.size() << " cases not run: this process may use only "
+                     << formatBytes(usableMemory().bytes) << ", less than the ulimit -v their messages name as the limit:" << list;
     }
 }
 
