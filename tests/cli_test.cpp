@@ -288,9 +288,11 @@ TEST(Cli, EveryEstimatorRendersEndToEnd) {
 TEST(Cli, IncrementalRunWritesTheBytesOfAFullRecomputation) {
     const fs::path dir = testScratchDir("incremental");
     // With exact direct light and a gather (fewer rays than the defaults': the update's work is
-    // the same kind, re-cast rays and kept hits).
+    // the same kind, re-cast rays and kept hits). Frames 0 to 2: frame 1 is updated from a frame
+    // computed from scratch, frame 2 from an updated one; the block moves by the same step each
+    // frame (data/cornell/animation.json), so a further frame would take frame 2's path again.
     const std::string common = cornell() + " --animation " + cornellAnimation() +
-                               " --frames 0:3 --photons 30000 --quiet --no-exr" + kCheapSecondPass;
+                               " --frames 0:2 --photons 30000 --quiet --no-exr" + kCheapSecondPass;
     for (const char* estimator : {"impact-count", "photon-map", "detp --detp-boundary clip", "detp --detp-boundary linear",
                                   "detp --detp-boundary paper"}) {
         SCOPED_TRACE(estimator);
@@ -300,7 +302,7 @@ TEST(Cli, IncrementalRunWritesTheBytesOfAFullRecomputation) {
         ASSERT_EQ(runQsgi("render " + common + " --estimator " + estimator + " --out " + inc.string()).exitCode, 0);
         const CommandResult r = runQsgi("render " + common + " --estimator " + estimator + " --full-recompute --out " + full.string());
         ASSERT_EQ(r.exitCode, 0) << r.output;
-        for (int f = 0; f <= 3; ++f) {
+        for (int f = 0; f <= 2; ++f) {
             const std::string name = "frame_000" + std::to_string(f) + ".ply";
             const std::string a = readFileBytes(inc / name);
             ASSERT_GT(a.size(), 1000u);
