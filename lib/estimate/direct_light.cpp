@@ -142,9 +142,8 @@ void DirectLight::forEachShadowRay(const Scene& scene, const VertexStarts& start
     const double perSample = 1.0 / double(samples_);
     for (uint32_t i = 0; i < samples_; ++i) {
         // Dimension 0 descends the tree, stratified; dimension 3 adds the bits below its 24, so
-        // that an emitter whose probability is below 2^-24 can still be drawn. A tree of one leaf
-        // (a few emitters) takes dimension 0 alone: the choice by power it always was.
-        const double u = tree_.nodeCount() == 1 ? double(choose.uniform(i)) : double(choose.uniform(i)) + double(fine.uniform(i)) * 0x1p-24;
+        // that an emitter whose probability is below 2^-24 can still be drawn.
+        const double u = double(choose.uniform(i)) + double(fine.uniform(i)) * 0x1p-24;
         LightTree::Choice choice;
         if (!tree_.sample(p, n, u, choice)) continue;
         const Emitter& emitter = emitters_[choice.emitter];

@@ -64,6 +64,7 @@ LightBounds LightBounds::triangle(const Vec3f corner[3], const Vec3d& normal, do
     LightBounds b;
     for (int k = 0; k < 3; ++k) b.box.extend(corner[k]);
     b.phi = phi;
+    b.area = 0.5 * length(cross(Vec3d(corner[1]) - Vec3d(corner[0]), Vec3d(corner[2]) - Vec3d(corner[0])));
     b.axis = normal;
     b.cosTheta_o = 1;
     b.cosTheta_e = 0;  // Lambertian: light leaves up to π/2 from the normal
@@ -96,6 +97,7 @@ LightBounds LightBounds::unite(const LightBounds& a, const LightBounds& b) {
     u.box = a.box;
     u.box.extend(b.box);
     u.phi = a.phi + b.phi;
+    u.area = a.area + b.area;
     u.cosTheta_e = std::min(a.cosTheta_e, b.cosTheta_e);
     // The smallest cone about both cones (pbrt-v4's DirectionCone::Union). Without a trigonometric
     // call where one cone is every direction (point lights) or both share an axis (a panel of
@@ -177,7 +179,8 @@ LightTree::LightTree(const std::vector<LightBounds>& bounds, size_t leafEmitters
     for (uint32_t i = 0; i < bounds.size(); ++i)
         if (bounds[i].phi > 0) items.push_back({bounds[i], bounds[i].box.center(), i});
     leafOf_.assign(bounds.size(), std::numeric_limits<uint32_t>::max());
-    leafShare_.assign(bounds.size(), 0.0);
+    positionOf_.assign(bounds.size(), 0);
+    running_.assign(1, 0.0);
     if (items.empty()) return;
     nodes_.reserve(2 * items.size() - 1);
     build(items, 0, items.size(), -1, 0);
@@ -187,27 +190,17 @@ int32_t LightTree::build(std::vector<Item>& items, size_t first, size_t last, in
     const int32_t index = int32_t(nodes_.size());
     nodes_.push_back({});
     nodes_[size_t(index)].parent = parent;
+    nodes_[size_t(index)].first = uint32_t(order_.size());
+    nodes_[size_t(index)].count = uint32_t(last - first);
     if (last - first <= leafSize_) {
-        // Shares as direct light gave them before the tree: each intensity over the sum, the
-        // running sum's last set to 1.
         Node& leaf = nodes_[size_t(index)];
-        leaf.first = uint32_t(leafEmitters_.size());
-        leaf.count = uint32_t(last - first);
-        double total = 0;
         for (size_t i = first; i < last; ++i) {
             leaf.bounds = LightBounds::unite(leaf.bounds, items[i].bounds);
-            total += items[i].bounds.phi;
-        }
-        double running = 0;
-        for (size_t i = first; i < last; ++i) {
-            const double share = items[i].bounds.phi / total;
-            running += share;
-            leafEmitters_.push_back(items[i].emitter);
-            leafCdf_.push_back(running);
-            leafShare_[items[i].emitter] = share;
+            positionOf_[items[i].emitter] = uint32_t(order_.size());
+            order_.push_back(items[i].emitter);
+            running_.push_back(running_.back() + items[i].bounds.phi);
             leafOf_[items[i].emitter] = uint32_t(index);
         }
-        leafCdf_.back() = 1.0;
         return index;
     }
     Bounds3f centroids, nodeBox;
@@ -268,14 +261,35 @@ int32_t LightTree::build(std::vector<Item>& items, size_t first, size_t last, in
     Node& node = nodes_[size_t(index)];
     node.second = second;
     node.bounds = LightBounds::unite(nodes_[size_t(index) + 1].bounds, nodes_[size_t(second)].bounds);
+    // A panel: one facing, and its triangles cover most of its box's largest face.
+    const Vec3d extent(node.bounds.box.diagonal());
+    const double largestFace = std::max({extent.x * extent.y, extent.y * extent.z, extent.z * extent.x});
+    node.panel = node.bounds.cosTheta_o == 1 && node.bounds.area >= kPanelFill * largestFace;
+    if (node.panel) {
+        // In the emitters' own order, as they were chosen by power before the tree: a panel that
+        // is the whole scene's light (data/cornell's) is sampled as it was. (The nodes under it,
+        // never descended into, keep ranges that no longer hold their emitters.)
+        const auto begin = order_.begin() + long(node.first);
+        std::sort(begin, begin + long(node.count));
+        for (size_t at = node.first; at < size_t(node.first) + node.count; ++at) {
+            const uint32_t e = order_[at];
+            positionOf_[e] = uint32_t(at);
+            running_[at + 1] = running_[at] + nodes_[leafOf_[e]].bounds.phi;  // a leaf holds one emitter
+        }
+    }
     return index;
+}
+
+double LightTree::shareInNode(const Node& node, uint32_t emitter) const {
+    const size_t k = positionOf_[emitter];
+    return (running_[k + 1] - running_[k]) / (running_[node.first + node.count] - running_[node.first]);
 }
 
 bool LightTree::sample(const Vec3d& p, const Vec3d& n, double u, Choice& choice) const {
     if (nodes_.empty()) return false;
     size_t i = 0;
     double probability = 1;
-    while (!nodes_[i].leaf()) {
+    while (!seenWhole(nodes_[i])) {
         const size_t second = size_t(nodes_[i].second);
         const double a = nodes_[i + 1].bounds.importance(p, n), b = nodes_[second].bounds.importance(p, n);
         if (!(a + b > 0)) return false;
@@ -291,27 +305,32 @@ bool LightTree::sample(const Vec3d& p, const Vec3d& n, double u, Choice& choice)
         }
         u = std::min(u, std::nextafter(1.0, 0.0));
     }
-    const Node& leaf = nodes_[i];
-    const auto cdf = leafCdf_.begin() + long(leaf.first);
-    const size_t k = std::min(size_t(std::upper_bound(cdf, cdf + leaf.count, u) - cdf), size_t(leaf.count) - 1);
-    const uint32_t emitter = leafEmitters_[leaf.first + k];
-    choice = {emitter, probability * leafShare_[emitter]};
+    // Within the node by intensity: u's place in its emitters' running sum.
+    const Node& node = nodes_[i];
+    const double lo = running_[node.first], hi = running_[node.first + node.count];
+    const double target = lo + u * (hi - lo);
+    const auto begin = running_.begin() + long(node.first) + 1, end = begin + long(node.count);
+    const size_t k = std::min(size_t(std::upper_bound(begin, end, target) - begin), size_t(node.count) - 1);
+    const uint32_t emitter = order_[node.first + k];
+    choice = {emitter, probability * shareInNode(node, emitter)};
     return true;
 }
 
 double LightTree::probability(const Vec3d& p, const Vec3d& n, uint32_t emitter) const {
     if (emitter >= leafOf_.size() || leafOf_[emitter] == std::numeric_limits<uint32_t>::max()) return 0;
-    int32_t node = int32_t(leafOf_[emitter]);
-    double probability = leafShare_[emitter];
-    while (nodes_[size_t(node)].parent >= 0) {
-        const int32_t parent = nodes_[size_t(node)].parent;
-        const size_t second = size_t(nodes_[size_t(parent)].second);
-        const double a = nodes_[size_t(parent) + 1].bounds.importance(p, n), b = nodes_[second].bounds.importance(p, n);
+    // The path from the root, then down it as sample() goes, to the node p sees whole.
+    std::vector<uint32_t> path;
+    for (int32_t node = int32_t(leafOf_[emitter]); node >= 0; node = nodes_[size_t(node)].parent) path.push_back(uint32_t(node));
+    double probability = 1;
+    for (size_t k = path.size(); k-- > 0;) {
+        const Node& node = nodes_[path[k]];
+        if (seenWhole(node)) return probability * shareInNode(node, emitter);
+        const size_t second = size_t(node.second);
+        const double a = nodes_[path[k] + 1].bounds.importance(p, n), b = nodes_[second].bounds.importance(p, n);
         if (!(a + b > 0)) return 0;
-        probability *= (size_t(node) == second ? b : a) / (a + b);
-        node = parent;
+        probability *= (path[k - 1] == second ? b : a) / (a + b);
     }
-    return probability;
+    return probability;  // not reached: a leaf is seen whole
 }
 
 }  // namespace qsgi

@@ -3,14 +3,16 @@
 // exact direct light samples (DirectLight), each node bounding its emitters' positions, power and
 // the directions they send light in. A shading point p with normal n descends from the root,
 // choosing each child in proportion to a conservative bound of what the child's emitters can send
-// to p (importance()), until it reaches a leaf: at most kLeafEmitters emitters, among which it
-// chooses by their intensity alone, as direct light chose among all emitters by power before the
-// tree. A few emitters (a panel of two triangles, a handful of lamps) are then one leaf and are
-// sampled exactly as before: a tree's bounds are too loose to beat power among a few neighbours
-// (data/cornell's interior error rose 8 % with one emitter a leaf). The probability of the chosen
-// emitter is the product of the choices along its path and in its leaf, so dividing its
-// contribution by it keeps the estimate unbiased; a
-// child that certainly sends nothing to p has importance 0 and is never chosen, and every emitter
+// to p (importance()), until it reaches a leaf or a panel — a node of emitters that all face one
+// way and tile its box (kPanelFill) — and chooses among its emitters by their intensity, as
+// direct light chose among all emitters by power before the tree. The bounds steer where emitters
+// differ in what they send p (far along a corridor, turned away); over one panel (data/cornell's
+// 32 triangles) intensity is the better guide, and the panel's emitters stay stratified by the
+// Sobol point as a whole (descending into it raised data/cornell's interior error from 0.0075 to
+// 0.0083). The probability of the
+// chosen emitter is the product of the choices along its path and its share of the node, so
+// dividing its contribution by it keeps the estimate unbiased; a child that certainly sends
+// nothing to p has importance 0 and is never chosen, and every emitter
 // that can light p has a probability above 0.
 //
 // The tree is built once (lights are static, docs/design.md §2), single-threaded, in a fixed
@@ -36,6 +38,7 @@ struct LightBounds {
     Vec3d axis{0, 0, 1};
     double cosTheta_o = 1;  // −1: every direction (a point light)
     double cosTheta_e = 0;
+    double area = 0;  // the triangles' (0 for lights)
 
     // A one-sided Lambertian triangle with the given corners, unit front normal and L_e A.
     static LightBounds triangle(const Vec3f corner[3], const Vec3d& normal, double phi);
@@ -57,7 +60,10 @@ struct LightBounds {
 class LightTree {
 public:
     // The most emitters a leaf holds.
-    static constexpr size_t kLeafEmitters = 8;
+    static constexpr size_t kLeafEmitters = 1;
+    // A node of emitters that all face one way and cover at least kPanelFill of its box's
+    // largest face is a panel: chosen among by intensity, never descended.
+    static constexpr double kPanelFill = 0.5;
 
     LightTree() = default;
     // Emitter i is bounds[i]; emitters with phi = 0 are left out.
@@ -66,17 +72,18 @@ public:
     bool empty() const { return nodes_.empty(); }
     size_t nodeCount() const { return nodes_.size(); }
     size_t bytes() const {
-        return nodes_.capacity() * sizeof(Node) + (leafOf_.capacity() + leafEmitters_.capacity()) * sizeof(uint32_t) +
-               (leafShare_.capacity() + leafCdf_.capacity()) * sizeof(double);
+        return nodes_.capacity() * sizeof(Node) + (leafOf_.capacity() + positionOf_.capacity() + order_.capacity()) * sizeof(uint32_t) +
+               running_.capacity() * sizeof(double);
     }
 
     struct Choice {
         uint32_t emitter = 0;
         double probability = 0;  // of choosing it at this point
     };
-    // Descends from the root with u in [0, 1) and chooses in the leaf it reaches with what is left
-    // of u: false if nothing can light (p, n). A tree that is one leaf asks no importance: it
-    // chooses by intensity with u, exactly as sampling all emitters by power did.
+    // Descends from the root with u in [0, 1) and chooses in the node p sees whole with what is
+    // left of u: false if nothing can light (p, n). A tree of one emitter returns it with
+    // probability 1 without asking its importance, which is exactly what sampling among one
+    // emitter by power did.
     bool sample(const Vec3d& p, const Vec3d& n, double u, Choice& choice) const;
     // The probability that sample() chooses `emitter` at (p, n): the product along its path.
     double probability(const Vec3d& p, const Vec3d& n, uint32_t emitter) const;
@@ -86,11 +93,12 @@ public:
         LightBounds bounds;
         int32_t second = -1;   // an interior node's second child; its first is the next node
         int32_t parent = -1;
-        uint32_t first = 0, count = 0;  // a leaf's emitters: leafEmitters_[first, first + count)
+        uint32_t first = 0, count = 0;  // its emitters: order_[first, first + count)
+        bool panel = false;             // chosen among by intensity, not descended
         bool leaf() const { return second < 0; }
     };
     const Node& node(size_t i) const { return nodes_[i]; }
-    uint32_t leafEmitter(const Node& leaf, uint32_t k) const { return leafEmitters_[leaf.first + k]; }
+    uint32_t leafEmitter(const Node& leaf, uint32_t k) const { return order_[leaf.first + k]; }
 
 private:
     // An emitter as the build sorts it: its bounds beside its index, so that the build's passes
@@ -104,12 +112,16 @@ private:
     // Builds the subtree over items[first, last) at nodes_.size(); returns its index.
     int32_t build(std::vector<Item>& items, size_t first, size_t last, int32_t parent, int depth);
 
+    // Whether sample() stops at `node` (a leaf or a panel), and the emitter's share of its intensity.
+    bool seenWhole(const Node& node) const { return node.leaf() || node.panel; }
+    double shareInNode(const Node& node, uint32_t emitter) const;
+
     size_t leafSize_ = kLeafEmitters;
     std::vector<Node> nodes_;
-    std::vector<uint32_t> leafOf_;       // per emitter, its leaf (UINT32_MAX if left out)
-    std::vector<double> leafShare_;      // per emitter, its share of its leaf's intensity
-    std::vector<uint32_t> leafEmitters_;  // the leaves' emitters, leaf by leaf
-    std::vector<double> leafCdf_;         // beside them: their cumulative shares, each leaf's last 1
+    std::vector<uint32_t> leafOf_;      // per emitter, its leaf (UINT32_MAX if left out)
+    std::vector<uint32_t> order_;       // the emitters in the leaves' order: every node's are consecutive
+    std::vector<uint32_t> positionOf_;  // per emitter, its place in order_
+    std::vector<double> running_;       // the running sum of order_'s intensities, from 0
 };
 
 }  // namespace qsgi
