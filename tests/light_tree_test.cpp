@@ -130,7 +130,7 @@ TEST(LightTree, SelectionProbabilitiesSumToOneAndEqualTheProductAlongEachPath) {
                 sum += probability;
             }
             ASSERT_LE(sum, 1 + 1e-12);
-            constexpr int kGrid = 1 << 16;
+            constexpr int kGrid = 1 << 14;
             std::vector<int> drawn(e.bounds.size(), 0);
             int failed = 0, failedRuns = 0;  // runs: the failed descents' intervals the grid sees
             LightTree::Choice choice;
