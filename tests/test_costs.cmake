@@ -12,6 +12,7 @@
 if(QSGI_TESTS_SANITIZED)
   # scripts/test-sanitizers.sh (the statistical tests are not run there).
   set(costs
+    ManyLights.AMillionLightsCoincidentAndPowerlessOnesRenderFinitely 27
     HostileInput.EveryBadFileIsRefusedWithOneLineNamingItExitTwoAndNothingWritten 85
     Estimators.IndexedPhotonMapAndDetpEqualBruteForce 50
     Cli.IncrementalRunWritesTheBytesOfAFullRecomputation 50
