@@ -173,7 +173,7 @@ TEST(LightTree, EveryNodeBoundsItsChildren) {
             for (int32_t up = node.parent; up >= 0; up = tree.node(size_t(up)).parent) underPanel = underPanel || tree.node(size_t(up)).panel;
             if (node.leaf() && !underPanel) {
                 // A leaf bounds its emitters as a node its children.
-                EXPECT_LE(node.count, LightTree::kLeafEmitters);
+                EXPECT_EQ(node.count, 1u) << "a leaf holds one emitter";
                 double phi = 0;
                 for (uint32_t k = 0; k < node.count; ++k) {
                     const LightBounds& b = e.bounds[tree.leafEmitter(node, k)];

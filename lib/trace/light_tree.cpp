@@ -174,7 +174,7 @@ double LightBounds::importance(const Vec3d& p, const Vec3d& n) const {
     return phi * std::max(emitterCosine, kLeastCosine) * std::max(receiverCosine, kLeastCosine) / d2;
 }
 
-LightTree::LightTree(const std::vector<LightBounds>& bounds, size_t leafEmitters) : leafSize_(std::max<size_t>(leafEmitters, 1)) {
+LightTree::LightTree(const std::vector<LightBounds>& bounds) {
     std::vector<Item> items;
     for (uint32_t i = 0; i < bounds.size(); ++i)
         if (bounds[i].phi > 0) items.push_back({bounds[i], bounds[i].box.center(), i});
@@ -192,15 +192,13 @@ int32_t LightTree::build(std::vector<Item>& items, size_t first, size_t last, in
     nodes_[size_t(index)].parent = parent;
     nodes_[size_t(index)].first = uint32_t(order_.size());
     nodes_[size_t(index)].count = uint32_t(last - first);
-    if (last - first <= leafSize_) {
-        Node& leaf = nodes_[size_t(index)];
-        for (size_t i = first; i < last; ++i) {
-            leaf.bounds = LightBounds::unite(leaf.bounds, items[i].bounds);
-            positionOf_[items[i].emitter] = uint32_t(order_.size());
-            order_.push_back(items[i].emitter);
-            running_.push_back(running_.back() + items[i].bounds.phi);
-            leafOf_[items[i].emitter] = uint32_t(index);
-        }
+    if (last - first == 1) {  // a leaf: one emitter
+        const Item& item = items[first];
+        nodes_[size_t(index)].bounds = item.bounds;
+        positionOf_[item.emitter] = uint32_t(order_.size());
+        order_.push_back(item.emitter);
+        running_.push_back(running_.back() + item.bounds.phi);
+        leafOf_[item.emitter] = uint32_t(index);
         return index;
     }
     Bounds3f centroids, nodeBox;
@@ -274,7 +272,7 @@ int32_t LightTree::build(std::vector<Item>& items, size_t first, size_t last, in
         for (size_t at = node.first; at < size_t(node.first) + node.count; ++at) {
             const uint32_t e = order_[at];
             positionOf_[e] = uint32_t(at);
-            running_[at + 1] = running_[at] + nodes_[leafOf_[e]].bounds.phi;  // a leaf holds one emitter
+            running_[at + 1] = running_[at] + nodes_[leafOf_[e]].bounds.phi;  // its leaf's bounds are its own
         }
     }
     return index;

@@ -59,15 +59,13 @@ struct LightBounds {
 
 class LightTree {
 public:
-    // The most emitters a leaf holds.
-    static constexpr size_t kLeafEmitters = 1;
     // A node of emitters that all face one way and cover at least kPanelFill of its box's
     // largest face is a panel: chosen among by intensity, never descended.
     static constexpr double kPanelFill = 0.5;
 
     LightTree() = default;
     // Emitter i is bounds[i]; emitters with phi = 0 are left out.
-    explicit LightTree(const std::vector<LightBounds>& bounds, size_t leafEmitters = kLeafEmitters);
+    explicit LightTree(const std::vector<LightBounds>& bounds);
 
     bool empty() const { return nodes_.empty(); }
     size_t nodeCount() const { return nodes_.size(); }
@@ -116,7 +114,6 @@ private:
     bool seenWhole(const Node& node) const { return node.leaf() || node.panel; }
     double shareInNode(const Node& node, uint32_t emitter) const;
 
-    size_t leafSize_ = kLeafEmitters;
     std::vector<Node> nodes_;
     std::vector<uint32_t> leafOf_;      // per emitter, its leaf (UINT32_MAX if left out)
     std::vector<uint32_t> order_;       // the emitters in the leaves' order: every node's are consecutive
