@@ -38,10 +38,10 @@ Solved solveDetp(const Scene& source, uint64_t photons, bool aim, float radius) 
     s.trace = TraceSettings{photons, 3, 32, EmissionAim{aim, 0}, PhotonSampling{}};
     s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
-    FrameTiming work;
     Solved out;
-    out.irradiance = solver.solve(scene.restPose(), work).irradiance;
-    out.missing = work.photonsMissingScene;
+    const FrameSolver::Solution solved = solver.solve(scene.restPose());
+    out.irradiance = solved.radiosity.irradiance;
+    out.missing = solved.record.photonsMissingScene;
     out.emittedFraction = solver.emittedFraction();
     return out;
 }

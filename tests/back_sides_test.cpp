@@ -43,8 +43,7 @@ FrameSolverSettings twoPassSettings(uint32_t seed) {
 VertexRadiosity solve(Scene& scene, uint32_t seed) {
     const EmbreeDevice device;
     FrameSolver solver(scene, device, twoPassSettings(seed));
-    FrameTiming stats;
-    return solver.solve(scene.restPose(), stats);
+    return solver.solve(scene.restPose()).radiosity;
 }
 
 // The vertex of instance `instance` of `scene` at `p` (the sheets' grids are laid out in
@@ -157,8 +156,7 @@ TEST(BackSides, TheInsideOfAClosedDoubleSidedMeshIsCoveredAndDark) {
         ASSERT_TRUE(s.backSides.has_value());
         const EmbreeDevice device;
         FrameSolver solver(s, device, twoPassSettings(3));
-        FrameTiming stats;
-        const VertexRadiosity r = solver.solve(s.restPose(), stats);
+        const VertexRadiosity r = solver.solve(s.restPose()).radiosity;
         const VertexRadiosity alone = solve(single, 3);
         ASSERT_EQ(s.frontVertexCount(), single.vertexCount());
         for (uint32_t v = 0; v < s.frontVertexCount(); ++v) EXPECT_EQ(r.irradiance[v], alone.irradiance[v]) << "vertex " << v;
@@ -206,8 +204,7 @@ TEST(BackSides, TheDarkInsideOfATubeCastsItsCoverRaysAlone) {
         FrameSolver solver(s, device, settings);
         std::vector<Transform> locals = s.restLocals();
         locals[size_t(cube)] = Transform::fromTRS(Vec3d(slide, 0, 0), {0, 0, 0, 1}, Vec3d(1.0)) * locals[size_t(cube)];
-        FrameTiming stats;
-        const VertexRadiosity r = solver.solve(Pose(locals), stats);
+        const VertexRadiosity r = solver.solve(Pose(locals)).radiosity;
         const std::vector<uint8_t> covered = solver.coveredVertices();
         size_t dark = 0, litBack = 0;
         for (uint32_t v = uint32_t(s.frontVertexCount()); v < s.vertexCount(); ++v) {

@@ -150,8 +150,7 @@ TEST(Estimators, DetpCountsEveryCrossingTheDefinitionAccepts) {
         discs.computeAll(scene, bvh);
         const DiscRegions* regions = rule == DetpBoundary::Paper ? nullptr : &discs;
         VertexRadiosity out;
-        FrameTiming stats;
-        Estimator::create(s, EstimatorContext{scene, bvh, device, regions})->solve(cache, out, stats);
+        const EstimateReport stats = Estimator::create(s, EstimatorContext{scene, bvh, device, regions})->solve(cache, out);
         uint64_t pairs = 0;
         for (uint32_t v = 0; v < scene.vertexCount(); ++v) {
             const VertexDisc disc = regions ? (*regions)[v] : VertexDisc{};

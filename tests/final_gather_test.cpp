@@ -100,8 +100,9 @@ TEST(FinalGather, ClosedSphereTwoPassGivesTheAnalyticIrradiance) {
     s.lighting.gatherRays = 256;
     s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
-    FrameTiming stats;
-    const std::vector<Vec3f> E = solver.solve(scene.restPose(), stats).irradiance;
+    const FrameSolver::Solution solved = solver.solve(scene.restPose());
+    const FrameTiming& stats = solved.record;
+    const std::vector<Vec3f> E = solved.radiosity.irradiance;
     ASSERT_EQ(E.size(), scene.vertexCount());
     const size_t n = scene.vertexCount();
 
@@ -233,9 +234,8 @@ TEST(FinalGather, RaysMeetingABackFaceReturnNothing) {
         VertexRadiosity photons;
         photons.irradiance = onSheet(*scene);
         VertexRadiosity out;
-        FrameTiming stats;
         TwoPassLighting second(lighting, 3);
-        second.solve(*scene, rig.bvh, photons, out, stats);
+        second.solve(*scene, rig.bvh, rig.starts, photons, out);
         const std::vector<Vec3f>& share = facesUp ? upShare : downShare;
         for (uint32_t v = 0; v < scene->vertexCount(); ++v) {
             if (inInstance(*scene, 1, v)) {
@@ -300,8 +300,7 @@ TEST(TwoPassLighting, BitIdenticalWithOneAndTwoThreads) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
             TwoPassLighting second(lighting, 9);
             VertexRadiosity out;
-            FrameTiming stats;
-            second.solve(scene, rig.bvh, photons, out, stats);
+            second.solve(scene, rig.bvh, rig.starts, photons, out);
             return out;
         };
         const VertexRadiosity one = run(1), two = run(2), twoAgain = run(2);
@@ -340,10 +339,9 @@ TEST(TwoPassLighting, ASolveThatKeepsNoHitsGivesTheSameBits) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
         TwoPassLighting second(lighting, 9);
         Run r;
-        FrameTiming stats;
-        second.solve(scene, rig.bvh, photons, r.out, stats, nullptr, keep);
+        const SecondPassReport report = second.solve(scene, rig.bvh, rig.starts, photons, r.out, nullptr, keep);
         r.bytes = second.stateBytes();
-        r.rays = stats.gatherRays;
+        r.rays = report.gatherRays;
         r.solved = second.solved();
         return r;
     };

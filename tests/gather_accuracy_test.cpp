@@ -75,8 +75,7 @@ Errors measure(const std::string& scenePath, const VertexRadiosityPly& reference
     s.lighting.gatherRays = gatherRays;
     s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
-    FrameTiming stats;
-    const VertexRadiosity& result = solver.solve(scene.restPose(), stats, false);
+    const VertexRadiosity& result = solver.solve(scene.restPose(), false).radiosity;
     Errors e;
     e.report = compareSolutions(reference.positions, reference.normals, reference.triangles, result.radiosity,
                                 reference.radiosity, 0.05f);

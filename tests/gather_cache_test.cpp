@@ -59,7 +59,9 @@ Frame solveFrame(Scene scene, const LightingSettings& lighting, uint64_t photons
     s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
     Frame f;
-    f.out = solver.solve(scene.restPose(), f.stats);
+    FrameSolver::Solution solved = solver.solve(scene.restPose());
+    f.out = solved.radiosity;
+    f.stats = std::move(solved.record);
     return f;
 }
 

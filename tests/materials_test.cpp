@@ -142,8 +142,7 @@ TEST(Materials, AClosedSphereWithATexturedAlbedoGivesEdOverOneMinusTheMeanAlbedo
     s.lighting.gatherRays = 256;
     s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
-    FrameTiming stats;
-    const VertexRadiosity solution = solver.solve(scene.restPose(), stats);
+    const VertexRadiosity solution = solver.solve(scene.restPose()).radiosity;
     const std::vector<Vec3f>& E = solution.irradiance;
     const size_t n = scene.vertexCount();
     double area = 0;

@@ -103,8 +103,7 @@ TEST(SegmentHash, CornellSegmentsKeepTheirBitsAtFrameZeroAndAfterFiveIncremental
         EmbreeDevice device;
         FrameSolver solver(scene, device, settings);
 
-        FrameTiming timing;
-        solver.solve(animation.poseAt(0), timing);
+        solver.solve(animation.poseAt(0));
         const RayCache frame0 = solver.tracer().traceAll();
         SegmentHash h0;
         frame0.forEachSegment([&](const Segment& s) { h0.add(s); });
@@ -112,9 +111,7 @@ TEST(SegmentHash, CornellSegmentsKeepTheirBitsAtFrameZeroAndAfterFiveIncremental
         EXPECT_LE(double(frame0.bytes()) / double(frame0.segmentCount()), 32.0);
 
         for (int f = 1; f <= 5; ++f) {
-            FrameTiming t;
-            solver.solve(animation.poseAt(f), t);
-            ASSERT_FALSE(t.fromScratch) << "frame " << f;
+            ASSERT_FALSE(solver.solve(animation.poseAt(f)).record.fromScratch) << "frame " << f;
         }
         ASSERT_NE(solver.trackedPaths(), nullptr);
         std::vector<Segment> kept;

@@ -39,8 +39,7 @@ std::vector<Vec3f> directLightOf(Scene& scene, float radius, uint32_t samples, u
     s.lighting.gatherRays = 0;
     s.update.fullRecompute = true;
     FrameSolver solver(scene, device, s);
-    FrameTiming stats;
-    return solver.solve(scene.restPose(), stats).irradiance;
+    return solver.solve(scene.restPose()).radiosity.irradiance;
 }
 
 // A rectangle { corner + a·u + b·w : a, b in [0, 1] } with u ⟂ w.
@@ -196,8 +195,7 @@ TEST(VertexStarts, APlateAHairUnderASheetReadsWhatReachesUnderIt) {
         s.lighting.directSamples = 256;
         s.lighting.gatherRays = 64;
         FrameSolver solver(scene, device, s);
-        FrameTiming stats;
-        const std::vector<Vec3f> E = solver.solve(scene.restPose(), stats).irradiance;
+        const std::vector<Vec3f> E = solver.solve(scene.restPose()).radiosity.irradiance;
         const std::vector<uint8_t> covered = solver.coveredVertices();
         size_t under = 0;
         double sum = 0;

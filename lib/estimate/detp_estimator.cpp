@@ -49,7 +49,9 @@ public:
         }
     }
 
-    void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
+    EstimateReport solve(const RayCache& cache, VertexRadiosity& out) override {
+        EstimateReport report;
+        report.verticesUpdated = scene_.vertexCount();
         quantizer_ = PowerQuantizer(cache.maxPhotonPower);
         const EstimatorSettings& e = settings_;
         if (!e.useIndex) {
@@ -62,18 +64,17 @@ public:
             const auto order = e.sortQueries ? mortonOrder(scene_.positions) : inputOrder(scene_.vertexCount());
             out.irradiance = detpFlannCandidates(scene_, cache, e.radius, e.detp.boundary, regions_, &bvh_, order, afterFirstBounce_);
             computeRadiosity(scene_, out);
-            stats.verticesUpdated = scene_.vertexCount();
-            return;
+            return report;
         } else {
             discs().updateDynamic();
             DetpQueryStats counted;
             sums_ = discs_->sums(cache, e.sortQueries, quantizer_, &counted, progress_);
-            stats.detpCrossings = counted.discHits;
+            report.detpCrossings = counted.discHits;
         }
         out.irradiance.resize(scene_.vertexCount());
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v) out.irradiance[v] = irradianceAt(v);
         computeRadiosity(scene_, out);
-        stats.verticesUpdated = scene_.vertexCount();
+        return report;
     }
 
     bool canUpdate() const override { return !(settings_.useIndex && settings_.detp.index == DetpIndex::Flann); }
@@ -84,7 +85,7 @@ public:
     }
     float reach() const override { return settings_.radius; }
 
-    void prepareUpdates(const TrackedPaths& tracked, FrameTiming&) override {
+    void prepareUpdates(const TrackedPaths& tracked) override {
         const uint32_t slots = uint32_t(tracked.trackedPaths());
         remembered_ = RememberedStore(slots, {true, moments_});
         if (!settings_.useIndex) return;  // brute force remembers nothing: it is the reference
@@ -118,7 +119,8 @@ public:
         remembered_.trimReserve();
     }
 
-    void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
+    EstimateReport update(const FrameChange& change, VertexRadiosity& out) override {
+        EstimateReport report;
         std::vector<uint8_t> skip(scene_.vertexCount(), 0);
         for (uint32_t v : change.touched) {
             // The remembered crossings are only right where no move ever reaches.
@@ -129,14 +131,14 @@ public:
         }
         std::vector<uint8_t> changed(scene_.vertexCount(), 0);
         Stopwatch clock;
-        if (settings_.useIndex) stats.crossingsForgotten = updateIndexed(change, skip, changed);
+        if (settings_.useIndex) report.crossingsForgotten = updateIndexed(change, skip, changed);
         else updateBruteForce(change, skip, changed);
-        stats.estimatorUpdateSeconds = clock.seconds();
+        report.updateSeconds = clock.seconds();
 
         clock.restart();
-        recompute(change.touched, change.tracked, stats);
-        stats.recomputeSeconds = clock.seconds();
-        stats.verticesRecomputed = change.touched.size();
+        report.recomputeCandidates = recompute(change.touched, change.tracked);
+        report.recomputeSeconds = clock.seconds();
+        report.verticesRecomputed = change.touched.size();
         for (uint32_t v : change.touched) changed[v] = 1;
         uint64_t updated = 0;
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
@@ -145,8 +147,11 @@ public:
                 ++updated;
             }
         computeRadiosity(scene_, out);
-        stats.verticesUpdated = updated;
+        report.verticesUpdated = updated;
+        return report;
     }
+
+    void dropUpdateState() override { remembered_ = RememberedStore(); }
 
     size_t stateBytes() const override {
         return remembered_.bytes() + sums_.capacity() * sizeof(DetpVertexSums) + mayBeTouched_.capacity();
@@ -291,9 +296,10 @@ private:
     }
 
     // The touched vertices from scratch: only tracked segments can cross their discs (the
-    // others never meet the envelope, which holds every disc a move touches).
-    void recompute(const std::vector<uint32_t>& vertices, const TrackedPaths& tracked, FrameTiming& stats) {
-        if (vertices.empty()) return;
+    // others never meet the envelope, which holds every disc a move touches). Returns the
+    // segments gathered for them.
+    uint64_t recompute(const std::vector<uint32_t>& vertices, const TrackedPaths& tracked) {
+        if (vertices.empty()) return 0;
         if (!settings_.useIndex) {
             std::vector<Segment> segments;
             tracked.allSegments(segments);
@@ -301,8 +307,7 @@ private:
             for (size_t i = 0; i < all.size(); ++i) all[i] = &segments[i];
             for (uint32_t v : vertices) sums_[v] = DetpVertexSums();
             bruteForceSums(vertices, all);
-            stats.recomputeCandidates += uint64_t(all.size()) * vertices.size();
-            return;
+            return uint64_t(all.size()) * vertices.size();
         }
         // The segments the grid lists in the cells around the recomputed discs (a crossing lies
         // within r of v, on the part of a segment the grid lists), traced once through a BVH of
@@ -318,7 +323,7 @@ private:
         std::vector<const Segment*> segments(near.size());
         for (size_t i = 0; i < near.size(); ++i) segments[i] = &near[i];
         discs_->recompute(segments, quantizer_, vertices, sums_);
-        stats.recomputeCandidates += segments.size();
+        return segments.size();
     }
 
     DetpVertexSums vertexSums(uint32_t v, const std::vector<const Segment*>& segments) const {

@@ -37,10 +37,9 @@ VertexRadiosity estimateVertexRadiosity(const Scene& scene, const SceneBvh& bvh,
     }
     if (!needsDiscRegions(settings)) regions = nullptr;
     VertexRadiosity out;
-    FrameTiming stats;
     EstimatorContext context{scene, bvh, device, regions};
     context.afterFirstBounce = afterFirstBounce;
-    Estimator::create(settings, context)->solve(cache, out, stats);
+    Estimator::create(settings, context)->solve(cache, out);
     return out;
 }
 

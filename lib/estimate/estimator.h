@@ -18,7 +18,6 @@
 #include "trace/ray_cache.h"
 #include "trace/scene_bvh.h"
 #include "trace/tracked_paths.h"
-#include "util/frame_timing.h"
 
 namespace qsgi {
 
@@ -41,6 +40,17 @@ struct FrameChange {
     // recomputed, every other vertex is updated.
     const std::vector<uint32_t>& touched;
     const TrackedPaths& tracked;  // every tracked segment after the change
+};
+
+// What a solve or an update measured, for the frame's record (FrameSolver assembles it).
+struct EstimateReport {
+    uint64_t verticesUpdated = 0;       // estimated again
+    uint64_t verticesRecomputed = 0;    // an update's: from the segments near them, afresh
+    uint64_t recomputeCandidates = 0;   // segments gathered for those recomputations
+    uint64_t detpCrossings = 0;         // DETP from scratch: the (segment, disc) crossings counted
+    uint64_t crossingsForgotten = 0;    // DETP update: removed crossings subtracted as remembered
+    double updateSeconds = 0;           // an update's + new − old at the vertices that keep sums
+    double recomputeSeconds = 0;        // an update's recomputed vertices
 };
 
 // Everything an estimator reads besides the segments; the references outlive it.
@@ -66,7 +76,7 @@ public:
     virtual ~Estimator() = default;
 
     // Every vertex's irradiance and radiosity from every segment of the cache (current pose).
-    virtual void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) = 0;
+    virtual EstimateReport solve(const RayCache& cache, VertexRadiosity& out) = 0;
 
     // Incremental updates. Whether this estimator has one (otherwise every frame is solved from
     // scratch, and timing.json says "estimator").
@@ -84,9 +94,12 @@ public:
     // envelope stay folded into the state solve() left.
     virtual float reach() const = 0;
     // Called after solve() and the tracked paths are known, before the first update.
-    virtual void prepareUpdates(const TrackedPaths& tracked, FrameTiming& stats) = 0;
+    virtual void prepareUpdates(const TrackedPaths& tracked) = 0;
     // The previous frame's answer in `out` becomes this frame's.
-    virtual void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) = 0;
+    virtual EstimateReport update(const FrameChange& change, VertexRadiosity& out) = 0;
+    // Frames will no longer be updated from this state (a frame solved from scratch, a reset):
+    // what prepareUpdates() built goes, so no update state outlives the tracked paths it mirrors.
+    virtual void dropUpdateState() {}
     // Bytes of incremental state (remembered crossings, indexes), apart from the tracked paths.
     virtual size_t stateBytes() const { return 0; }
 };

@@ -15,12 +15,14 @@ public:
     ImpactCountEstimator(const EstimatorContext& context)
         : scene_(context.scene), sums_(context.scene, context.afterFirstBounce), afterFirstBounce_(context.afterFirstBounce) {}
 
-    void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
+    EstimateReport solve(const RayCache& cache, VertexRadiosity& out) override {
         quantizer_ = PowerQuantizer(cache.maxPhotonPower);
         sums_.updateGeometry(scene_);
         sums_.accumulate(cache);
         out = sums_.estimate(scene_, quantizer_);
-        stats.verticesUpdated = scene_.vertexCount();
+        EstimateReport report;
+        report.verticesUpdated = scene_.vertexCount();
+        return report;
     }
 
     float reach() const override { return 0.0f; }  // an impact counts where it lands
@@ -29,9 +31,9 @@ public:
                                               const std::vector<uint8_t>& vertexMoved) const override {
         return movedOnly(changed, vertexMoved);
     }
-    void prepareUpdates(const TrackedPaths&, FrameTiming&) override {}
+    void prepareUpdates(const TrackedPaths&) override {}
 
-    void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
+    EstimateReport update(const FrameChange& change, VertexRadiosity& out) override {
         // Old segments leave with the facing they were counted with, before the triangles move.
         for (const Segment& s : change.removed) sums_.subtract(s, quantizer_);
         const std::vector<uint32_t>& moved = change.movedTriangles;
@@ -51,7 +53,9 @@ public:
         for (uint32_t v = 0; v < scene_.vertexCount(); ++v)
             if (changed[v]) vertices.push_back(v);
         sums_.estimateAt(scene_, quantizer_, vertices, out);
-        stats.verticesUpdated = vertices.size();
+        EstimateReport report;
+        report.verticesUpdated = vertices.size();
+        return report;
     }
 
 private:

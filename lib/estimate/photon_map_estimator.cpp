@@ -26,7 +26,7 @@ public:
           keepLists_(context.updatesFollow && settings.useIndex), progress_(context.progress),
           afterFirstBounce_(context.afterFirstBounce) {}
 
-    void solve(const RayCache& cache, VertexRadiosity& out, FrameTiming& stats) override {
+    EstimateReport solve(const RayCache& cache, VertexRadiosity& out) override {
         map_.emplace(cache, scene_, &bvh_, afterFirstBounce_);
         map_->keepLists(keepLists_);
         const EstimatorSettings& e = settings_;
@@ -38,14 +38,17 @@ public:
             out.irradiance = map_->bruteForce(scene_, regions_, e.radius, e.photonMap.k);
         }
         computeRadiosity(scene_, out);
-        stats.verticesUpdated = scene_.vertexCount();
+        EstimateReport report;
+        report.verticesUpdated = scene_.vertexCount();
+        return report;
     }
 
     float reach() const override { return 0.0f; }  // impacts only
-    void prepareUpdates(const TrackedPaths&, FrameTiming&) override {}
+    void prepareUpdates(const TrackedPaths&) override {}
 
-    void update(const FrameChange& change, VertexRadiosity& out, FrameTiming& stats) override {
+    EstimateReport update(const FrameChange& change, VertexRadiosity& out) override {
         const EstimatorSettings& e = settings_;
+        EstimateReport report;
         Stopwatch clock;
         // The lists (or, without them, the balls) of the previous frame that a changed impact
         // which counts there enters or leaves: the removed ones judged with the triangles as
@@ -68,7 +71,7 @@ public:
         vertices.insert(vertices.end(), change.touched.begin(), change.touched.end());
         std::sort(vertices.begin(), vertices.end());
         vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-        stats.estimatorUpdateSeconds = clock.seconds();
+        report.updateSeconds = clock.seconds();
         clock.restart();
         if (e.useIndex) {
             map_->irradianceAt(scene_, regions_, e.radius, e.photonMap.k, queryOrder(vertices), out.irradiance);
@@ -77,10 +80,11 @@ public:
             vertices = inputOrder(scene_.vertexCount());
         }
         computeRadiosity(scene_, out);
-        stats.recomputeSeconds = clock.seconds();
+        report.recomputeSeconds = clock.seconds();
         // Updated: estimated again; recomputed: from a fresh query of the trees.
-        stats.verticesUpdated = vertices.size();
-        stats.verticesRecomputed = e.useIndex ? map_->lastQueries() : vertices.size();
+        report.verticesUpdated = vertices.size();
+        report.verticesRecomputed = e.useIndex ? map_->lastQueries() : vertices.size();
+        return report;
     }
 
     size_t stateBytes() const override { return map_ && keepLists_ ? map_->listBytes() : 0; }

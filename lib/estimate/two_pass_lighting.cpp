@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "estimate/covered_vertices.h"
+#include "util/memory.h"
 #include "util/stopwatch.h"
 
 namespace qsgi {
@@ -14,70 +15,81 @@ TwoPassLighting::TwoPassLighting(const LightingSettings& settings, uint64_t seed
     if (settings.cachesGather()) cache_.emplace(settings.gatherCache);
 }
 
+TwoPassLighting::KeptHits TwoPassLighting::keptGatherHits(const LightingSettings& settings, size_t vertices, bool updatesFollow) {
+    KeptHits kept;
+    if (!settings.gathers()) return kept;
+    kept.perVertex = settings.cachesGather() ? LightingSettings::kGatherProbeRays : updatesFollow ? settings.gatherRays : 0;
+    kept.bytes = saturatingMultiply(vertices, kept.perVertex * sizeof(GatherHit));
+    return kept;
+}
+
 size_t TwoPassLighting::stateBytes() const {
-    return starts_.bytes() + direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes() + (cache_ ? cache_->bytes() : 0);
+    return direct_.irradiance().capacity() * sizeof(Vec3f) + gather_.bytes() + (cache_ ? cache_->bytes() : 0);
 }
 
-void TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats, WorkCounter* progress) {
-    if (!cache_) return;
-    cache_->select(scene, bvh, starts_, gather_);
-    gather_.setRecords(scene, bvh, starts_, cache_->records(), progress);
-    stats.gatherRecords = cache_->recordCount();
+uint64_t TwoPassLighting::placeRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress) {
+    if (!cache_) return 0;
+    cache_->select(scene, bvh, starts, gather_);
+    gather_.setRecords(scene, bvh, starts, cache_->records(), progress);
+    return cache_->recordCount();
 }
 
-void TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons,
-                            VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress, bool keepForUpdates) {
+SecondPassReport TwoPassLighting::solve(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                                        const VertexRadiosity& photons, VertexRadiosity& out, WorkCounter* progress,
+                                        bool keepForUpdates) {
+    SecondPassReport report;
     Stopwatch clock;
-    starts_.computeAll(scene, bvh);
-    const double startsSeconds = clock.seconds();
     // The gather's rays first: their cover rays tell the dark back sides, which direct light skips.
     auto direct = [&] {
         Stopwatch directClock;
         if (progress) progress->start("direct", scene.vertexCount());
-        direct_.computeAll(scene, bvh, starts_, progress, dark_.empty() ? nullptr : &dark_);
-        stats.directSeconds = startsSeconds + directClock.seconds();
-        stats.shadowRays = direct_.raysCast();
+        direct_.computeAll(scene, bvh, starts, progress, dark_.empty() ? nullptr : &dark_);
+        report.directSeconds = directClock.seconds();
+        report.shadowRays = direct_.raysCast();
     };
     dark_.clear();
     if (settings_.gathers() && !keepForUpdates && !cache_) {
         clock.restart();
         if (progress) progress->start("gathering", scene.vertexCount());
         // castAndGather keeps no hit: the rays that tell covered vertices are cast first.
-        covered_ = gather_.castCovered(scene, bvh, starts_);
-        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts_, covered_);
+        covered_ = gather_.castCovered(scene, bvh, starts);
+        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts, covered_);
         double gatherSeconds = clock.seconds();
         direct();
         clock.restart();
         const FirstPassValues first = firstPass(scene, bvh, photons);
-        gather_.castAndGather(scene, bvh, starts_, first.view(covered_), out.irradiance, progress);
+        gather_.castAndGather(scene, bvh, starts, first.view(covered_), out.irradiance, progress);
         zeroDark(out.irradiance);
-        stats.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
+        report.gatherRays = gather_.raysCast() + uint64_t(scene.vertexCount()) * gather_.coverRays();
         addDirect(scene, out);
-        stats.gatherSeconds = gatherSeconds + clock.seconds();
+        report.gatherSeconds = gatherSeconds + clock.seconds();
         solved_ = false;  // nothing kept to update
-        return;
+        return report;
     }
     double gatherSeconds = 0;
     if (settings_.gathers()) {
         clock.restart();
         if (progress) progress->start("gathering", scene.vertexCount());
-        gather_.castAll(scene, bvh, starts_, progress);
-        placeRecords(scene, bvh, stats, progress);
-        stats.gatherRays = gather_.raysCast();
-        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts_);
+        gather_.castAll(scene, bvh, starts, progress);
+        report.gatherRecords = placeRecords(scene, bvh, starts, progress);
+        report.gatherRays = gather_.raysCast();
+        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts);
         gatherSeconds = clock.seconds();
     }
     direct();
     clock.restart();
-    combine(scene, bvh, photons, out);
-    stats.gatherSeconds = gatherSeconds + clock.seconds();
+    combine(scene, bvh, starts, photons, out);
+    report.gatherSeconds = gatherSeconds + clock.seconds();
     // Without a gather nothing grows with M: the state stays for updates either way.
     solved_ = keepForUpdates || !settings_.gathers();
     if (!solved_) gather_.clear();
+    return report;
 }
 
-void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const MovedGeometry& moved,
-                             const VertexRadiosity& photons, VertexRadiosity& out, FrameTiming& stats) {
+SecondPassReport TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                                         const std::vector<uint32_t>& newStarts, const MovedGeometry& moved,
+                                         const VertexRadiosity& photons, VertexRadiosity& out) {
+    SecondPassReport report;
     Stopwatch clock;
     // A segment that grazes a mover's bounds is re-cast: the margin covers Embree's hits on the
     // bounds' faces.
@@ -85,37 +97,35 @@ void TwoPassLighting::update(const Scene& scene, const SceneBvh& bvh, const Move
     std::vector<Bounds3f> boxes;
     for (const Bounds3f& b : moved.bounds)
         if (!b.empty()) boxes.push_back(b.expanded(margin));
-    const std::vector<uint32_t> newStarts = starts_.update(scene, bvh, moved.bounds, moved.vertexMoved);
-    const double startsSeconds = clock.seconds();
-    clock.restart();
     // The gather first, as solve(): which back sides are dark may change with the move.
     const std::vector<uint8_t> darkBefore = dark_;
     if (settings_.gathers()) {
         gather_.resetRayCount();
-        gather_.cast(scene, bvh, starts_, newStarts);
+        gather_.cast(scene, bvh, starts, newStarts);
         std::vector<uint8_t> skip(scene.vertexCount(), 0);
         for (uint32_t v : newStarts) skip[v] = 1;
-        gather_.recastMeeting(scene, bvh, starts_, boxes, skip);
-        placeRecords(scene, bvh, stats);
-        stats.gatherRays = gather_.raysCast();
-        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts_);
+        gather_.recastMeeting(scene, bvh, starts, boxes, skip);
+        report.gatherRecords = placeRecords(scene, bvh, starts);
+        report.gatherRays = gather_.raysCast();
+        if (scene.backSides) dark_ = gather_.darkBackSides(scene, starts);
     }
     const double gatherSeconds = clock.seconds();
     clock.restart();
     // Lights are static (an emissive mover is refused, docs/design.md §2): the emitters read at the
     // first solve stand.
-    std::vector<uint32_t> vertices = direct_.raysMeeting(scene, starts_, boxes);
+    std::vector<uint32_t> vertices = direct_.raysMeeting(scene, starts, boxes);
     vertices.insert(vertices.end(), newStarts.begin(), newStarts.end());
     for (uint32_t v = 0; v < dark_.size(); ++v)
         if ((darkBefore.empty() ? 0 : darkBefore[v]) != dark_[v]) vertices.push_back(v);
     std::sort(vertices.begin(), vertices.end());
     vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-    direct_.recompute(scene, bvh, starts_, vertices, dark_.empty() ? nullptr : &dark_);
-    stats.directSeconds = startsSeconds + clock.seconds();
-    stats.shadowRays = direct_.raysCast();
+    direct_.recompute(scene, bvh, starts, vertices, dark_.empty() ? nullptr : &dark_);
+    report.directSeconds = clock.seconds();
+    report.shadowRays = direct_.raysCast();
     clock.restart();
-    combine(scene, bvh, photons, out);
-    stats.gatherSeconds = gatherSeconds + clock.seconds();
+    combine(scene, bvh, starts, photons, out);
+    report.gatherSeconds = gatherSeconds + clock.seconds();
+    return report;
 }
 
 TwoPassLighting::FirstPassValues TwoPassLighting::firstPass(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons) {
@@ -156,12 +166,13 @@ void TwoPassLighting::addDirect(const Scene& scene, VertexRadiosity& out) const 
     computeRadiosity(scene, out);
 }
 
-void TwoPassLighting::combine(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons, VertexRadiosity& out) {
+void TwoPassLighting::combine(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const VertexRadiosity& photons,
+                              VertexRadiosity& out) {
     const std::vector<Vec3f>& direct = direct_.irradiance();
     const size_t n = scene.vertexCount();
     out.irradiance.resize(n);
     if (settings_.gathers()) {
-        covered_ = gather_.coveredFromKept(scene, starts_);
+        covered_ = gather_.coveredFromKept(scene, starts);
         const FirstPassValues first = firstPass(scene, bvh, photons);
         gather_.gather(scene, first.view(covered_), out.irradiance);
         if (cache_) cache_->interpolate(out.irradiance);

@@ -6,8 +6,8 @@
 // visible neighbours' (covered_vertices.h), except from the covered vertices themselves.
 // It owns what that takes — the direct light and the gather's kept hits — and keeps each up to date
 // across a move, touching only what the move can change, so that every update gives the bits a
-// from-scratch solve of the same pose gives. The rays leave from the vertices themselves
-// (VertexStarts, which it owns and keeps current: its rule depends on no estimator setting).
+// from-scratch solve of the same pose gives. The rays leave from the vertices themselves: their
+// start points are VertexGeometry's (one owner for the solver's per-vertex geometry), handed in.
 #pragma once
 
 #include <memory>
@@ -22,7 +22,6 @@
 #include "estimate/vertex_starts.h"
 #include "scene/scene.h"
 #include "trace/scene_bvh.h"
-#include "util/frame_timing.h"
 #include "util/work_counter.h"
 
 namespace qsgi {
@@ -33,23 +32,42 @@ struct MovedGeometry {
     const std::vector<uint8_t>& vertexMoved;
 };
 
+// What a solve or an update measured, for the frame's record.
+struct SecondPassReport {
+    double directSeconds = 0, gatherSeconds = 0;  // the gather's includes combining the passes
+    uint64_t shadowRays = 0, gatherRays = 0;
+    uint64_t gatherRecords = 0;  // with the gather cache: the vertices that gathered all M rays
+};
+
 class TwoPassLighting {
 public:
     TwoPassLighting(const LightingSettings& settings, uint64_t seed);
 
-    // From scratch for the current pose (bvh holds it). photons: the estimator's answer
-    // (after the first bounce). keepForUpdates false: no frame will update from this one (the
-    // last frame, --full-recompute), so the gather keeps no hits — the same bits, without M hits
-    // a vertex of memory — and the next frame solves from scratch.
-    void solve(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons,
-               VertexRadiosity& out, FrameTiming& stats, WorkCounter* progress = nullptr, bool keepForUpdates = true);
-    // The last solve's or update's state brought to the current pose.
-    void update(const Scene& scene, const SceneBvh& bvh, const MovedGeometry& moved,
-                const VertexRadiosity& photons, VertexRadiosity& out, FrameTiming& stats);
+    // What the gather keeps at most, for a run's pre-flight (issue 48): its hits (GatherHit, 16
+    // bytes each), per vertex the cache's probes, or all M rays when frames will update from
+    // this one; none when every frame streams them (a run of one frame, --full-recompute).
+    // `settings` resolved for the scene (LightingSettings::resolvedFor).
+    struct KeptHits {
+        uint64_t perVertex = 0;
+        uint64_t bytes = 0;  // saturating
+    };
+    static KeptHits keptGatherHits(const LightingSettings& settings, size_t vertices, bool updatesFollow);
+
+    // From scratch for the current pose (bvh and starts hold it). photons: the estimator's
+    // answer (after the first bounce). keepForUpdates false: no frame will update from this one
+    // (the last frame, --full-recompute), so the gather keeps no hits — the same bits, without M
+    // hits a vertex of memory — and the next frame solves from scratch.
+    SecondPassReport solve(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const VertexRadiosity& photons,
+                           VertexRadiosity& out, WorkCounter* progress = nullptr, bool keepForUpdates = true);
+    // The last solve's or update's state brought to the current pose. newStarts: the vertices
+    // whose start point or normal the pose changed (VertexStarts::update's answer).
+    SecondPassReport update(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts,
+                            const std::vector<uint32_t>& newStarts, const MovedGeometry& moved, const VertexRadiosity& photons,
+                            VertexRadiosity& out);
     bool solved() const { return solved_; }
     void reset() { solved_ = false; }
 
-    // Bytes kept across frames (starts, direct light, gather hits, the cache's records and weights).
+    // Bytes kept across frames (direct light, gather hits, the cache's records and weights).
     size_t stateBytes() const;
     // The gather cache of the last solve or update (nullptr without one).
     const GatherCache* gatherCache() const { return cache_ ? &*cache_ : nullptr; }
@@ -59,7 +77,8 @@ public:
     const std::vector<uint8_t>& covered() const { return covered_; }
 
 private:
-    void combine(const Scene& scene, const SceneBvh& bvh, const VertexRadiosity& photons, VertexRadiosity& out);
+    void combine(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, const VertexRadiosity& photons,
+                 VertexRadiosity& out);
     // What the gather reads of the first pass: F_u = ρ_u (D_u + I_u), 0 at hidden vertices, as
     // solved and with the covered vertices' (covered_) stand-ins (fillCoveredFirstPass), which
     // the rays of every other vertex read; where an albedo varies over a triangle, D + I alike.
@@ -75,11 +94,11 @@ private:
     void zeroDark(std::vector<Vec3f>& gathered) const;
     // E = D + the gathered mean, and B.
     void addDirect(const Scene& scene, VertexRadiosity& out) const;
-    // With the cache: the records for the current pose, and the rest of their rays.
-    void placeRecords(const Scene& scene, const SceneBvh& bvh, FrameTiming& stats, WorkCounter* progress = nullptr);
+    // With the cache: the records for the current pose, and the rest of their rays. Returns how
+    // many records there are (0 without the cache).
+    uint64_t placeRecords(const Scene& scene, const SceneBvh& bvh, const VertexStarts& starts, WorkCounter* progress = nullptr);
 
     LightingSettings settings_;
-    VertexStarts starts_;
     DirectLight direct_;
     FinalGather gather_;
     std::optional<GatherCache> cache_;  // with --gather-cache A

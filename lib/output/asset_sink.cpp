@@ -11,7 +11,8 @@
 
 namespace qsgi {
 
-void AssetSink::finish(OutputDirectory& out, WholeRunReport& report) {
+WholeRunReport AssetSink::make(OutputDirectory& out) {
+    WholeRunReport report;
     Warnings warnings;
     const double fps = settings_.fps;
     std::optional<BakedFrame> firstFrame;  // read once: for the exposure here and by the encoder
@@ -46,6 +47,7 @@ void AssetSink::finish(OutputDirectory& out, WholeRunReport& report) {
     report.sizes = sizes;
     report.seconds = clock.seconds();
     report.warnings = warnings.messages;
+    return report;
 }
 
 }  // namespace qsgi

@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "output/baked_asset.h"
-#include "output/frame_sink.h"
+#include "output/whole_run_sink.h"
 
 namespace qsgi {
 
@@ -20,11 +20,11 @@ struct AssetSinkSettings {
     std::vector<NodeMotion> motion;                // a transform file's, at every frame baked
 };
 
-class AssetSink : public FrameSink {
+class AssetSink : public WholeRunSink {
 public:
     // scene: the render's (its vertices are the PLYs').
     AssetSink(const Scene& scene, AssetSinkSettings settings) : scene_(scene), settings_(std::move(settings)) {}
-    void finish(OutputDirectory& out, WholeRunReport& report) override;
+    WholeRunReport make(OutputDirectory& folder) override;
 
 private:
     const Scene& scene_;

@@ -12,10 +12,10 @@ void ImageSink::calibrate(const SolvedFrame& frame0) {
     if (settings_.png && !exposure_) exposure_ = automaticExposure(render(frame0));
 }
 
-void ImageSink::prepare(const SolvedFrame& frame, FrameTiming& timing) {
+double ImageSink::prepare(const SolvedFrame& frame) {
     Stopwatch clock;
     image_ = render(frame);
-    timing.renderSeconds = clock.seconds();
+    return clock.seconds();
 }
 
 void ImageSink::encode(const SolvedFrame& frame, std::vector<EncodedFile>& files) {

@@ -24,7 +24,7 @@ public:
     explicit ImageSink(ImageSinkSettings settings) : settings_(std::move(settings)), exposure_(settings_.exposure) {}
     void calibrate(const SolvedFrame& frame0) override;
     const char* preparingStage() const override { return "image"; }
-    void prepare(const SolvedFrame& frame, FrameTiming& timing) override;
+    double prepare(const SolvedFrame& frame) override;
     void encode(const SolvedFrame& frame, std::vector<EncodedFile>& files) override;
 
 private:

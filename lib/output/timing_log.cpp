@@ -1,5 +1,7 @@
 #include "output/timing_log.h"
 
+#include <string_view>
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -78,7 +80,11 @@ EarlierRun readTimingLog(const std::filesystem::path& path) {
         if (j.contains("inputs")) run.inputs = j.at("inputs");
         for (const nlohmann::json& entry : j.at("frames")) {
             FrameTiming f;
-            forEachTimingField(f, [&](const char* name, auto& value) { entry.at(name).get_to(value); });
+            // A counter that a log of an earlier version did not have yet (fit_bytes) reads as its
+            // default: --resume accepts a folder of the same inputs whichever version wrote it.
+            forEachTimingField(f, [&](const char* name, auto& value) {
+                if (std::string_view(name) == "frame" || entry.contains(name)) entry.at(name).get_to(value);
+            });
             if (entry.contains("files"))
                 for (const nlohmann::json& file : entry.at("files"))
                     f.files.push_back(FileRecord{file.at("name").get<std::string>(), file.at("bytes").get<uint64_t>(),

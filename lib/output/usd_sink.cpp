@@ -10,7 +10,8 @@
 
 namespace qsgi {
 
-void UsdSink::finish(OutputDirectory& out, WholeRunReport& report) {
+WholeRunReport UsdSink::make(OutputDirectory& out) {
+    WholeRunReport report;
     Stopwatch clock;
     UsdAssetSummary summary;
     auto frameAt = [&](int frame) { return readFramePly(out, frame, scene_); };
@@ -24,6 +25,7 @@ void UsdSink::finish(OutputDirectory& out, WholeRunReport& report) {
                   double(summary.bytes) / double(std::max<size_t>(1, summary.points * summary.frames)));
     report.sizes = sizes;
     report.seconds = clock.seconds();
+    return report;
 }
 
 }  // namespace qsgi

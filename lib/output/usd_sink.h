@@ -4,17 +4,16 @@
 // one straight run; written as it is made, so a long animation's text is never held whole.
 #pragma once
 
-#include "output/frame_sink.h"
+#include "output/whole_run_sink.h"
 #include "output/usd_asset.h"
 
 namespace qsgi {
 
-
-class UsdSink : public FrameSink {
+class UsdSink : public WholeRunSink {
 public:
     // scene: the render's (its vertices are the PLYs').
     UsdSink(const Scene& scene, UsdAssetSettings settings) : scene_(scene), settings_(std::move(settings)) {}
-    void finish(OutputDirectory& out, WholeRunReport& report) override;
+    WholeRunReport make(OutputDirectory& folder) override;
 
 private:
     const Scene& scene_;

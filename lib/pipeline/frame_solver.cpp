@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <stdexcept>
 
 #include "util/stopwatch.h"
 
@@ -55,13 +56,40 @@ constexpr double kWorthUpdatingBelow = 0.8;
 // data/cornell (its full frame is cheap). A frame pays it whole, so the larger figure is taken.
 constexpr double kTrackingBuildPerTrackedShare = 2.0;
 
+// The stages' reports into the frame's record (timing.json's fields, docs/outputs.md).
+void addEstimate(const EstimateReport& e, FrameTiming& record) {
+    record.verticesUpdated = e.verticesUpdated;
+    record.verticesRecomputed = e.verticesRecomputed;
+    record.recomputeCandidates = e.recomputeCandidates;
+    record.detpCrossings = e.detpCrossings;
+    record.crossingsForgotten = e.crossingsForgotten;
+    record.estimatorUpdateSeconds = e.updateSeconds;
+    record.recomputeSeconds = e.recomputeSeconds;
+}
+
+void addGeometry(const GeometryReport& g, FrameTiming& record) {
+    record.discRegionsSeconds = g.regionsSeconds;
+    record.discRegionsUpdated = g.regionsUpdated;
+    record.discRegionsRays = g.regionsRays;
+    record.discRegionsStaticSkipped = g.regionsStaticSkipped;
+    record.ownSurfacesProved = g.ownSurfacesProved;
+}
+
+void addSecondPass(const SecondPassReport& p, FrameTiming& record) {
+    record.directSeconds += p.directSeconds;
+    record.gatherSeconds = p.gatherSeconds;
+    record.shadowRays = p.shadowRays;
+    record.gatherRays = p.gatherRays;
+    record.gatherRecords = p.gatherRecords;
+}
+
 }  // namespace
 
 FrameSolver::FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings)
     : scene_(scene), settings_(settings),
       work_([this](const char* name, uint64_t done, uint64_t total) { stage(name, done, total); }),
       bvh_(device, scene),
-      geometry_(settings.estimator),
+      geometry_(settings.estimator, settings.lighting.exactDirect() || settings.reportsCoveredVertices),
       estimator_(Estimator::create(settings.estimator,
                                    EstimatorContext{scene_, bvh_, device, geometry_.regions(), !settings.update.fullRecompute,
                                                     &work_, settings.lighting.exactDirect()})),
@@ -76,8 +104,13 @@ FrameSolver::~FrameSolver() = default;
 void FrameSolver::reset() {
     mode_ = Mode::Fresh;
     if (lighting_) lighting_->reset();
-    tracked_.reset();
+    dropTracking();
     lastCache_.reset();
+}
+
+void FrameSolver::dropTracking() {
+    tracked_.reset();
+    estimator_->dropUpdateState();
 }
 
 FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
@@ -162,29 +195,37 @@ double FrameSolver::predictedUpdateShare(const PoseChange& change, size_t recomp
     return segmentShare + vertexShare + trackingBuildShare();
 }
 
-FromScratchReason FrameSolver::fromScratchReason(const PoseChange& change, size_t recomputed, FrameTiming& stats) const {
-    if (settings_.update.fullRecompute) return FromScratchReason::FullRecompute;
-    if (!estimator_->canUpdate()) return FromScratchReason::EstimatorHasNoUpdate;
-    if (mode_ == Mode::FromScratch && !lastCache_) return FromScratchReason::NoKeptState;
-    if (!change.any) return FromScratchReason::None;
-    stats.predictedUpdateShare = predictedUpdateShare(change, recomputed);
-    if (!settings_.update.alwaysUpdate && stats.predictedUpdateShare > kWorthUpdatingBelow) return FromScratchReason::ChangeTooLarge;
-    return FromScratchReason::None;
+FrameSolver::Verdict FrameSolver::judge(const PoseChange& change, size_t recomputed) const {
+    Verdict verdict;
+    if (settings_.update.fullRecompute) verdict.reason = FromScratchReason::FullRecompute;
+    else if (!estimator_->canUpdate()) verdict.reason = FromScratchReason::EstimatorHasNoUpdate;
+    else if (mode_ == Mode::FromScratch && !lastCache_) verdict.reason = FromScratchReason::NoKeptState;
+    else if (change.any) {
+        verdict.predictedUpdateShare = predictedUpdateShare(change, recomputed);
+        if (!settings_.update.alwaysUpdate && verdict.predictedUpdateShare > kWorthUpdatingBelow)
+            verdict.reason = FromScratchReason::ChangeTooLarge;
+    }
+    return verdict;
 }
 
-const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats, bool updateFollows) {
-    stats = FrameTiming();
+FrameSolver::Solution FrameSolver::solve(const Pose& target, bool updateFollows) {
+    FrameTiming record;
     const PoseChange change = pose(target);
     Stopwatch clock;
     work_.start("regions", 0);
     const bool firstFrame = mode_ == Mode::Fresh;
-    std::vector<uint32_t> changed;  // vertices the pose change left different
-    if (firstFrame) geometry_.computeAll(scene_, bvh_, &work_, stats);
-    else if (change.any) changed = geometry_.update(scene_, bvh_, change.bounds, change.vertexMoved, &work_, stats);
-    const std::vector<uint32_t> recomputed = estimator_->verticesToRecompute(changed, change.vertexMoved);
-    const double regionSeconds = clock.seconds();
+    GeometryChange geometry;  // what the pose change left different (nothing on a first frame)
+    if (firstFrame) geometry.report = geometry_.computeAll(scene_, bvh_, &work_);
+    else if (change.any) geometry = geometry_.update(scene_, bvh_, change.bounds, change.vertexMoved, &work_);
+    addGeometry(geometry.report, record);
+    const std::vector<uint32_t> recomputed = estimator_->verticesToRecompute(geometry.changed, change.vertexMoved);
+    // The start points are the second pass's: their time is counted with direct light's.
+    const double regionSeconds = clock.seconds() - geometry.report.startsSeconds;
+    record.directSeconds = geometry.report.startsSeconds;
 
-    const FromScratchReason why = firstFrame ? FromScratchReason::None : fromScratchReason(change, recomputed.size(), stats);
+    const Verdict verdict = firstFrame ? Verdict{} : judge(change, recomputed.size());
+    const FromScratchReason why = verdict.reason;
+    record.predictedUpdateShare = verdict.predictedUpdateShare;
     if (firstFrame || why != FromScratchReason::None) {
         // A frame may update from this one only if one follows and could.
         const bool updatesMayFollow = updateFollows && !settings_.update.fullRecompute && estimator_->canUpdate();
@@ -195,56 +236,59 @@ const VertexRadiosity& FrameSolver::solve(const Pose& target, FrameTiming& stats
         if (firstFrame && updatesMayFollow) {
             const TrackingLayout layout = trackingLayout();
             EnvelopeTails tails{layout.envelope, layout.extension, {}};
-            solveFromScratch(false, stats, &tails);
-            startTracking(stats, &tails);
+            solveFromScratch(false, record, &tails);
+            startTracking(record, &tails, record.segments);
         } else {
-            solveFromScratch(updatesMayFollow, stats);
+            solveFromScratch(updatesMayFollow, record);
         }
-        stats.fromScratchReason = nameOf(kFromScratchReasonNames, why);
+        record.fromScratchReason = nameOf(kFromScratchReasonNames, why);
     } else {
-        stats.fromScratch = false;
+        record.fromScratch = false;
         if (change.any) {
-            if (mode_ == Mode::FromScratch) startTracking(stats);
-            solveIncrementally(change, recomputed, stats);
+            if (mode_ == Mode::FromScratch) startTracking(record);
+            solveIncrementally(change, recomputed, record);
         } else if (mode_ == Mode::FromScratch && updateFollows && trackingBuildShare() <= kWorthUpdatingBelow) {
             // Nothing moved, so nothing changes; a frame that costs nothing else is the time to
             // build the tracking state, if that costs less than a frame (else the next update
             // pays for it, or falls back).
-            startTracking(stats);
+            startTracking(record);
         }
     }
-    stats.estimationSeconds += regionSeconds;
-    if (lighting_) secondPass(change, updateFollows, stats);
+    record.estimationSeconds += regionSeconds;
+    if (lighting_) addSecondPass(secondPass(change, geometry.newStarts, updateFollows), record);
     if (mode_ == Mode::Tracking) {
-        stats.trackedPaths = tracked_->trackedPaths();
-        stats.trackedSegments = tracked_->trackedSegments();
-        stats.trackedBytes = tracked_->bytes();
-        stats.segments = foldedSegments_ + tracked_->trackedSegments();
+        record.trackedPaths = tracked_->trackedPaths();
+        record.trackedSegments = tracked_->trackedSegments();
+        record.trackedBytes = tracked_->bytes();
+        record.segments = foldedSegments_ + tracked_->trackedSegments();
     }
     // The per-vertex geometry's kept static answers are incremental state too.
-    stats.estimatorStateBytes = estimator_->stateBytes() + geometry_.stateBytes() + (lighting_ ? lighting_->stateBytes() : 0);
-    geometry_.report(stats);
-    return result_;
+    record.estimatorStateBytes = estimator_->stateBytes() + geometry_.stateBytes() + (lighting_ ? lighting_->stateBytes() : 0);
+    if (const DiscRegions* regions = geometry_.regions()) {
+        record.ownSurfaceFallbacks = regions->fallbackVertices();
+        record.buriedVertices = regions->buriedVertices();
+    }
+    return Solution{result_, std::move(record)};
 }
 
-void FrameSolver::solveFromScratch(bool keepCache, FrameTiming& stats, EnvelopeTails* tails) {
-    stats.fromScratch = true;
+void FrameSolver::solveFromScratch(bool keepCache, FrameTiming& record, EnvelopeTails* tails) {
+    record.fromScratch = true;
     mode_ = Mode::FromScratch;
-    tracked_.reset();
+    dropTracking();
     lastCache_.reset();
     Stopwatch clock;
     work_.start("tracing", settings_.trace.photons);
     RayCache cache = tracer_.traceAll(&work_, tails);
-    stats.photonSimulationSeconds = clock.seconds();
-    stats.segments = cache.segmentCount();
-    stats.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
-    stats.pathsRetraced = cache.pathCount();
-    stats.segmentsAdded = cache.segmentCount();
+    record.photonSimulationSeconds = clock.seconds();
+    record.segments = cache.segmentCount();
+    record.photonsMissingScene = tracer_.lights().empty() ? 0 : cache.pathsMissingScene();
+    record.pathsRetraced = cache.pathCount();
+    record.segmentsAdded = cache.segmentCount();
 
     clock.restart();
     work_.start("estimating", 0);
-    estimator_->solve(cache, estimate(), stats);
-    stats.estimationSeconds = clock.seconds();
+    addEstimate(estimator_->solve(cache, estimate()), record);
+    record.estimationSeconds = clock.seconds();
     if (keepCache) lastCache_ = std::move(cache);
 }
 
@@ -266,14 +310,14 @@ FrameSolver::TrackingLayout FrameSolver::trackingLayout() const {
     return layout;
 }
 
-void FrameSolver::startTracking(FrameTiming& stats, EnvelopeTails* tails) {
+void FrameSolver::startTracking(FrameTiming& record, EnvelopeTails* tails, uint64_t tracedSegments) {
     stage("tracking");
     Stopwatch clock;
     const uint32_t generations = settings_.update.trackedGenerations;
     const TrackingLayout layout = trackingLayout();
     uint64_t segments = 0;
     if (tails) {
-        segments = stats.segments;  // this frame's trace
+        segments = tracedSegments;
         tracked_ = std::make_unique<TrackedPaths>(tracer_.source(), *tails, layout.gridBounds, layout.cellSize, generations);
     } else {
         const RayCache& cache = *lastCache_;
@@ -283,52 +327,62 @@ void FrameSolver::startTracking(FrameTiming& stats, EnvelopeTails* tails) {
     }
     foldedSegments_ = segments - tracked_->trackedSegments();
     trackedShare_ = double(tracked_->trackedSegments()) / double(std::max<uint64_t>(segments, 1));
-    stats.photonSimulationSeconds += clock.seconds();
+    record.photonSimulationSeconds += clock.seconds();
     clock.restart();
-    estimator_->prepareUpdates(*tracked_, stats);
-    stats.estimationSeconds += clock.seconds();
+    estimator_->prepareUpdates(*tracked_);
+    record.estimationSeconds += clock.seconds();
     lastCache_.reset();
     mode_ = Mode::Tracking;
     returnFreedMemory();
 }
 
-void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& stats) {
+void FrameSolver::solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& record) {
     Stopwatch clock;
     stage("retracing");
-    const std::vector<AffectedPath> affected =
-        tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.update.gridForBlocking, stats);
+    const AffectedPaths affected =
+        tracked_->findAffected(change.movedTriangles, change.triangleMoved, change.newBounds, bvh_, settings_.update.gridForBlocking);
+    record.findAffectedSeconds += affected.seconds;
+    record.impactCandidates += affected.impactCandidates;
+    record.blockingCandidates += affected.blockingCandidates;
+    record.pathsAffectedByImpact += affected.byImpact;
+    record.pathsAffectedByBlocking += affected.byBlockingOnly;
+    Stopwatch retrace;
     PathChanges changes;
-    tracked_->retrace(affected, tracer_, changes, stats);
-    stats.photonSimulationSeconds += clock.seconds();
+    tracked_->retrace(affected.paths, tracer_, changes);
+    record.retraceSeconds += retrace.seconds();
+    record.pathsRetraced += affected.paths.size();
+    record.segmentsRemoved += changes.removed.size();
+    record.segmentsAdded += changes.added.size();
+    record.photonSimulationSeconds += clock.seconds();
 
     clock.restart();
     const FrameChange frameChange{changes.removed,         changes.added, change.vertexMoved, change.triangleMoved,
                                   change.movedTriangles, recomputed,    *tracked_};
     stage("updating");
-    estimator_->update(frameChange, estimate(), stats);
-    stats.estimationSeconds += clock.seconds();
+    addEstimate(estimator_->update(frameChange, estimate()), record);
+    record.estimationSeconds += clock.seconds();
 }
 
 }  // namespace qsgi
 
 namespace qsgi {
 
-void FrameSolver::secondPass(const PoseChange& change, bool updateFollows, FrameTiming& stats) {
+SecondPassReport FrameSolver::secondPass(const PoseChange& change, const std::vector<uint32_t>& newStarts, bool updateFollows) {
+    const VertexStarts& starts = *geometry_.starts();
     if (!lighting_->solved() || settings_.update.fullRecompute) {
         // Keep what an update reads only if one may come.
         const bool keep = updateFollows && !settings_.update.fullRecompute;
-        lighting_->solve(scene_, bvh_, photons_, result_, stats, &work_, keep);
-        return;
+        return lighting_->solve(scene_, bvh_, starts, photons_, result_, &work_, keep);
     }
     stage("gathering");
-    lighting_->update(scene_, bvh_, MovedGeometry{change.bounds, change.vertexMoved}, photons_, result_, stats);
+    return lighting_->update(scene_, bvh_, starts, newStarts, MovedGeometry{change.bounds, change.vertexMoved}, photons_, result_);
 }
 
 std::vector<uint8_t> FrameSolver::coveredVertices() const {
     if (lighting_ && !lighting_->covered().empty()) return lighting_->covered();
-    VertexStarts starts;
-    starts.computeAll(scene_, bvh_);
-    return FinalGather(FinalGather::kCoverRays, settings_.trace.seed).castCovered(scene_, bvh_, starts);
+    const VertexStarts* starts = geometry_.starts();
+    if (!starts) throw std::logic_error("FrameSolver::coveredVertices: asked without reportsCoveredVertices or a second pass");
+    return FinalGather(FinalGather::kCoverRays, settings_.trace.seed).castCovered(scene_, bvh_, *starts);
 }
 
 }  // namespace qsgi

@@ -34,6 +34,9 @@ struct FrameSolverSettings {
     // Direct light from the photons or exact, and the final gather (TwoPassLighting).
     LightingSettings lighting;
     UpdateSettings update;  // frames after the first: updated or from scratch
+    // coveredVertices() will be asked (the vertex fit): the vertices' start points are kept even
+    // without a second pass.
+    bool reportsCoveredVertices = false;
     static_assert(kTrackedGenerations == TrackedPaths::kGenerations, "update_settings.h's default is TrackedPaths' most");
 };
 
@@ -55,12 +58,18 @@ public:
     FrameSolver(Scene& scene, const EmbreeDevice& device, const FrameSolverSettings& settings);
     ~FrameSolver();
 
-    // Poses the scene as the frame shows it and computes its radiosity. Every counter of the
-    // frame's record except frame, render and write times is filled here, by the stage it counts.
-    // `updateFollows`: another frame will be solved after this one; when none will (the last
-    // frame of a run), a frame from scratch builds no state for updates (tracked paths, the
-    // estimator's), which would cost time and, at 10^7 photons, most of the run's memory.
-    const VertexRadiosity& solve(const Pose& pose, FrameTiming& stats, bool updateFollows = true);
+    // A solved frame: the radiosity (valid until the next solve) and the frame's record, every
+    // counter but the frame number, render and write times assembled from what each stage
+    // measured and returned.
+    struct Solution {
+        const VertexRadiosity& radiosity;
+        FrameTiming record;
+    };
+    // Poses the scene as the frame shows it and computes its radiosity. `updateFollows`: another
+    // frame will be solved after this one; when none will (the last frame of a run), a frame
+    // from scratch builds no state for updates (tracked paths, the estimator's), which would cost
+    // time and, at 10^7 photons, most of the run's memory.
+    Solution solve(const Pose& pose, bool updateFollows = true);
     // The next solve starts from scratch, disc regions included.
     void reset();
 
@@ -84,7 +93,8 @@ public:
     const PhotonTracer& tracer() const { return tracer_; }
     // The vertices covered in the last frame's pose — inside or under closed geometry, by
     // FinalGather's rule: the gather's own flags, or without a gather the same 16 rays cast now
-    // from the vertices' start points (VertexStarts).
+    // from the vertices' start points (VertexGeometry's). Only with reportsCoveredVertices or a
+    // second pass, which keep the starts.
     std::vector<uint8_t> coveredVertices() const;
 
 private:
@@ -108,10 +118,13 @@ private:
         bool any = false;
     };
     PoseChange pose(const Pose& target);
-    // Why this frame cannot or should not be updated (None: update it). `recomputed`: the
-    // vertices the estimator would recompute.
-    // The prediction it judges by goes to stats.predictedUpdateShare.
-    FromScratchReason fromScratchReason(const PoseChange& change, size_t recomputed, FrameTiming& stats) const;
+    // Why this frame cannot or should not be updated (None: update it), and the prediction it
+    // judged by (0 where none was made). `recomputed`: the vertices the estimator would recompute.
+    struct Verdict {
+        FromScratchReason reason = FromScratchReason::None;
+        double predictedUpdateShare = 0;
+    };
+    Verdict judge(const PoseChange& change, size_t recomputed) const;
     // What updating to this pose would cost, in shares of a frame solved from scratch, from
     // counts alone (timing.json's predicted_update_share): the update's own work and, when the
     // last frame was solved from scratch, the tracking state it must build first.
@@ -119,8 +132,9 @@ private:
     // The share of a from-scratch frame that building the tracking state costs.
     double trackingBuildShare() const;
     // keepCache: a frame may update from this one (its cache is kept for the tracked paths).
-    // tails, if given, receives what the tracked paths keep, found while tracing.
-    void solveFromScratch(bool keepCache, FrameTiming& stats, EnvelopeTails* tails = nullptr);
+    // tails, if given, receives what the tracked paths keep, found while tracing. Its stages'
+    // counts and times go to the frame's record, as do startTracking's and solveIncrementally's.
+    void solveFromScratch(bool keepCache, FrameTiming& record, EnvelopeTails* tails = nullptr);
     // What the tracked paths keep (the envelope of the moving geometry and how far past an impact
     // a segment counts), and where the grid that finds them lies and how fine it is.
     struct TrackingLayout {
@@ -131,15 +145,17 @@ private:
     };
     TrackingLayout trackingLayout() const;
     // The incremental state: tracked paths and the estimator's own, from the tails this frame's
-    // trace kept (the frame's segment count then read from stats.segments), or else from the last
-    // frame's cache.
-    void startTracking(FrameTiming& stats, EnvelopeTails* tails = nullptr);
-    void solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& stats);
+    // trace kept (tracedSegments: that trace's segment count), or else from the last frame's cache.
+    void startTracking(FrameTiming& record, EnvelopeTails* tails = nullptr, uint64_t tracedSegments = 0);
+    void solveIncrementally(const PoseChange& change, const std::vector<uint32_t>& recomputed, FrameTiming& record);
+    // Tracking is dropped (a frame from scratch, a reset): the tracked paths and the estimator's
+    // update state go together.
+    void dropTracking();
     // Where the estimator's answer goes: result_ itself, or photons_ under a second pass.
     VertexRadiosity& estimate() { return lighting_ ? photons_ : result_; }
     // The second pass for this frame: from scratch the first time and under --full-recompute,
-    // else brought from the last frame's.
-    void secondPass(const PoseChange& change, bool updateFollows, FrameTiming& stats);
+    // else brought from the last frame's. newStarts: the vertices whose start points the pose changed.
+    SecondPassReport secondPass(const PoseChange& change, const std::vector<uint32_t>& newStarts, bool updateFollows);
 
     Scene& scene_;
     FrameSolverSettings settings_;

@@ -15,7 +15,7 @@
 #include "estimate/estimator.h"
 #include "estimate/final_gather.h"
 #include "estimate/impact_count.h"
-#include "estimate/vertex_fit.h"
+#include "estimate/two_pass_lighting.h"
 #include "output/asset_sink.h"
 #include "output/image_sink.h"
 #include "output/ply_sink.h"
@@ -25,7 +25,7 @@
 #include "output/output_directory.h"
 #include "output/run_folder.h"
 #include "pipeline/render_options.h"
-#include "pipeline/frame_solver.h"
+#include "pipeline/output_frame_solver.h"
 #include "pipeline/run_fingerprint.h"
 #include "scene/gltf_loader.h"
 #include "scene/back_sides.h"
@@ -96,9 +96,18 @@ size_t refinedTriangleLimit() {
 }
 }  // namespace
 
-RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
-    : settings_(std::move(settings)), scene_(), animation_() {
+RenderJob::RenderJob(RenderSettings settings, Warnings& warnings) : settings_(std::move(settings)) {
     validateSettings(settings_);
+    loadScene(warnings);
+    resolveAnimation();
+    refineScene();
+    describeScene(warnings);
+    resolveFrames();
+    fingerprint_ = runFingerprint(settings_, scene_, source_.fingerprintBytes(scene_), camera_);
+    preflight();
+}
+
+void RenderJob::loadScene(Warnings& warnings) {
     // One read of the file: the scene is built from it, and with --gltf-out the asset is made from
     // it too, so that the asset is the file the render read even if it changes on disk meanwhile.
     auto document = std::make_shared<const GltfDocument>(readGltfDocument(settings_.scenePath, warnings));
@@ -119,27 +128,22 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         if (luminance(light->integral()) > 0) scene_.environment = std::move(light);
     }
     if (scene_.triangleCount() == 0) throw InputError(settings_.scenePath, "", "the scene has no triangles");
-    bool emissive = false;
-    for (uint32_t t = 0; t < scene_.triangleCount() && !emissive; ++t)
-        emissive = scene_.materials[scene_.triangleMaterial[t]].isEmissive() && scene_.triangleArea(t) > 0;
-    lit_ = emissive;
+    for (uint32_t t = 0; t < scene_.triangleCount() && !lit_; ++t)
+        lit_ = scene_.materials[scene_.triangleMaterial[t]].isEmissive() && scene_.triangleArea(t) > 0;
     for (const PunctualLight& l : scene_.lights) lit_ = lit_ || luminance(l.intensity) > 0;
     lit_ = lit_ || scene_.environment != nullptr;
+}
 
-    // Where the animation comes from, as messages name it.
-    std::string animationSource = settings_.animationPath;
-    const std::optional<int> gltfAnimation =
-        gltfAnimationSelector(settings_.animationPath, settings_.configPath.empty() ? "command line" : settings_.configPath);
-    if (settings_.animationPath.empty()) animation_ = Animation::still(scene_);
-    else if (gltfAnimation) {
-        animationSource = settings_.scenePath + " (--animation " + settings_.animationPath + ")";
-        animation_ = Animation::fromGltf(scene_, *gltfAnimation, settings_.fps.value_or(kDefaultGltfFps), animationSource);
-        // "gltf" plays them all: the one there is, if there is one.
-        playedGltfAnimation_ = *gltfAnimation >= 0 ? *gltfAnimation : scene_.animations.size() == 1 ? 0 : -1;
-    } else animation_ = Animation::fromTransformFile(settings_.animationPath, scene_);
-    if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, animationSource);
+void RenderJob::resolveAnimation() {
+    source_ = AnimationSource::resolve(settings_);
+    animation_ = source_.load(scene_, settings_.fps.value_or(kDefaultGltfFps));
+    if (!source_.still()) checkLightsAreStatic(scene_, animation_, source_.name());
     scene_.setRestPose(animation_.poseAt(0));
     inputVertices_ = scene_.vertexCount();
+}
+
+void RenderJob::refineScene() {
+    auto poseAt = [&](int frame) { return animation_.poseAt(frame); };
     if (settings_.subdivide > 0) {
         const size_t estimate = estimatedRefinedTriangles(scene_, settings_.subdivide);
         if (double(estimate) > kMaxRefinedTriangles) {
@@ -160,8 +164,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
             throw InputError("refine_contacts (--refine-contacts)", "", text);
         }
         const std::optional<ContactRefinementReport> refined =
-            refineContacts(scene_, settings_.refineContacts, animation_.lastFrame(), [&](int frame) { return animation_.poseAt(frame); },
-                           refinedTriangleLimit());
+            refineContacts(scene_, settings_.refineContacts, animation_.lastFrame(), poseAt, refinedTriangleLimit());
         if (!refined) refuseRefinement("refine_contacts (--refine-contacts)", settings_.refineContacts);
         contactRefinement_ = {{"vertices_added", refined->mesh.verticesAfter - refined->mesh.verticesBefore},
                               {"poses_judged", refined->posesJudged}};
@@ -175,27 +178,21 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     scene_.markDynamic(animation_.movedNodes(), animation_.morphedNodes());
     sweepAnimationBounds(scene_, animation_);
     // Which doubleSided surfaces get a back side (lib/scene/back_sides.h), decided on the output
-    // mesh: the sampling mesh takes the same, so that the fit pairs their instances.
-    const std::vector<uint8_t> backSided = instancesWithBackSides(scene_);
+    // mesh: the fit's sampling mesh takes the same, so that the fit pairs their instances.
+    backSided_ = instancesWithBackSides(scene_);
     if (settings_.vertexFit == VertexFitKind::LeastSquares) {
-        // The sampling mesh: the output's, refined where surfaces touch as --refine-contacts R
-        // refines (R the default radius, 1.5 % of the animation's diagonal: the score's contact
-        // band), every frame judged (docs/method.md: the least-squares vertex fit).
-        samplingScene_ = scene_;
-        const std::optional<ContactRefinementReport> sampled =
-            refineContacts(*samplingScene_, defaultRadius(scene_), animation_.lastFrame(),
-                           [&](int frame) { return animation_.poseAt(frame); }, refinedTriangleLimit());
-        if (!sampled)
+        std::optional<Scene> samples =
+            VertexFitStage::samplingMesh(scene_, animation_, backSided_, defaultRadius(scene_), refinedTriangleLimit());
+        if (!samples)
             refuseRefinement("vertex_fit (--vertex-fit): its samples, edges within R of a contact split to R/2 with R", defaultRadius(scene_),
                              "use --vertex-fit point");
-        addBackSides(*samplingScene_, backSided);
-        samplingScene_->markDynamic(animation_.movedNodes(), animation_.morphedNodes());
-        sweepAnimationBounds(*samplingScene_, animation_);
+        fit_.emplace(std::move(*samples));
     }
-    checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
-    if (!settings_.animationPath.empty())
-        checkSceneExtent(scene_.positions, scene_.animationBounds, animationSource, "frames");
+}
 
+void RenderJob::describeScene(Warnings& warnings) {
+    checkLightPowerAndPlace(scene_, settings_.scenePath, settings_.configPath);
+    if (!source_.still()) checkSceneExtent(scene_.positions, scene_.animationBounds, source_.name(), "frames");
     camera_ = resolveCamera(settings_, scene_, warnings);
     if (!settings_.radiusGiven) settings_.estimator.radius = defaultRadius(scene_);
     resolution_ = qsgi::meshResolution(scene_, settings_.estimator.radius);
@@ -211,8 +208,10 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     }
     // Last, after every refinement (which would take a back side for a surface touching its front)
     // and after the mesh's resolution, which describes the file's mesh.
-    addBackSides(scene_, backSided);
+    addBackSides(scene_, backSided_);
+}
 
+void RenderJob::resolveFrames() {
     first_ = 0;
     last_ = animation_.lastFrame();
     if (settings_.frames) {
@@ -225,8 +224,8 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
             if (!unplayed.empty()) note += (note.empty() ? "" : "; ") + unplayed;
             throw InputError(settings_.framesSource.empty() ? "command line" : settings_.framesSource, "frames",
                              std::to_string(first_) + ":" + std::to_string(last_) + " reaches past the " +
-                                 (settings_.animationPath.empty() ? std::string("last frame, 0 (a still scene has one frame)")
-                                                                  : "animation's last frame " + std::to_string(animation_.lastFrame())) +
+                                 (source_.still() ? std::string("last frame, 0 (a still scene has one frame)")
+                                                  : "animation's last frame " + std::to_string(animation_.lastFrame())) +
                                  (note.empty() ? "" : " (" + note + ")"));
         }
     }
@@ -236,44 +235,22 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
     if (camera_.node >= 0 && !animation_.movedNodes().empty())
         for (int frame = first_; frame <= last_; ++frame) {
             if (!hasDirection(cameraAt(frame)))
-                throw InputError(animationSource, "frame " + std::to_string(frame),
+                throw InputError(source_.name(), "frame " + std::to_string(frame),
                                  "the camera's node '" + scene_.nodes[size_t(camera_.node)].name +
                                      "' has a singular transform (a zero scale), so the camera has no direction");
         }
-    std::string animationBytes;
-    if (gltfAnimation) {
-        // The keyframes the run samples (the fps is among the fingerprinted options): their size
-        // is the file's, not the frame count's, so a long animation costs no memory per frame.
-        auto append = [&](const void* data, size_t bytes) { animationBytes.append(static_cast<const char*>(data), bytes); };
-        append(&*gltfAnimation, sizeof(int));
-        for (size_t a = 0; a < scene_.animations.size(); ++a) {
-            if (*gltfAnimation >= 0 && size_t(*gltfAnimation) != a) continue;
-            for (const AnimationChannel& channel : scene_.animations[a].channels) {
-                const int64_t header[6] = {channel.node, int64_t(channel.property), int64_t(channel.track.interpolation),
-                                           channel.track.components, int64_t(channel.track.times.size()),
-                                           int64_t(channel.track.values.size())};
-                append(header, sizeof header);
-                append(channel.track.times.data(), sizeof(double) * channel.track.times.size());
-                append(channel.track.values.data(), sizeof(double) * channel.track.values.size());
-            }
-        }
-    } else if (!settings_.animationPath.empty()) {
-        animationBytes = readInputFile(settings_.animationPath, kMaxJsonFileBytes, "a transform file");
-    }
-    fingerprint_ = runFingerprint(settings_, scene_, animationBytes, camera_);
+}
 
-    // The gather's kept hits (16 bytes each), checked before the render (issue 48): every vertex
-    // keeps its probes under the cache, all M rays without it when a frame will update from this
-    // one (a run of one frame streams them).
-    const Scene& solved = samplingScene_ ? *samplingScene_ : scene_;
+void RenderJob::preflight() const {
+    // The gather's kept hits (issue 48), by the second pass's own count.
+    const Scene& solved = fit_ ? fit_->samplingScene() : scene_;
     const LightingSettings lighting = settings_.lighting.resolvedFor(solved.vertexCount());
-    if (lighting.gathers()) {
-        const bool updates = last_ > first_ && !settings_.update.fullRecompute;  // else every frame streams its rays
-        const uint64_t kept = lighting.cachesGather() ? LightingSettings::kGatherProbeRays : updates ? lighting.gatherRays : 0;
-        refuseBeyondMemory(saturatingMultiply(solved.vertexCount(), kept * sizeof(GatherHit)), "gather (--gather)", "",
-                           "the gather's kept hits (" + std::to_string(kept) + " a vertex, at " + std::to_string(sizeof(GatherHit)) +
-                               " bytes, for " + std::to_string(solved.vertexCount()) + " vertices)");
-    }
+    const bool updates = last_ > first_ && !settings_.update.fullRecompute;  // else every frame streams its rays
+    const TwoPassLighting::KeptHits kept = TwoPassLighting::keptGatherHits(lighting, solved.vertexCount(), updates);
+    if (lighting.gathers())
+        refuseBeyondMemory(kept.bytes, "gather (--gather)", "",
+                           "the gather's kept hits (" + std::to_string(kept.perVertex) + " a vertex, at " +
+                               std::to_string(sizeof(GatherHit)) + " bytes, for " + std::to_string(solved.vertexCount()) + " vertices)");
 }
 
 void RenderJob::refuseIfUnlit() const {
@@ -284,7 +261,7 @@ void RenderJob::refuseIfUnlit() const {
 }
 
 std::string RenderJob::unplayedAnimationsNote() const {
-    if (scene_.animations.empty() || gltfAnimationSelector(settings_.animationPath, "").has_value()) return "";
+    if (scene_.animations.empty() || source_.gltf()) return "";
     const double fps = settings_.fps.value_or(kDefaultGltfFps);
     const size_t count = scene_.animations.size();
     std::string note = "the scene file has " + std::to_string(count) + (count == 1 ? " animation: " : " animations: ");
@@ -360,7 +337,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     log.animationDiagonal = scene_.animationBounds.extent();
     log.inputVertices = inputVertices_;
     log.contactRefinement = contactRefinement_;
-    log.fitSamples = samplingScene_ ? samplingScene_->vertexCount() : 0;
+    log.fitSamples = fit_ ? fit_->samplingScene().vertexCount() : 0;
     log.inputsFingerprint = fingerprint_.digest;
     log.inputs = fingerprint_.parts;
     const RunFolder::Started started = folder.startLog(std::move(log), start, last_);
@@ -368,13 +345,12 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     outcome.framesKept = settings_.resume ? 0 : started.framesOutside;
     outcome.framesRemoved = started.framesRemoved;
     outcome.nextFrame = start;
-    const std::vector<std::unique_ptr<FrameSink>> sinks = makeSinks();
+    const std::vector<std::unique_ptr<FrameSink>> sinks = makeFrameSinks();
     auto finish = [&] {
-        for (const std::unique_ptr<FrameSink>& sink : sinks) {
-            WholeRunReport report;
-            sink->finish(folder.directory(), report);
+        for (const std::unique_ptr<WholeRunSink>& sink : makeWholeRunSinks()) {
+            WholeRunReport report = sink->make(folder.directory());
             for (const std::string& w : report.warnings) warn(w);
-            if (!report.name.empty()) outcome.wholeRunFiles.push_back(std::move(report));
+            outcome.wholeRunFiles.push_back(std::move(report));
         }
     };
     if (start > last_) {  // resumed with nothing left to do
@@ -385,36 +361,15 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     EmbreeDevice device;
     const FrameSolverSettings solverSettings{settings_.estimator, effectiveTrace(settings_.trace), settings_.lighting,
                                              settings_.update};
-    // Built in the rest pose, before any frame: every run refits the same BVHs (docs/design.md §6.0).
-    scene_.applyPose(scene_.restPose());
-    // With the fit, the frames are solved on the sampling mesh; the output mesh is posed after it
-    // and has its own BVH, which the images trace.
-    Scene& solvedScene = samplingScene_ ? *samplingScene_ : scene_;
-    solvedScene.applyPose(solvedScene.restPose());
-    FrameSolver solver(solvedScene, device, solverSettings);
-    std::optional<VertexFit> fit;
-    std::optional<SceneBvh> outputBvh;
-    VertexRadiosity fitted;
-    if (samplingScene_) {
-        fit.emplace(scene_, solvedScene);
-        outputBvh.emplace(device, scene_);
-    }
-    // The frame's solve and, with the fit, the output's pose and values: what the sinks see.
-    auto solveFrame = [&](int frame, FrameTiming& timing, bool updateFollows) -> SolvedFrame {
-        const Pose pose = animation_.poseAt(frame);
-        const VertexRadiosity& result = solver.solve(pose, timing, updateFollows);
-        if (!fit) return SolvedFrame{frame, scene_, solver.bvh(), result};
-        Stopwatch clock;
-        if (scene_.applyPose(pose)) outputBvh->updateDynamic(scene_);
-        const VertexFit::Report report = fit->fit(scene_, solvedScene, result.irradiance, solver.coveredVertices(), fitted);
-        if (report.pointFallbacks > 0)
-            warn("frame " + std::to_string(frame) + ": the vertex fit's solve failed for " +
-                               std::to_string(report.pointFallbacks) + " meshes, which keep their point values");
-        timing.fitSeconds = clock.seconds();
-        timing.fitFactorisations = report.factorisations;
-        timing.fitClampedVertices = report.clampedVertices;
-        timing.estimatorStateBytes += fit->bytes();
-        return SolvedFrame{frame, scene_, *outputBvh, fitted};
+    OutputFrameSolver solver(scene_, fit_ ? &*fit_ : nullptr, device, solverSettings);
+    // The frame's solve: what the sinks see, and its record.
+    auto solveFrame = [&](int frame, bool updateFollows) {
+        OutputFrameSolver::Result solved = solver.solve(frame, animation_.poseAt(frame), updateFollows);
+        if (solved.fitFallbacks > 0)
+            warn("frame " + std::to_string(frame) + ": the vertex fit's solve failed for " + std::to_string(solved.fitFallbacks) +
+                 " meshes, which keep their point values");
+        refuseNonFinite(solved.frame, settings_.scenePath);
+        return solved;
     };
 
     // Previews are tonemapped as frame 0 of the animation is (docs/design.md §6.0), so that any frame
@@ -426,10 +381,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         calibrated = true;
     };
     if (start > 0) {
-        FrameTiming ignored;
-        const SolvedFrame frame0 = solveFrame(0, ignored, false);
-        refuseNonFinite(frame0, settings_.scenePath);
-        calibrate(frame0);
+        calibrate(solveFrame(0, false).frame);
         solver.reset();
     }
 
@@ -438,26 +390,27 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     auto stage = [&](const char* name, uint64_t done, uint64_t total) {
         if (observer.onStage) observer.onStage(StageReport{current, current - start, count, name, done, total});
     };
-    solver.reportStagesTo(stage);
+    const FrameSolver& frames = solver.frameSolver();
+    solver.frameSolver().reportStagesTo(stage);
     const double setupSeconds = started_.seconds();
     for (int frame = start; frame <= last_; ++frame) {
         current = frame;
         Stopwatch frameClock;
-        FrameTiming timing;
-        const SolvedFrame solved = solveFrame(frame, timing, frame < last_);
-        refuseNonFinite(solved, settings_.scenePath);
+        OutputFrameSolver::Result result = solveFrame(frame, frame < last_);
+        const SolvedFrame& solved = result.frame;
+        FrameTiming& timing = result.record;
         timing.frame = frame;
         if (!calibrated) calibrate(solved);
         if (frame == start) {
             TimingLog& log = folder.log();
             log.photonsMissingScene = timing.photonsMissingScene;
-            log.emittedFraction = solver.emittedFraction();
+            log.emittedFraction = frames.emittedFraction();
             log.emissionMeasured = true;
-            const LightSampler& lights = solver.tracer().lights();
+            const LightSampler& lights = frames.tracer().lights();
             log.setup = {{"before_first_frame_s", setupSeconds},
                          {"aimed_lights", lights.aimedLights()},
                          {"aim_s", lights.aimSeconds()}};
-            if (const DirectLight* direct = solver.directLight())
+            if (const DirectLight* direct = frames.directLight())
                 log.setup["light_tree"] = {{"emitters", direct->sampledEmitters()},
                                            {"lights_sampled", direct->lightsSampled()},
                                            {"bytes", direct->treeBytes()},
@@ -466,7 +419,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
         for (const std::unique_ptr<FrameSink>& sink : sinks)
             if (const char* preparing = sink->preparingStage()) {
                 stage(preparing, 0, 0);
-                sink->prepare(solved, timing);
+                timing.renderSeconds += sink->prepare(solved);
             }
 
         Stopwatch encoding;
@@ -491,7 +444,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     return outcome;
 }
 
-std::vector<std::unique_ptr<FrameSink>> RenderJob::makeSinks() const {
+std::vector<std::unique_ptr<FrameSink>> RenderJob::makeFrameSinks() const {
     std::vector<std::unique_ptr<FrameSink>> sinks;
     // In the order the log lists a frame's files: PLY, EXR, PNG.
     sinks.push_back(std::make_unique<PlySink>());
@@ -517,6 +470,11 @@ std::vector<std::unique_ptr<FrameSink>> RenderJob::makeSinks() const {
         };
         sinks.push_back(std::make_unique<ImageSink>(std::move(image)));
     }
+    return sinks;
+}
+
+std::vector<std::unique_ptr<WholeRunSink>> RenderJob::makeWholeRunSinks() const {
+    std::vector<std::unique_ptr<WholeRunSink>> sinks;
     // A run of --frames-only (a Slurm chunk) leaves the whole-run files to the run that has every frame.
     if (settings_.writeGltf && !settings_.framesOnly) {
         AssetSinkSettings asset;
@@ -525,14 +483,12 @@ std::vector<std::unique_ptr<FrameSink>> RenderJob::makeSinks() const {
         asset.last = last_;
         asset.fps = animation_.fps();
         asset.asset.colourSet = settings_.gltfColourSet;
-        asset.asset.playedAnimation = playedGltfAnimation_;
+        asset.asset.playedAnimation = source_.playedGltfAnimation(scene_);
         asset.asset.assetFolder = settings_.outDir;
         // A transform file's motion becomes the asset's node animation; a glTF animation is the file's already.
-        const std::optional<int> gltfAnimation = gltfAnimationSelector(settings_.animationPath, "");
-        const bool transformFile = !settings_.animationPath.empty() && !gltfAnimation.has_value();
-        asset.asset.playedAll = gltfAnimation.has_value() && *gltfAnimation < 0 && playedGltfAnimation_ < 0;
-        if (transformFile) asset.asset.firstPose = animation_.localsAt(first_);
-        if (transformFile && last_ > first_) {
+        asset.asset.playedAll = source_.gltf() && source_.gltfIndex() < 0 && asset.asset.playedAnimation < 0;
+        if (source_.transformFile()) asset.asset.firstPose = animation_.localsAt(first_);
+        if (source_.transformFile() && last_ > first_) {
             for (const int node : animation_.movedNodes()) asset.motion.push_back(NodeMotion{node, {}});
             for (int frame = first_; frame <= last_; ++frame) {
                 const std::vector<Transform> locals = animation_.localsAt(frame);

@@ -10,7 +10,10 @@
 
 #include "output/folder_survey.h"
 #include "output/frame_sink.h"
+#include "output/whole_run_sink.h"
+#include "pipeline/animation_source.h"
 #include "pipeline/run_fingerprint.h"
+#include "pipeline/vertex_fit_stage.h"
 #include "pipeline/render_settings.h"
 #include "scene/animation.h"
 #include "scene/mesh_resolution.h"
@@ -21,7 +24,6 @@
 namespace qsgi {
 
 class OutputDirectory;
-class FrameSink;
 
 struct FrameReport {
     int frame;
@@ -104,22 +106,31 @@ public:
     std::string unplayedAnimationsNote() const;
 
 private:
-    // The run's outputs, each a sink of the frame loop (lib/output/frame_sink.h): the PLY, the
-    // images, and (not with --frames-only) asset.glb with --gltf-out and asset.usda with --usd-out,
-    // made from the folder's PLYs.
-    std::vector<std::unique_ptr<FrameSink>> makeSinks() const;
+    // The constructor's steps, in order (each reads what the ones before it settled).
+    void loadScene(Warnings& warnings);      // the glTF, the config's lights, the environment
+    void resolveAnimation();                 // the animation and the rest pose
+    void refineScene();                      // --subdivide, --refine-contacts, movers, the fit's samples
+    void describeScene(Warnings& warnings);  // the camera, the radius, the mesh's resolution; back sides
+    void resolveFrames();                    // --frames against the animation, the camera at each
+    void preflight() const;                  // refuses, before any work, what memory cannot hold
+
+    // The run's outputs: the sinks of the frame loop (lib/output/frame_sink.h: the PLY, the
+    // images), and (not with --frames-only) those of the whole run made after it from the
+    // folder's PLYs (asset.glb with --gltf-out, asset.usda with --usd-out).
+    std::vector<std::unique_ptr<FrameSink>> makeFrameSinks() const;
+    std::vector<std::unique_ptr<WholeRunSink>> makeWholeRunSinks() const;
 
     Stopwatch started_;  // first: the job's set-up is timed from its construction (timing.json's "setup")
     RenderSettings settings_;
     Scene scene_;
-    // --vertex-fit least-squares: scene_ refined near contacts, which the frames are solved on;
-    // the bake is then fitted to scene_'s vertices (lib/estimate/vertex_fit.h).
-    std::optional<Scene> samplingScene_;
+    // --vertex-fit least-squares: the fit's stage, with its sampling mesh (which the frames are
+    // solved on; the bake is then fitted to scene_'s vertices).
+    std::optional<VertexFitStage> fit_;
     Camera camera_;  // at frame 0
     Camera cameraAt(int frame) const;
+    AnimationSource source_;
     Animation animation_;
     int first_ = 0, last_ = 0;
-    int playedGltfAnimation_ = -1;  // the glTF animation the frames show (-1: none, all, a transform file)
     std::shared_ptr<const struct GltfDocument> assetDocument_;  // --gltf-out: the scene file as the render read it
     std::vector<std::string> meshNames_;                         // the file's, by mesh index
     RunFingerprint fingerprint_;
@@ -127,6 +138,7 @@ private:
     MeshResolution resolution_;
     uint64_t inputVertices_ = 0;           // before --subdivide and --refine-contacts
     nlohmann::json contactRefinement_;     // what --refine-contacts added (timing.json), null without it
+    std::vector<uint8_t> backSided_;       // the instances that get a back side (decided on the output mesh)
 };
 
 }  // namespace qsgi

@@ -185,25 +185,24 @@ uint64_t TrackedPaths::segmentsListedOn(const std::vector<uint32_t>& triangles) 
     return index_.countListedOn(triangles, [&](const SegmentRef& r) { return isLive(r); });
 }
 
-std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>& movedTriangles,
-                                                     const std::vector<uint8_t>& triangleMoved,
-                                                     const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh,
-                                                     bool useGrid, FrameTiming& stats) {
+AffectedPaths TrackedPaths::findAffected(const std::vector<uint32_t>& movedTriangles, const std::vector<uint8_t>& triangleMoved,
+                                        const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh, bool useGrid) {
     Stopwatch clock;
+    AffectedPaths found;
     constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
     auto live = [&](const SegmentRef& r) { return isLive(r); };
     // Per affected path, the first place to retrace from: (slot, place).
     std::vector<std::pair<uint32_t, uint32_t>> byImpact;
     // (a) A segment that hit a triangle that moved: the photon would now land elsewhere.
     for (uint32_t triangle : movedTriangles)
-        stats.impactCandidates += index_.visitListedOn(triangle, live, [&](const SegmentRef& r) { byImpact.push_back({r.slot, r.place}); });
+        found.impactCandidates += index_.visitListedOn(triangle, live, [&](const SegmentRef& r) { byImpact.push_back({r.slot, r.place}); });
     auto firstPerPath = [](std::vector<std::pair<uint32_t, uint32_t>>& list) {
         std::sort(list.begin(), list.end());
         list.erase(std::unique(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
                    list.end());
     };
     firstPerPath(byImpact);
-    stats.pathsAffectedByImpact += byImpact.size();
+    found.byImpact = byImpact.size();
 
     // (b) A segment that a moved triangle now blocks before its impact. Only segments passing
     // through a moved object's new bounds can be; the grid lists them, the dynamic BVH decides,
@@ -229,7 +228,7 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
                 if (rayMeetsAny(boxes, r.origin, r.direction, double(r.length) + double(eps))) candidates.push_back({s, j});
             }
     }
-    stats.blockingCandidates += candidates.size();
+    found.blockingCandidates = candidates.size();
     // A path that rule (a) retraces from this place or earlier changes the same way whether or
     // not the candidate is blocked: no need to ask.
     std::vector<uint32_t> fromImpact(trackedPaths(), kNone);
@@ -247,7 +246,7 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
     firstPerPath(byBlocking);
 
     // Merge: per path the earlier of the two places; paths in increasing order (slots are).
-    std::vector<AffectedPath> affected;
+    std::vector<AffectedPath>& affected = found.paths;
     affected.reserve(byImpact.size() + byBlocking.size());
     size_t i = 0, j = 0;
     while (i < byImpact.size() || j < byBlocking.size()) {
@@ -256,15 +255,15 @@ std::vector<AffectedPath> TrackedPaths::findAffected(const std::vector<uint32_t>
             std::tie(slot, place) = byImpact[i++];
         } else if (i == byImpact.size() || byBlocking[j].first < byImpact[i].first) {
             std::tie(slot, place) = byBlocking[j++];
-            ++stats.pathsAffectedByBlocking;
+            ++found.byBlockingOnly;
         } else {
             slot = byImpact[i].first;
             place = std::min(byImpact[i++].second, byBlocking[j++].second);
         }
         affected.push_back({pathOf_[slot], firstBounce_[slot] + place, slot});
     }
-    stats.findAffectedSeconds += clock.seconds();
-    return affected;
+    found.seconds = clock.seconds();
+    return found;
 }
 
 // A retrace's new tails: per affected path (in order) its segments, and per segment the grid
@@ -277,15 +276,8 @@ struct TrackedPaths::NewTails {
     uint32_t length(size_t i) const { return runOf(i).segmentsEnd[i % kChunk] - first(i); }
 };
 
-void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes,
-                           FrameTiming& stats) {
-    Stopwatch clock;
-    const size_t removed = changes.removed.size(), added = changes.added.size();
+void TrackedPaths::retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes) {
     commit(affected, traceTails(affected, tracer), changes);
-    stats.pathsRetraced += affected.size();
-    stats.segmentsRemoved += changes.removed.size() - removed;
-    stats.segmentsAdded += changes.added.size() - added;
-    stats.retraceSeconds += clock.seconds();
 }
 
 TrackedPaths::NewTails TrackedPaths::traceTails(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer) const {

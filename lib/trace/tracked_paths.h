@@ -23,7 +23,6 @@
 #include "trace/scene_bvh.h"
 #include "trace/segment_index.h"
 #include "trace/slotted_path_store.h"
-#include "util/frame_timing.h"
 
 namespace qsgi {
 
@@ -35,6 +34,16 @@ struct AffectedPath {
 };
 
 // The segments one frame's retrace exchanged: old tails and new tails, in path order.
+// findAffected's answer: the paths, and what finding them took (the frame's record).
+struct AffectedPaths {
+    std::vector<AffectedPath> paths;
+    uint64_t impactCandidates = 0;    // rule (a): tracked segments listed on the moved triangles
+    uint64_t blockingCandidates = 0;  // rule (b): tracked segments the grid handed to the exact test
+    uint64_t byImpact = 0;            // paths rule (a) found
+    uint64_t byBlockingOnly = 0;      // paths rule (b) found and rule (a) did not
+    double seconds = 0;
+};
+
 struct PathChanges {
     std::vector<Segment> removed, added;
 };
@@ -60,11 +69,10 @@ public:
     // triangleMoved the same as flags; newBounds: the moved triangles' bounds in the current
     // pose; bvh: the current pose. useGrid = false tests every tracked segment (the baseline the
     // grid is measured against). Rule (a) reads the segments listed on the moved triangles, rule
-    // (b) the grid's cells in the new bounds: neither scans the tracked segments. Counts and time
-    // go to `stats`. Drops the stale entries it passes.
-    std::vector<AffectedPath> findAffected(const std::vector<uint32_t>& movedTriangles, const std::vector<uint8_t>& triangleMoved,
-                                           const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh, bool useGrid,
-                                           FrameTiming& stats);
+    // (b) the grid's cells in the new bounds: neither scans the tracked segments. Drops the stale
+    // entries it passes.
+    AffectedPaths findAffected(const std::vector<uint32_t>& movedTriangles, const std::vector<uint8_t>& triangleMoved,
+                               const std::vector<Bounds3f>& newBounds, const SceneBvh& bvh, bool useGrid);
     // Live tracked segments that impacted one of the triangles: what rule (a) will find, known
     // before any work, for the update's price.
     uint64_t segmentsListedOn(const std::vector<uint32_t>& triangles) const;
@@ -73,7 +81,7 @@ public:
     uint64_t entriesNear(const std::vector<Bounds3f>& boxes) const { return index_.entriesNear(boxes); }
     // Retraces the affected paths (findAffected's answer) and swaps their tails in; fills
     // changes.removed/added.
-    void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes, FrameTiming& stats);
+    void retrace(const std::vector<AffectedPath>& affected, const PhotonTracer& tracer, PathChanges& changes);
 
     // The live tracked segments listed in the grid cells that overlap any of the boxes (with
     // their extension past the impact), each once, in the grid's order: the discs an update

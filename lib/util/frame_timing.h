@@ -1,7 +1,9 @@
-// One frame's record in timing.json (docs/design.md §7): what computing it cost and changed. Every stage
-// writes its own counters here directly (tracing, finding affected paths, the estimator's update,
-// disc regions, rendering); forEachTimingField is the one list that writing and reading (for
-// --resume) share, so a new counter is one member and one line.
+// One frame's record in timing.json (docs/design.md §7): what computing it cost and changed. The
+// stages do not write here: each returns a report of what it measured (the estimator's
+// EstimateReport, VertexGeometry's GeometryReport, the second pass's SecondPassReport, ...), and the
+// solver (FrameSolver, OutputFrameSolver) and the run (render and write times) assemble the
+// record; no logic reads it back. forEachTimingField is the one list that writing and reading
+// (for --resume) share, so a new counter is one member and one line.
 #pragma once
 
 #include <cstdint>
@@ -65,6 +67,7 @@ struct FrameTiming {
     // output vertices whose fitted irradiance was negative in some channel and written as 0.
     double fitSeconds = 0;
     uint64_t fitFactorisations = 0, fitClampedVertices = 0;
+    uint64_t fitBytes = 0;  // kept across frames: each mesh's matrix and factorisation
     // The frame's files as written, which --resume verifies before it trusts them ("files" in
     // timing.json; not a timing, so not in forEachTimingField's list).
     std::vector<FileRecord> files;
@@ -117,6 +120,7 @@ void forEachTimingField(Timing& f, Visit&& visit) {
     visit("fit_s", f.fitSeconds);
     visit("fit_factorisations", f.fitFactorisations);
     visit("fit_clamped_vertices", f.fitClampedVertices);
+    visit("fit_bytes", f.fitBytes);
 }
 
 }  // namespace qsgi
