@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "pipeline/render_options.h"
 #include "pipeline/render_settings.h"
 #include "util/error.h"
 

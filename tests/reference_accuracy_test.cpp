@@ -101,11 +101,14 @@ TEST_P(ReferenceAccuracy, EveryEstimatorStaysWithinItsMeasuredError) {
                     f.report.interior.relativeBias, f.region.relativeBias);
         EXPECT_LE(f.report.all.relativeRms, b.allRms) << b.estimator;
         EXPECT_LE(std::fabs(f.report.edge.relativeBias), b.edgeBias) << b.estimator;
-        if (f.report.nearEdge.vertices > 0) {  // empty on the corner scene: nothing to bound
+        // A bounded region must hold vertices: an empty one has a bias of 0, which passes any bound.
+        if (b.nearBias > 0) {  // 0 on the corner scene, which has no vertex near an edge
+            EXPECT_GT(f.report.nearEdge.vertices, 0u) << b.estimator << ": no vertex near an edge to bound";
             EXPECT_LE(std::fabs(f.report.nearEdge.relativeBias), b.nearBias) << b.estimator;
         }
         EXPECT_LE(f.report.interior.relativeRms, b.interiorRms) << b.estimator;
         if (b.regionBias > 0) {
+            EXPECT_GT(f.region.vertices, 0u) << b.estimator << ": no ceiling vertex above the panel to bound";
             EXPECT_LE(std::fabs(f.region.relativeBias), b.regionBias) << b.estimator;
         }
     }

@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "output/baked_asset.h"
+#include "output/bake_inputs.h"
 #include "output/glb_builder.h"
 #include "scene/scene.h"
 #include "util/error.h"

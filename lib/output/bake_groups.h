@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "output/baked_asset.h"
+#include "output/bake_inputs.h"
 #include "scene/scene.h"
 #include "util/error.h"
 

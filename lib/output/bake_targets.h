@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "output/bake_groups.h"
-#include "output/baked_asset.h"
+#include "output/bake_inputs.h"
 #include "output/glb_builder.h"
 #include "scene/gltf_document.h"
 #include "scene/scene.h"

@@ -6,23 +6,17 @@
 #include <xxhash.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <new>
 #include <vector>
 
 #include "util/error.h"
+#include "util/hex.h"
 
 namespace qsgi {
 
 namespace {
-std::string hex(uint64_t value) {
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
-    return text;
-}
-
 struct StateFree {
     void operator()(XXH3_state_t* state) const { XXH3_freeState(state); }
 };

@@ -687,6 +687,54 @@ void applyCommandLineOption(const RenderOption& o, const std::string& text, Rend
     applyOption(o, value, src, s);
 }
 
+void applyConfigFile(const std::string& path, RenderSettings& s) { applyConfigJson(path, readJsonFile(path), s); }
+
+void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderSettings& s) {
+    s.configPath = path;
+    if (!doc.is_object()) throw InputError(path, "", "must be a JSON object");
+    std::vector<std::string> keys;
+    for (const RenderOption& o : renderOptions())
+        if (o.key) keys.push_back(o.key);
+    refuseUnknownKeys(doc, keys, path, "");
+    OptionSource source{path, "", std::filesystem::path(path).parent_path()};
+    try {
+        for (auto it = doc.begin(); it != doc.end(); ++it) {
+            // Any other key is a note for people ("_…", "comment"): refuseUnknownKeys let it through.
+            const RenderOption* option = optionWithKey(it.key());
+            if (!option) continue;
+            source.place = it.key();
+            applyOption(*option, it.value(), source, s);
+        }
+    } catch (const json::exception& e) {
+        throw InputError(path, source.place, std::string("has the wrong JSON type (") + e.what() + ")");
+    }
+}
+
+void validateSettings(const RenderSettings& s) {
+    // Values from a config or the command line were checked as they were read, naming their
+    // source; this catches a program that fills RenderSettings itself, by the same rules.
+    for (const RenderOption& o : renderOptions()) {
+        if (!o.key || !o.get || o.type == OptionType::Object) continue;
+        const json value = o.get(s);
+        if (value.is_null()) continue;
+        RenderSettings scratch = s;
+        applyOption(o, value, {"settings", o.key, {}}, scratch);
+    }
+    if (s.scenePath.empty()) throw InputError("command line", "SCENE", "no scene given");
+    // Checked after the config and the command line are merged: the bound is max_bounces.
+    if (s.qmcBouncesGiven && s.trace.sampling.kind == SamplerKind::Sobol)  // K means nothing under random
+        checkedInteger(s.trace.sampling.qmcBounces, 0, std::min<int64_t>(s.trace.maxBounces, kMaxQmcBounces),
+                       s.configPath.empty() ? "command line" : s.configPath + " or the command line", "qmc_bounces",
+                       " (at most max_bounces, and the Sobol table covers 32 scatterings)");
+    // The gather replaces the estimate of indirect light only; with direct light from the photons
+    // there is nothing apart for it to add to.
+    if (s.gatherGiven && s.lighting.gatherRays > 0 && !s.lighting.exactDirect())
+        throw InputError(s.configPath.empty() ? "command line" : s.configPath + " or the command line", "gather",
+                         std::to_string(s.lighting.gatherRays) +
+                             " gather rays need --direct exact (the gather adds one bounce over the photons to exact "
+                             "direct light); give --gather 0 with --direct photons");
+}
+
 json optionValues(const RenderSettings& s, OptionSelection selection) {
     json values = json::object();
     for (const RenderOption& o : renderOptions()) {

@@ -1,6 +1,6 @@
 // Every option of a render, declared once: its config key, its command-line flag, its type and
 // range, its default, its help, and whether it reaches the resume fingerprint and timing.json.
-// The config reader (render_settings.cpp), the command line (cli/main.cpp), validateSettings, the
+// The config reader (applyConfigJson below), the command line (cli/main.cpp), validateSettings, the
 // fingerprint (run_fingerprint.cpp), the timing log's "config" and the option table of
 // docs/command-line.md are all made from this list (tests/render_options_test.cpp checks the docs
 // and --help against it). Adding an option is one entry here and one field in RenderSettings or in a
@@ -65,6 +65,16 @@ void applyOption(const RenderOption& option, const nlohmann::json& value, const 
 // The same for a command-line argument: its text becomes the JSON value a config would hold
 // ("1e6" a number, "detp" a string) and is checked by the same rules.
 void applyCommandLineOption(const RenderOption& option, const std::string& text, RenderSettings& settings);
+
+// Reads a config file into `settings` (only the keys present change). Relative scene and
+// animation paths are resolved against the config's folder. Throws InputError.
+void applyConfigFile(const std::string& path, RenderSettings& settings);
+// The same for a config already parsed (`path` names it in messages and resolves relative paths).
+void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderSettings& settings);
+
+// Checks every option's value by the rules its declaration gives (for settings filled by a
+// program), and what no single option can: a scene is given, K is at most max_bounces.
+void validateSettings(const RenderSettings& settings);
 
 // Every option's value in force, by config key (options without a key are left out); only those
 // that reach the frame files, or only those timing.json records, when asked. Those two are for

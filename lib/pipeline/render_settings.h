@@ -1,9 +1,8 @@
 // Everything a render run needs to know, from a JSON config (configs/*.json) overridden by the
-// command line (docs/design.md §8). Each option is declared once, in render_options.cpp: its key, flag,
-// range, default and help; the config reader here and the CLI both apply values through it.
+// command line (docs/design.md §8), and the parsing and range rules the options share. Each option
+// is declared once, in render_options.cpp: its key, flag, range, default and help; the config
+// reader and validateSettings (render_options.h) and the CLI all apply values through it.
 #pragma once
-
-#include <nlohmann/json_fwd.hpp>
 
 #include <cstdint>
 #include <optional>
@@ -94,12 +93,6 @@ int64_t checkedInteger(int64_t value, int64_t lo, int64_t hi, const std::string&
 // least one segment and its path's start).
 uint64_t checkedPhotons(int64_t value, const std::string& source, const std::string& place);
 
-// Reads a config file into `settings` (only the keys present change). Relative scene and
-// animation paths are resolved against the config's folder. Throws InputError.
-void applyConfigFile(const std::string& path, RenderSettings& settings);
-// The same for a config already parsed (`path` names it in messages and resolves relative paths).
-void applyConfigJson(const std::string& path, const nlohmann::json& doc, RenderSettings& settings);
-
 // The glTF animation an --animation value names: nullopt for a transform file, -1 for "gltf" (every
 // animation of the scene at once), N for "gltf:N". Throws InputError for "gltf:" without a valid N.
 std::optional<int> gltfAnimationSelector(const std::string& animation, const std::string& source);
@@ -117,9 +110,5 @@ float defaultRadius(const Bounds3f& animationBounds);
 // The trace settings a run uses: as given, but the default K is capped at max_bounces (an
 // explicit K above it is refused by validateSettings); K means nothing under random and is 0 there.
 TraceSettings effectiveTrace(const TraceSettings& trace);
-
-// Checks every option's value by the rules its declaration gives (for settings filled by a
-// program), and what no single option can: a scene is given, K is at most max_bounces.
-void validateSettings(const RenderSettings& settings);
 
 }  // namespace qsgi

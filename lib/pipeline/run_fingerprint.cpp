@@ -3,6 +3,7 @@
 #include <OpenImageIO/hash.h>
 
 #include "pipeline/render_options.h"
+#include "util/hex.h"
 
 #include <cstdio>
 #include <type_traits>
@@ -37,12 +38,6 @@ private:
 }  // namespace
 
 namespace {
-
-std::string hex(uint64_t value) {
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
-    return text;
-}
 
 // An option's value as a message shows it: strings bare, numbers to 7 digits (a float's),
 // values the estimator does not read as "unused".
