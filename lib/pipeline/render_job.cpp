@@ -128,6 +128,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
 
     // Where the animation comes from, as messages name it.
     std::string animationSource = settings_.animationPath;
+    std::string transformFileBytes;  // read once: parsed here, fingerprinted below
     const std::optional<int> gltfAnimation =
         gltfAnimationSelector(settings_.animationPath, settings_.configPath.empty() ? "command line" : settings_.configPath);
     if (settings_.animationPath.empty()) animation_ = Animation::still(scene_);
@@ -136,7 +137,10 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
         animation_ = Animation::fromGltf(scene_, *gltfAnimation, settings_.fps.value_or(kDefaultGltfFps), animationSource);
         // "gltf" plays them all: the one there is, if there is one.
         playedGltfAnimation_ = *gltfAnimation >= 0 ? *gltfAnimation : scene_.animations.size() == 1 ? 0 : -1;
-    } else animation_ = Animation::fromTransformFile(settings_.animationPath, scene_);
+    } else {
+        transformFileBytes = readInputFile(settings_.animationPath, kMaxJsonFileBytes, "a transform file");
+        animation_ = Animation::fromTransformFileBytes(settings_.animationPath, transformFileBytes, scene_);
+    }
     if (!settings_.animationPath.empty()) checkLightsAreStatic(scene_, animation_, animationSource);
     scene_.setRestPose(animation_.poseAt(0));
     inputVertices_ = scene_.vertexCount();
@@ -258,7 +262,7 @@ RenderJob::RenderJob(RenderSettings settings, Warnings& warnings)
             }
         }
     } else if (!settings_.animationPath.empty()) {
-        animationBytes = readInputFile(settings_.animationPath, kMaxJsonFileBytes, "a transform file");
+        animationBytes = std::move(transformFileBytes);
     }
     fingerprint_ = runFingerprint(settings_, scene_, animationBytes, camera_);
 
