@@ -19,6 +19,7 @@
 #include "pipeline/render_job.h"
 #include "pipeline/render_options.h"
 #include "util/error.h"
+#include "util/input_file.h"
 #include "util/nearest_name.h"
 #include "pipeline/scene_inspection.h"
 #include "run_display.h"
@@ -159,12 +160,14 @@ std::string commandLineError(const CLI::App& app, int argc, char** argv, const C
 // `qsgi compare` against a surface reference: the frame's irradiance interpolated at its points,
 // overall and by band (contact, edge, interior), with the reference's noise taken out.
 // width: the bands' (--radius; default qsgi's default radius over the frame's vertices).
-int runSurfaceCompare(const std::string& a, const std::string& b, std::optional<double> widthOption, bool json) {
-    const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(a);
+int runSurfaceCompare(qsgi::InputFile& solutionFile, qsgi::InputFile& referenceFile, std::optional<double> widthOption,
+                      bool json) {
+    const std::string &a = solutionFile.path(), &b = referenceFile.path();
+    const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(solutionFile);
     qsgi::Bounds3f bounds;
     for (const qsgi::Vec3f& p : solution.positions) bounds.extend(p);
     const float width = widthOption ? float(*widthOption) : qsgi::defaultRadius(bounds);
-    const qsgi::SurfaceReferencePly reference = qsgi::readSurfaceReferencePly(b);
+    const qsgi::SurfaceReferencePly reference = qsgi::readSurfaceReferencePly(referenceFile);
     if (solution.irradiance.empty())
         throw qsgi::InputError(a, "header", "has no irradiance_r/g/b: a surface reference scores irradiance");
     qsgi::SurfaceAccuracyReport r;
@@ -196,12 +199,15 @@ int runSurfaceCompare(const std::string& a, const std::string& b, std::optional<
 }
 
 // `qsgi compare`: reads both PLYs and prints the accuracy report, overall and by edge region.
+// Each file is opened once: the reference's header says which reader takes it, from the same
+// descriptor.
 int runCompare(const std::string& a, const std::string& b, std::optional<double> radiusOption, bool json) {
     if (radiusOption && (!(*radiusOption > 0) || !std::isfinite(*radiusOption)))
         throw qsgi::InputError("command line", "--radius", "must be a positive distance (scene units)");
-    if (qsgi::plyFirstElement(b) == "point") return runSurfaceCompare(a, b, radiusOption, json);
-    const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(a);
-    const qsgi::VertexRadiosityPly reference = qsgi::readVertexRadiosityPly(b);
+    qsgi::InputFile solutionFile(a, UINT64_MAX, "a PLY file"), referenceFile(b, UINT64_MAX, "a PLY file");
+    if (qsgi::plyFirstElement(referenceFile) == "point") return runSurfaceCompare(solutionFile, referenceFile, radiusOption, json);
+    const qsgi::VertexRadiosityPly solution = qsgi::readVertexRadiosityPly(solutionFile);
+    const qsgi::VertexRadiosityPly reference = qsgi::readVertexRadiosityPly(referenceFile);
     if (solution.positions.size() != reference.positions.size())
         throw qsgi::InputError(a, "", "has " + std::to_string(solution.positions.size()) + " vertices but " + b + " has " +
                                           std::to_string(reference.positions.size()) + ": not the same scene");

@@ -28,6 +28,7 @@ test_packages=(
   python3 python3-numpy python3-matplotlib   # scripts/sweep.py, tests/data/make_inputs.py, reference checks
   python3-xxhash            # the Slurm merge verifies chunk files (scripts/qsgibatch/output_folder.py)
   openimageio-tools
+  strace                    # tests/read_once_test.cpp counts the opens of each input
   libgtest-dev libgmock-dev
   libbenchmark-dev
   clang libclang-rt-14-dev    # libFuzzer (scripts/fuzz.sh)

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <istream>
 #include <map>
 #include <sstream>
 
@@ -78,15 +78,14 @@ const char* plural(const std::string& element) {
 }
 
 // The header of a binary PLY whose first element is `first`: every element with its count and
-// properties, checked against the file's size before any data is read. `in` is left at the data.
-std::vector<PlyElement> readHeader(const std::string& path, std::ifstream& in, const std::string& first) {
-    // The one opening rule (util/input_file.h) first: a directory, device or pipe is refused by its
-    // kind before the stream opens it (a pipe's open would wait for a writer).
-    uint64_t fileSize = 0;
-    const std::string why = InputFile::problem(path, UINT64_MAX, "a PLY file", fileSize);
-    if (!why.empty()) throw InputError(path, "", why);
-    in.open(path, std::ios::binary);
-    if (!in) throw InputError(path, "", "cannot be opened for reading");
+// properties, checked against the file's size before any data is read. The file's stream is left
+// at the data.
+std::vector<PlyElement> readHeader(InputFile& file, const std::string& first) {
+    const std::string& path = file.path();
+    const uint64_t fileSize = file.size();
+    std::istream& in = file.stream();
+    in.clear();
+    in.seekg(0);  // after plyFirstElement's look at the header
 
     std::string line;
     if (!std::getline(in, line) || line != "ply") throw InputError(path, "line 1", "not a PLY file");
@@ -185,7 +184,7 @@ PlyRows layoutOf(const PlyElement& element) {
 }
 
 // Reads the rows of `rows`' layout (layoutOf), every property finite.
-void readFirstElementRows(const std::string& path, std::ifstream& in, const PlyElement& element, PlyRows& rows) {
+void readFirstElementRows(const std::string& path, std::istream& in, const PlyElement& element, PlyRows& rows) {
     const size_t count = size_t(element.count);
     if (count > (size_t(1) << 31)) throw InputError(path, "header", "implausible " + element.name + " count");
     rows.data.resize(count * rows.stride);
@@ -203,8 +202,14 @@ void readFirstElementRows(const std::string& path, std::ifstream& in, const PlyE
 }  // namespace
 
 VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
-    std::ifstream in;
-    const std::vector<PlyElement> elements = readHeader(path, in, "vertex");
+    InputFile file(path, UINT64_MAX, "a PLY file");
+    return readVertexRadiosityPly(file);
+}
+
+VertexRadiosityPly readVertexRadiosityPly(InputFile& file) {
+    const std::string& path = file.path();
+    const std::vector<PlyElement> elements = readHeader(file, "vertex");
+    std::istream& in = file.stream();
     // Vertices: every property of every vertex finite, the nine qsgi reads within float's range
     // (the properties are looked for before any row is read).
     PlyRows rows = layoutOf(elements[0]);
@@ -308,8 +313,14 @@ VertexRadiosityPly readVertexRadiosityPly(const std::string& path) {
 }
 
 SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
-    std::ifstream in;
-    const std::vector<PlyElement> elements = readHeader(path, in, "point");
+    InputFile file(path, UINT64_MAX, "a PLY file");
+    return readSurfaceReferencePly(file);
+}
+
+SurfaceReferencePly readSurfaceReferencePly(InputFile& file) {
+    const std::string& path = file.path();
+    const std::vector<PlyElement> elements = readHeader(file, "point");
+    std::istream& in = file.stream();
     if (elements[0].count == 0) throw InputError(path, "header", "has no points: nothing to score");
     PlyRows rows = layoutOf(elements[0]);
     auto find = [&](const std::string& name) -> const PlyProperty& {
@@ -349,10 +360,10 @@ SurfaceReferencePly readSurfaceReferencePly(const std::string& path) {
     return out;
 }
 
-std::string plyFirstElement(const std::string& path) {
-    uint64_t size = 0;
-    if (!InputFile::problem(path, UINT64_MAX, "a PLY file", size).empty()) return "";
-    std::ifstream in(path, std::ios::binary);
+std::string plyFirstElement(InputFile& file) {
+    std::istream& in = file.stream();
+    in.clear();
+    in.seekg(0);
     std::string line;
     if (!std::getline(in, line) || line != "ply") return "";
     for (int lines = 0; lines < 1000 && std::getline(in, line); ++lines) {

@@ -11,6 +11,8 @@
 
 namespace qsgi {
 
+class InputFile;
+
 struct VertexRadiosityPly {
     std::vector<Vec3f> positions, normals, radiosity;
     std::vector<Vec3f> irradiance;    // empty when the file has none (written before issue 35)
@@ -23,8 +25,11 @@ struct VertexRadiosityPly {
     std::vector<uint8_t> referenced;
 };
 
-// Throws InputError naming the file for anything it cannot read.
+// Throws InputError naming the file for anything it cannot read. The file is opened once, under
+// the one opening rule (util/input_file.h), and read as a stream: its rows are not held twice.
 VertexRadiosityPly readVertexRadiosityPly(const std::string& path);
+// The same from a file already open (after plyFirstElement, say): it is read from its start.
+VertexRadiosityPly readVertexRadiosityPly(InputFile& file);
 
 // A surface reference (scripts/reference.py --surface N): `element point N` (N ≥ 1) with the
 // properties SurfacePoint holds: int triangle, float b1 b2 x y z nx ny nz irradiance_r/g/b
@@ -34,9 +39,11 @@ struct SurfaceReferencePly {
     std::vector<SurfacePoint> points;
 };
 SurfaceReferencePly readSurfaceReferencePly(const std::string& path);
+SurfaceReferencePly readSurfaceReferencePly(InputFile& file);
 
 // The name of a PLY's first element ("vertex", "point"), or "" if it is not a PLY header: which
-// of the two readers a file is for. Opens a regular file only (anything else: "").
-std::string plyFirstElement(const std::string& path);
+// of the two readers a file is for. Reads the open file's header, which the reader then reads
+// again from the same descriptor.
+std::string plyFirstElement(InputFile& file);
 
 }  // namespace qsgi

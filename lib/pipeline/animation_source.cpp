@@ -21,6 +21,7 @@ AnimationSource AnimationSource::resolve(const RenderSettings& settings) {
     source.kind_ = Kind::TransformFile;
     source.path_ = option;
     source.name_ = option;
+    source.bytes_ = readInputFile(option, kMaxJsonFileBytes, "a transform file");
     return source;
 }
 
@@ -30,7 +31,7 @@ Animation AnimationSource::load(const Scene& scene, double fps) const {
     case Kind::Gltf: return Animation::fromGltf(scene, gltfIndex_, fps, name_);
     case Kind::TransformFile: break;
     }
-    return Animation::fromTransformFile(path_, scene);
+    return Animation::fromTransformFileBytes(path_, bytes_, scene);
 }
 
 int AnimationSource::playedGltfAnimation(const Scene& scene) const {
@@ -39,7 +40,7 @@ int AnimationSource::playedGltfAnimation(const Scene& scene) const {
 }
 
 std::string AnimationSource::fingerprintBytes(const Scene& scene) const {
-    if (transformFile()) return readInputFile(path_, kMaxJsonFileBytes, "a transform file");
+    if (transformFile()) return bytes_;
     std::string bytes;
     if (!gltf()) return bytes;
     auto append = [&](const void* data, size_t size) { bytes.append(static_cast<const char*>(data), size); };

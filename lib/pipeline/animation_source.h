@@ -16,7 +16,8 @@ public:
     enum class Kind { Still, TransformFile, Gltf };
 
     // From the settings' --animation (and its config file, for messages). A transform file is read
-    // here, once: the parser and the run's fingerprint read these bytes. Throws InputError for
+    // here, once (the opening rule, util/input_file.h): the parser and the run's fingerprint read
+    // these bytes. Throws InputError for
     // "gltf:" without a valid index and for a transform file that cannot be read.
     static AnimationSource resolve(const RenderSettings& settings);
 
@@ -44,6 +45,7 @@ private:
     int gltfIndex_ = -1;
     std::string path_;   // the transform file's
     std::string name_;
+    std::string bytes_;  // the transform file's, read once: parsed by load(), digested by fingerprintBytes()
 };
 
 }  // namespace qsgi

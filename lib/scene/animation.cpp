@@ -12,6 +12,7 @@
 
 #include "scene/swept_boxes.h"
 #include "util/error.h"
+#include "util/input_file.h"
 #include "util/json_file.h"
 #include "util/nearest_name.h"
 
@@ -93,8 +94,12 @@ Transform parseNodeTransform(const json& j, const std::string& file, const std::
 }  // namespace
 
 Animation Animation::fromTransformFile(const std::string& path, const Scene& scene) {
+    return fromTransformFileBytes(path, readInputFile(path, kMaxJsonFileBytes, "a transform file"), scene);
+}
+
+Animation Animation::fromTransformFileBytes(const std::string& path, const std::string& bytes, const Scene& scene) {
     try {
-        return parseTransformFile(path, readJsonFile(path), scene);
+        return parseTransformFile(path, parseJsonFile(path, bytes), scene);
     } catch (const json::exception& e) {
         throw InputError(path, "", std::string("a field has the wrong JSON type (") + e.what() + ")");
     }

@@ -24,6 +24,10 @@ public:
     static Animation still(const Scene& scene);
     // Throws InputError naming the file, frame and node for anything unusable.
     static Animation fromTransformFile(const std::string& path, const Scene& scene);
+    // The same for the transform file's bytes, read once by the caller (kMaxJsonFileBytes at
+    // most): the run parses them here and fingerprints the same bytes, so the file is opened once
+    // and what is fingerprinted is what was parsed. `path` names the file in messages.
+    static Animation fromTransformFileBytes(const std::string& path, const std::string& bytes, const Scene& scene);
     // The same for a transform file already parsed as JSON (`path` names it in messages; the
     // fuzzer uses this). Wrong JSON types may also throw nlohmann::json::exception.
     static Animation parseTransformFile(const std::string& path, const nlohmann::json& doc, const Scene& scene);

@@ -1,5 +1,6 @@
 #include "scene/environment_light.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -46,13 +47,21 @@ EnvironmentLight EnvironmentLight::fromPixels(std::vector<Vec3f> pixels, uint32_
 
 EnvironmentLight EnvironmentLight::fromImage(const std::string& path, float intensity, float rotationDegrees) {
     // The one opening rule first: a pipe, a device (/dev/zero) or a directory is refused by its
-    // kind before OpenImageIO opens the path (a pipe's open would wait for a writer, a device's
-    // bytes never end).
-    uint64_t fileBytes = 0;
-    const std::string why = InputFile::problem(path, kMaxImageFileBytes, "an environment map", fileBytes);
-    if (!why.empty()) throw InputError(path, "", why);
-    auto input = OIIO::ImageInput::open(path);
+    // kind before anything reads it (a pipe's open would wait for a writer, a device's bytes never
+    // end). OpenImageIO then decodes the bytes read from that descriptor, from memory: it never
+    // opens the path itself, which could name another file by then.
+    InputFile file(path, kMaxImageFileBytes, "an environment map");
+    refuseBeyondMemory(file.size(), path, "", "reading the environment map's " + std::to_string(file.size()) + " bytes");
+    const std::string bytes = file.readAll();
+    OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
+    // The path still chooses the format to try first by its extension, as a file's open does.
+    auto input = OIIO::ImageInput::open(path, nullptr, &memory);
     if (!input) throw InputError(path, "", "cannot be read as an image: " + oneLine(OIIO::geterror()));
+    // A format whose reader cannot take bytes (SGI, FITS, Cineon, …) has opened the path instead.
+    if (!input->supports("ioproxy"))
+        throw InputError(path, "", std::string("is an image in the '") + input->format_name() +
+                                       "' format, which OpenImageIO reads only by opening the path again, not from the "
+                                       "bytes qsgi checked; convert it to OpenEXR or Radiance HDR");
     const OIIO::ImageSpec& spec = input->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
         throw InputError(path, "", "has no pixels");
@@ -63,10 +72,12 @@ EnvironmentLight EnvironmentLight::fromImage(const std::string& path, float inte
     // Grey maps are read as one channel and spread to three; colour maps as their first three (R,
     // G, B; alpha ignored).
     const int channels = spec.nchannels >= 3 ? 3 : 1;
-    // What loading holds at once, before any of it is allocated: the file's floats, OpenImageIO's
-    // own copy of them while it converts, the radiance and the sampling tables.
+    // What loading holds at once, before any of it is allocated: the file's bytes, its floats,
+    // OpenImageIO's own copy of them while it converts, the radiance and the sampling tables.
     const uint64_t pixelCount = uint64_t(width) * height;
-    refuseBeyondMemory(saturatingMultiply(pixelCount, 2 * 4 * uint64_t(channels) + sizeof(Vec3f) + kTableBytesPerPixel), path, "",
+    refuseBeyondMemory(saturatingAdd(bytes.size(), saturatingMultiply(pixelCount, 2 * 4 * uint64_t(channels) + sizeof(Vec3f) +
+                                                                                      kTableBytesPerPixel)),
+                       path, "",
                        "an environment map of " + std::to_string(width) + " x " + std::to_string(height) + " pixels");
     std::vector<float> raw(size_t(width) * height * size_t(channels));
     if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, raw.data()))

@@ -1,5 +1,6 @@
 // Light from infinitely far away (docs/design.md §2, issue 35): a uniform sky, or an equirectangular
-// HDR map read with OpenImageIO (EXR, Radiance HDR, anything it reads), static as every light is.
+// HDR map decoded by OpenImageIO from the file's bytes (EXR, Radiance HDR, any format it reads from
+// memory), static as every light is.
 //
 // The map's orientation, in glTF's Y-up frame, as Blender and three.js show an equirectangular
 // world. Pixel column u ∈ [0, 1) (left to right) and row v ∈ [0, 1) (top to bottom) hold the
@@ -43,8 +44,9 @@ class EnvironmentLight {
 public:
     // A uniform sky of radiance L (finite, non-negative: the option checks).
     static EnvironmentLight uniform(const Vec3f& radiance);
-    // An equirectangular map. Throws InputError naming the file and the pixel when the file cannot
-    // be read or holds a negative, NaN or infinite radiance.
+    // An equirectangular map, its file opened once (util/input_file.h). Throws InputError naming
+    // the file and the pixel when the file cannot be read or holds a negative, NaN or infinite
+    // radiance.
     static EnvironmentLight fromImage(const std::string& path, float intensity, float rotationDegrees);
     // The same from pixels in memory (RGB, row-major from the top row): for tests and the loader.
     static EnvironmentLight fromPixels(std::vector<Vec3f> pixels, uint32_t width, uint32_t height, float rotationDegrees);

@@ -14,6 +14,7 @@
 
 #include "util/input_file.h"
 #include "util/json_file.h"
+#include "util/memory.h"
 
 // Part of libtinygltf's exported API, though its header declares it only for the translation
 // unit that compiles the implementation.
@@ -310,6 +311,7 @@ struct UriFiles {
     std::string baseDir;
     std::set<std::string> imagePaths;             // the paths images' uris resolve to
     std::map<std::string, std::string> problems;  // a path not read -> why ("names a directory, …")
+    uint64_t heldBytes = 0;                       // what the files read so far hold in the model
 };
 
 // A uri as tinygltf turns it into a file name (its dlib::urldecode: %XX is a byte, '+' a space).
@@ -341,18 +343,27 @@ std::vector<std::string> uriFilePaths(const std::string& baseDir, const std::str
     return {join(baseDir), join(".")};
 }
 
-// "" if `path` is a regular file of 1 to `limit` - 1 bytes (its size in `size`); else why not, as
-// what the uri names.
-std::string uriFileProblem(const std::string& path, uint64_t limit, uint64_t& size) {
-    // The kind by the one opening rule (InputFile), in the words of a uri: "names a directory, …".
-    const std::string why = InputFile::problem(path, UINT64_MAX, "a file", size);
+// What the one opening rule's `why` (InputFile) says, in the words of a uri: "names a directory,
+// not a file", "names no file", "names a file that became shorter while it was read".
+std::string uriFileProblem(const std::string& why) {
     if (why == "no such file") return "names no file";
     if (why.rfind("is a", 0) == 0) return "names " + why.substr(3);  // its kind: "names a named pipe, …"
-    if (!why.empty()) return "names a file that " + why;
+    return "names a file that " + why;
+}
+
+// "" if a uri's file of `size` bytes is one to read: 1 to `limit` - 1 bytes, which with what the
+// files read before it hold fit in the memory the process may use; else why not.
+std::string uriFileSizeProblem(uint64_t size, uint64_t limit, uint64_t heldBytes) {
     if (size == 0) return "names an empty file";
     if (size >= limit)
         return "names a file of " + std::to_string(size) + " bytes, beyond the " +
                (limit == kMaxImageFileBytes ? "2 GiB qsgi reads for an image" : "4 GiB qsgi reads for a buffer");
+    const MemoryLimit memory = usableMemory();
+    const uint64_t held = saturatingAdd(heldBytes, size);
+    if (held > memory.bytes)
+        return "names a file of " + std::to_string(size) + " bytes: with the files read before it, the scene's buffers "
+               "and images would hold " + formatBytes(held) + ", more than the " + formatBytes(memory.bytes) +
+               " of memory " + memory.source;
     return "";
 }
 
@@ -363,20 +374,26 @@ bool uriFileExists(const std::string& path, void*) {
 
 std::string uriFileExpand(const std::string& path, void*) { return path; }  // no ~ or $ expansion, as tinygltf's
 
+// Opens the file once and reads it straight into tinygltf's vector, which tinygltf swaps into
+// the buffer or hands to the image callback: a buffer's bytes are held once, never copied.
 bool uriFileRead(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
     UriFiles& files = *static_cast<UriFiles*>(user);
-    uint64_t size = 0;
-    std::string problem = uriFileProblem(path, files.imagePaths.count(path) ? kMaxImageFileBytes : kMaxBufferFileBytes, size);
-    if (problem.empty()) {
-        try {
-            InputFile file(path, size, "a file");
-            const std::string bytes = file.readAll();
-            out->assign(bytes.begin(), bytes.end());
-        } catch (const InputError& e) {
-            problem = "names a file that " + e.problem();
+    const uint64_t limit = files.imagePaths.count(path) ? kMaxImageFileBytes : kMaxBufferFileBytes;
+    std::string problem;
+    try {
+        InputFile file(path, UINT64_MAX, "a file");
+        problem = uriFileSizeProblem(file.size(), limit, files.heldBytes);
+        if (problem.empty()) {
+            out->resize(size_t(file.size()));
+            file.readAllInto(out->data());
+            files.heldBytes += file.size();
         }
+    } catch (const InputError& e) {
+        problem = uriFileProblem(e.problem());
     }
     if (problem.empty()) return true;
+    out->clear();
+    out->shrink_to_fit();
     files.problems[path] = problem;
     if (err) *err += problem;
     return false;

@@ -3,7 +3,9 @@
 //   - asset.version must be 2.x and asset.minVersion at most 2.0;
 //   - buffers and images are local files or data URIs: a remote URI (http:, https:, …) is refused;
 //     a uri's file is read only if it is a regular file of sane size (never a directory, a pipe or
-//     a device): an unreadable buffer is refused, an unreadable image recorded in unreadableImages;
+//     a device) that fits in memory beside the files read before it: an unreadable buffer is
+//     refused, an unreadable image recorded in unreadableImages. Each is opened once and read
+//     straight into tinygltf's own array (a buffer of N bytes is held as N bytes, not copied);
 //   - a buffer without a uri (other than a GLB's BIN chunk) is valid as long as nothing reads it;
 //     tinygltf refuses the whole file, so such buffers are handed to it as a 1-byte placeholder and
 //     listed in absentBuffers, and any read through them is refused by the accessor reader.

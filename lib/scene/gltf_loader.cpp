@@ -85,7 +85,10 @@ Vec3f vec3FromFactor(const std::vector<double>& f, Vec3f fallback) {
 // however many textures and materials share it. What a texture's sampler says comes with it.
 class TextureImages {
 public:
-    TextureImages(const GltfDocument& document, const AccessorReader& reader) : document_(document), reader_(reader) {}
+    TextureImages(const GltfDocument& document, const AccessorReader& reader) : document_(document), reader_(reader) {
+        for (const tinygltf::Buffer& buffer : document.model.buffers) documentBytes_ += buffer.data.size();
+        for (const tinygltf::Image& image : document.model.images) documentBytes_ += image.image.size();
+    }
 
     // Texture `index` with its sampler, or why its image cannot be read; the image is added to
     // `decoded` (read, whatever came of it).
@@ -127,9 +130,11 @@ private:
         const tinygltf::Image& image = document_.model.images[size_t(source)];
         const std::string imagePlace = gltfPlace("images", source);
         DecodedTexture out;
-        // Decoded textures count against the memory the process may use: what the images decoded
-        // so far hold is not there for the next.
-        const uint64_t usable = usableMemory().bytes, budget = usable > bytes() ? usable - bytes() : 0;
+        // Decoded textures count against the memory the process may use: what the file's buffers
+        // and encoded images hold while the scene is built, and what the images decoded so far
+        // hold, is not there for the next.
+        const uint64_t usable = usableMemory().bytes, held = saturatingAdd(documentBytes_, bytes());
+        const uint64_t budget = usable > held ? usable - held : 0;
         if (image.bufferView >= 0) {
             const auto bytes = reader_.viewBytes(image.bufferView, usedBy + " -> " + imagePlace);
             out = decodeTextureImage(bytes.data, bytes.size, budget);
@@ -147,6 +152,7 @@ private:
 
     const GltfDocument& document_;
     const AccessorReader& reader_;
+    uint64_t documentBytes_ = 0;  // the file's buffers and encoded images, held by the document
     std::map<int, DecodedTexture> images_;  // by image index
 };
 

@@ -73,7 +73,10 @@ private:
 }  // namespace
 
 nlohmann::json readJsonFile(const std::string& path) {
-    const std::string text = readInputFile(path, kMaxJsonFileBytes, "a JSON file");
+    return parseJsonFile(path, readInputFile(path, kMaxJsonFileBytes, "a JSON file"));
+}
+
+nlohmann::json parseJsonFile(const std::string& path, const std::string& text) {
     refuseDeepNesting(text, path);
     try {
         DuplicateKeyFinder duplicates(path);

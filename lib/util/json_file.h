@@ -15,6 +15,9 @@ namespace qsgi {
 // kMaxJsonDepth; it is read under the one opening rule (util/input_file.h): a directory, a
 // device or a pipe is refused by its kind.
 nlohmann::json readJsonFile(const std::string& path);
+// The same rules for a JSON file's bytes already read (`path` names it in messages): a reader
+// that keeps the bytes too (the fingerprint of a transform file) reads the file once.
+nlohmann::json parseJsonFile(const std::string& path, const std::string& text);
 
 // Nesting deeper than this is refused before any parser sees it: recursive readers (tinygltf's
 // copy of extras) overflow the stack around 10^4–10^5 levels, and no scene needs more than a few.
