@@ -40,13 +40,28 @@ export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:dete
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 status=0
 mkdir -p build-fuzz/artifacts
+# Each harness is one single-threaded process: they run side by side, as many at a time as there
+# are cores (QSGI_FUZZ_JOBS overrides), so each still has a core of its own for its SECONDS and the
+# stage takes ceil(harnesses / cores) x SECONDS instead of harnesses x SECONDS.
+jobs=${QSGI_FUZZ_JOBS:-$(nproc)}
+fuzz_one() {  # fuzz_one HARNESS: runs it, its output in build-fuzz/HARNESS.log, exit status its verdict
+  "build-fuzz/fuzz/${1}_fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
+    -dict=fuzz/json.dict -artifact_prefix="build-fuzz/artifacts/$1-" \
+    "build-fuzz/corpus/$1" "build-fuzz/seeds/$1" > "build-fuzz/$1.log" 2>&1
+}
+declare -A pid_of
+running=0
 for h in "${harnesses[@]}"; do
   mkdir -p "build-fuzz/corpus/$h"
-  log="build-fuzz/$h.log"
+  if [ "$running" -ge "$jobs" ]; then wait -n || true; running=$((running - 1)); fi
   echo "fuzz: $h for ${seconds} s ($(ls "build-fuzz/seeds/$h" | wc -l) seeds)"
-  if "build-fuzz/fuzz/${h}_fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 \
-       -dict=fuzz/json.dict -artifact_prefix="build-fuzz/artifacts/$h-" \
-       "build-fuzz/corpus/$h" "build-fuzz/seeds/$h" > "$log" 2>&1; then
+  fuzz_one "$h" &
+  pid_of[$h]=$!
+  running=$((running + 1))
+done
+for h in "${harnesses[@]}"; do
+  log="build-fuzz/$h.log"
+  if wait "${pid_of[$h]}"; then
     execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
     echo "fuzz: $h ok: $execs executions, corpus $(ls "build-fuzz/corpus/$h" | wc -l) inputs"
   else

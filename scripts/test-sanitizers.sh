@@ -12,7 +12,8 @@
 # incremental updates, the sweep and resume CLIs. Also left out: the glTF-Validator corpus
 # (ValidatorCorpus), some 650 runs of the executable that would take minutes under the
 # sanitizers; the same readers meet hostile bytes under them in the fuzzers (scripts/fuzz.sh) and
-# in HostileInput.*, which run here.
+# in HostileInput.*, which run here. HostileInput's bad-file corpus runs only here when this stage
+# runs (scripts/test.sh leaves it out of the release suite): the same assertions, and memory checked.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh --test
