@@ -19,6 +19,7 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh --test
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release -DQSGI_SANITIZE=ON -DQSGI_BUILD_BENCHMARKS=OFF
 cmake --build build-asan
+echo "test-sanitizers: setup and build took $SECONDS s" >&2
 # Use of a stack frame after its function returned is looked for by the fuzzers (scripts/fuzz.sh),
 # which feed the readers hostile bytes; here it would double the suite's time (ImpactCount's
 # closed sphere: 10.3 s with it, 5.9 s without), for code that takes no input of its own.

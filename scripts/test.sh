@@ -11,9 +11,14 @@
 # go to ctest in step 1.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each step's wall time on stderr, so that a CI log shows where its minutes went.
+step_start=$SECONDS
+timed() { echo "test.sh: $1 took $((SECONDS - step_start)) s" >&2; step_start=$SECONDS; }
 scripts/setup.sh --test
+timed "setup"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DQSGI_BUILD_TESTS=ON -DQSGI_BUILD_BENCHMARKS=ON
 cmake --build build
+timed "release build"
 # A corpus the sanitizer stage (step 3) runs with the same assertions is left to it when it runs:
 # HostileInput's bad files (tests/data/bad/: each refused with exit 2, one line naming it, nothing
 # written) are checked there, where a hostile byte that reaches memory it should not also fails.
@@ -21,6 +26,7 @@ cmake --build build
 asan_proves='HostileInput\.EveryBadFileIsRefusedWithOneLineNamingItExitTwoAndNothingWritten'
 if [ "${QSGI_SKIP_SANITIZERS:-0}" != 1 ] && [ $# -eq 0 ]; then set -- -E "$asan_proves"; fi
 (cd build && ctest --output-on-failure -j 2 "$@")
-if [ "${QSGI_SKIP_SLURM:-0}" != 1 ]; then scripts/test-slurm.sh; fi
-if [ "${QSGI_SKIP_SANITIZERS:-0}" != 1 ]; then scripts/test-sanitizers.sh; fi
-if [ "${QSGI_SKIP_FUZZ:-0}" != 1 ]; then scripts/fuzz.sh "${QSGI_FUZZ_SECONDS:-30}"; fi
+timed "release suite"
+if [ "${QSGI_SKIP_SLURM:-0}" != 1 ]; then scripts/test-slurm.sh; timed "slurm"; fi
+if [ "${QSGI_SKIP_SANITIZERS:-0}" != 1 ]; then scripts/test-sanitizers.sh; timed "sanitizer build and suite"; fi
+if [ "${QSGI_SKIP_FUZZ:-0}" != 1 ]; then scripts/fuzz.sh "${QSGI_FUZZ_SECONDS:-30}"; timed "fuzz"; fi
