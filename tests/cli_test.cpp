@@ -293,8 +293,13 @@ TEST(Cli, IncrementalRunWritesTheBytesOfAFullRecomputation) {
     // frame (data/cornell/animation.json), so a further frame would take frame 2's path again.
     const std::string common = cornell() + " --animation " + cornellAnimation() +
                                " --frames 0:2 --photons 30000 --quiet --no-exr" + kCheapSecondPass;
-    for (const char* estimator : {"impact-count", "photon-map", "detp --detp-boundary clip", "detp --detp-boundary linear",
-                                  "detp --detp-boundary paper"}) {
+    std::vector<std::string> estimators = {"impact-count", "photon-map", "detp --detp-boundary clip",
+                                           "detp --detp-boundary linear", "detp --detp-boundary paper"};
+    // Under the sanitizers two of them: every estimator's update is checked in-process there
+    // (Incremental.EveryFrameEqualsFullRecomputationForEveryEstimator); what this test adds, the
+    // render job's incremental frames end to end, is the same code for all five.
+    if (kSanitized) estimators = {"photon-map", "detp --detp-boundary linear"};
+    for (const std::string& estimator : estimators) {
         SCOPED_TRACE(estimator);
         const fs::path inc = dir / "inc", full = dir / "full";
         fs::remove_all(inc);

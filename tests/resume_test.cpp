@@ -21,10 +21,12 @@ namespace {
 // frame after the first is the same kind of work (an incremental update, then three files
 // written), so twelve give a kill as many kinds of moment to land in as thirty did.
 constexpr int kFrames = 12;
+// Fewer photons under the sanitizers, where each run is slower: the same stages, files and signals.
 std::string renderArguments() {
     const fs::path cornell = sourceDir() / "data" / "cornell";
     return "render " + (cornell / "cornell.gltf").string() + " --animation " + (cornell / "animation.json").string() +
-           " --frames 0:" + std::to_string(kFrames - 1) + " --photons 100000 --width 80 --height 60 --png --quiet" +
+           " --frames 0:" + std::to_string(kFrames - 1) + " --photons " + (kSanitized ? "30000" : "100000") +
+           " --width 80 --height 60 --png --quiet" +
            kCheapSecondPass;
 }
 
