@@ -50,25 +50,35 @@ constexpr int kExitInternal = 1;
 constexpr int kExitEnvironment = 74;  // sysexits' EX_IOERR: the disk failed (full, I/O error)
 constexpr int kExitBusy = 75;         // sysexits' EX_TEMPFAIL: another run holds the folder; retry later
 
+// What a subcommand's work ended with: its exit code and, when it failed, the one line saying why.
+struct WorkOutcome {
+    int exitCode = 0;
+    std::string error;  // "qsgi: error: ...", empty when the work succeeded
+};
+
 // Runs a subcommand's work; bad input becomes one line and exit 2, a failing disk 74, a folder
 // another run holds 75, anything else exit 1.
 template <typename Work>
-int exitCodeOf(Work&& work) {
+WorkOutcome outcomeOf(Work&& work) {
     try {
-        return work();
+        return {work(), ""};
     } catch (const qsgi::InputError& e) {
-        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
-        return kExitBadInput;
+        return {kExitBadInput, std::string("qsgi: error: ") + e.what()};
     } catch (const qsgi::EnvironmentError& e) {
-        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
-        return kExitEnvironment;
+        return {kExitEnvironment, std::string("qsgi: error: ") + e.what()};
     } catch (const qsgi::FolderBusyError& e) {
-        std::fprintf(stderr, "qsgi: error: %s\n", e.what());
-        return kExitBusy;
+        return {kExitBusy, std::string("qsgi: error: ") + e.what()};
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "qsgi: internal error: %s\n", e.what());
-        return kExitInternal;
+        return {kExitInternal, std::string("qsgi: internal error: ") + e.what()};
     }
+}
+
+// outcomeOf, its line on stderr.
+template <typename Work>
+int exitCodeOf(Work&& work) {
+    const WorkOutcome outcome = outcomeOf(std::forward<Work>(work));
+    if (!outcome.error.empty()) std::fprintf(stderr, "%s\n", outcome.error.c_str());
+    return outcome.exitCode;
 }
 
 // A render's options on the command line, made from the one table (lib/pipeline/render_options.cpp):
@@ -240,6 +250,39 @@ int runCompare(const std::string& a, const std::string& b, std::optional<double>
     return 0;
 }
 
+// `qsgi inspect --scenes LIST`: each listed scene inspected with `settings`, one JSON line each, so
+// that a folder of assets (or the glTF-Validator's corpus, scripts/validator_corpus.py) is checked
+// without a process start per file. Each line's exit code and error are what the scene alone gives.
+int inspectEach(const std::string& listPath, const qsgi::RenderSettings& settings) {
+    constexpr uint64_t kMaxListBytes = uint64_t(1) << 26;
+    const std::string list = qsgi::readInputFile(listPath, kMaxListBytes, "scene list");
+    int refused = 0, otherFailure = 0;
+    size_t start = 0;
+    while (start < list.size()) {
+        size_t end = list.find('\n', start);
+        if (end == std::string::npos) end = list.size();
+        std::string scene = list.substr(start, end - start);
+        start = end + 1;
+        if (!scene.empty() && scene.back() == '\r') scene.pop_back();
+        if (scene.empty()) continue;
+        nlohmann::json report;
+        const WorkOutcome outcome = outcomeOf([&] {
+            qsgi::RenderSettings own = settings;
+            own.scenePath = scene;
+            qsgi::Warnings warnings;
+            const qsgi::RenderJob job(own, warnings);
+            report = qsgi::inspectRender(job, warnings);
+            return 0;
+        });
+        const nlohmann::json line = {{"scene", scene}, {"exit", outcome.exitCode}, {"error", outcome.error}, {"report", report}};
+        std::printf("%s\n", line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+        std::fflush(stdout);
+        if (outcome.exitCode == kExitBadInput) refused = kExitBadInput;
+        else if (outcome.exitCode != 0 && otherFailure == 0) otherFailure = outcome.exitCode;
+    }
+    return otherFailure ? otherFailure : refused;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -271,6 +314,15 @@ int main(int argc, char** argv) {
     const BoundOptions inspectOptions = addRenderOptions(inspect);
     bool inspectJson = false;
     inspect->add_flag("--json", inspectJson, "print JSON instead of text");
+    std::string inspectScenes;
+    CLI::Option* scenesOption = inspect->add_option(
+        "--scenes", inspectScenes,
+        "inspect each scene this file lists (one path a line) with the other options, in one process: one JSON line "
+        "each, {scene, exit, error, report}, with the exit code and error line `qsgi inspect SCENE --json` would give "
+        "alone; exits 2 if any scene is refused");
+    scenesOption->type_name("LIST");
+    for (const auto& [o, option] : inspectOptions)
+        if (o->key && std::string(o->key) == "scene") scenesOption->excludes(option);
 
     CLI::App* options = app.add_subcommand("options", "every render option: its flag, config key, default and meaning");
     bool optionsMarkdown = false;
@@ -294,6 +346,8 @@ int main(int argc, char** argv) {
         return 0;
     }
 
+    if (inspect->parsed() && !inspectScenes.empty())
+        return exitCodeOf([&] { return inspectEach(inspectScenes, settingsFrom(inspectOptions)); });
     if (inspect->parsed())
         return exitCodeOf([&] {
             qsgi::Warnings warnings;

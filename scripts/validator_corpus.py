@@ -38,6 +38,12 @@ errors, a missing "asset") counts as named by any refusal, since there is no obj
 
 A crash is any exit code other than 0 and 2: 1, a signal, or no answer within 60 s.
 
+The runs go in batches, one `qsgi inspect --scenes LIST --json` for many files (a process start
+costs more than most of these files take to read): each line of its output carries the exit code
+and error line the file alone would give. A batch that crashes or stops answering has its
+unanswered files run alone, so a crash is charged to its file. One file in SAMPLE_EVERY is also run
+alone and its answers compared with the batch's; a difference fails the script.
+
 --expect FILE names the known gaps, {"invalid-silent-in-scene": [...], "invalid-accepted-in-all":
 [...], "valid-refused": [...], "valid-refused-under-strict": [...], "crash": [...]} with
 "category/file" entries; the script exits 1 when a file is worse than listed
@@ -52,6 +58,7 @@ import base64
 import collections
 import concurrent.futures
 import json
+import os
 import re
 import shutil
 import struct
@@ -63,6 +70,7 @@ from pathlib import Path
 
 DEFAULT_CORPUS = Path(__file__).resolve().parents[1].parent / "shared/data/gltf-validator-corpus"
 TIMEOUT_SECONDS = 60
+SAMPLE_EVERY = 16  # of the files, one in this many is also run alone and compared with its batch answer
 SKIPPED = 77  # the exit code ctest's SKIP_RETURN_CODE reports as a skipped test
 EXIT_LOADED, EXIT_REFUSED = 0, 2
 
@@ -330,26 +338,61 @@ def run_inspect(qsgi, path, strict):
     except subprocess.TimeoutExpired:
         return {"exit": None, "crash": "no answer in %d s" % TIMEOUT_SECONDS,
                 "errors": [], "warnings": [], "message": ""}
+    stderr = done.stderr.decode("utf-8", "replace").splitlines()
+    report_warnings = []
+    if done.returncode == EXIT_LOADED:
+        try:
+            report_warnings = json.loads(done.stdout).get("warnings", [])
+        except (ValueError, AttributeError):
+            stderr.append("(inspect --json printed no JSON object)")
+    return run_of(path, done.returncode, stderr, report_warnings)
 
+
+def run_of(path, exit_code, stderr_lines, report_warnings):
+    """A run's record from its exit code, its stderr lines and its report's warnings."""
     def clean(text):
         return text.replace(str(path), "<file>")
 
-    stderr = [clean(line) for line in done.stderr.decode("utf-8", "replace").splitlines()]
+    stderr = [clean(line) for line in stderr_lines]
     errors = [line for line in stderr if not line.startswith("qsgi: warning: ")]
     warnings = [line for line in stderr if line.startswith("qsgi: warning: ")]
-    if done.returncode == EXIT_LOADED:
-        try:
-            warnings += [clean(w) for w in json.loads(done.stdout).get("warnings", [])]
-        except (ValueError, AttributeError):
-            errors.append("(inspect --json printed no JSON object)")
+    if exit_code == EXIT_LOADED:
+        warnings += [clean(w) for w in report_warnings]
     crash = None
-    if done.returncode < 0:
-        crash = "signal %d" % -done.returncode
-    elif done.returncode not in (EXIT_LOADED, EXIT_REFUSED):
-        crash = "exit %d" % done.returncode
-    message = next(iter(errors if done.returncode != EXIT_LOADED else warnings), "")
-    return {"exit": done.returncode, "crash": crash, "errors": errors, "warnings": warnings,
-            "message": message}
+    if exit_code < 0:
+        crash = "signal %d" % -exit_code
+    elif exit_code not in (EXIT_LOADED, EXIT_REFUSED):
+        crash = "exit %d" % exit_code
+    message = next(iter(errors if exit_code != EXIT_LOADED else warnings), "")
+    return {"exit": exit_code, "crash": crash, "errors": errors, "warnings": warnings, "message": message}
+
+
+def run_batch(qsgi, paths, strict, work_dir):
+    """{path: run} for every path, from one `qsgi inspect --scenes LIST --json [--strict]`.
+
+    Each line of its output is what the scene alone gives (exit code, error line, report). Where
+    the batch process itself fails (a crash, no answer) or leaves a path out, those paths are run
+    alone with run_inspect, so that a crash is charged to its file as before.
+    """
+    fd, list_name = tempfile.mkstemp(suffix=".txt", dir=work_dir)
+    with os.fdopen(fd, "w", encoding="utf-8") as f:
+        f.write("".join(str(p) + "\n" for p in paths))
+    command = [qsgi, "inspect", "--scenes", list_name, "--json"] + (["--strict"] if strict else [])
+    runs = {}
+    try:
+        done = subprocess.run(command, capture_output=True, timeout=TIMEOUT_SECONDS * max(1, len(paths) // 20))
+        output = done.stdout
+    except subprocess.TimeoutExpired as e:
+        output = e.stdout or b""
+    for line in output.decode("utf-8", "replace").splitlines():
+        try:
+            entry = json.loads(line)
+        except ValueError:
+            continue
+        path = entry["scene"]
+        warnings = (entry.get("report") or {}).get("warnings", []) if entry["exit"] == EXIT_LOADED else []
+        runs[path] = run_of(path, entry["exit"], [entry["error"]] if entry["error"] else [], warnings)
+    return {p: runs.get(str(p)) or run_inspect(qsgi, p, strict) for p in paths}
 
 
 def naming_line(lines, names):
@@ -418,8 +461,8 @@ INVALID_RUNS = [("scene", "scene", False), ("scene --strict", "scene", True), ("
 VALID_RUNS = INVALID_RUNS
 
 
-def check_file(qsgi, work_dir, category, model, report):
-    """Makes the variants of one corpus file in work_dir/category, runs them and classes the runs."""
+def prepare_file(work_dir, category, model, report):
+    """The record of one corpus file, with the paths of its variants made in work_dir/category."""
     errors = report_errors(report)
     pointers = [p for _, p in errors]
     valid = report["issues"]["numErrors"] == 0
@@ -443,18 +486,56 @@ def check_file(qsgi, work_dir, category, model, report):
             continue
         paths[variant] = folder / ("%s.%s%s" % (model.stem, variant, model.suffix))
         paths[variant].write_bytes(data)
+    return result, paths
 
-    for label, variant, strict in (VALID_RUNS if valid else INVALID_RUNS):
-        plain = result["runs"].get(label.replace(" --strict", ""))
-        if strict and plain and plain["exit"] == EXIT_REFUSED and not plain["crash"]:
-            # --strict refuses all that the plain run refuses: the same answer, without the run.
-            run = dict(plain)
-        else:
-            run = run_inspect(qsgi, paths[variant], strict)
-        run["class"] = (class_of_valid(run) if valid
-                        else class_of_invalid(label, run, names, result["whole_file"]))
-        result["runs"][label] = run
-    return result
+
+def run_everything(qsgi, work_dir, files, jobs):
+    """Runs every file's variants, in batches (one qsgi per batch, `jobs` at once), and classes them.
+
+    The plain runs first; then --strict, where the plain run did not refuse (--strict refuses all
+    that the plain run refuses: the same answer, without the run).
+    """
+    def in_batches(wanted, strict):
+        paths = sorted({str(p) for p in wanted})
+        size = max(1, -(-len(paths) // (4 * max(1, jobs))))
+        chunks = [[Path(p) for p in paths[i:i + size]] for i in range(0, len(paths), size)]
+        runs = {}
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            for part in pool.map(lambda chunk: run_batch(qsgi, chunk, strict, work_dir), chunks):
+                runs.update({str(p): r for p, r in part.items()})
+        return runs
+
+    plain = in_batches([paths[variant] for _, paths in files for _, variant, strict in INVALID_RUNS if not strict], False)
+    strict_paths = [paths[variant] for _, paths in files for _, variant, strict in INVALID_RUNS
+                    if strict and not (plain[str(paths[variant])]["exit"] == EXIT_REFUSED and not plain[str(paths[variant])]["crash"])]
+    strict_runs = in_batches(strict_paths, True)
+    results = []
+    for result, paths in files:
+        valid = result["valid"]
+        for label, variant, strict in (VALID_RUNS if valid else INVALID_RUNS):
+            run = dict((strict_runs if strict and str(paths[variant]) in strict_runs else plain)[str(paths[variant])])
+            run["class"] = (class_of_valid(run) if valid
+                            else class_of_invalid(label, run, result["object_names"], result["whole_file"]))
+            result["runs"][label] = run
+        results.append(result)
+    return results
+
+
+def batch_equals_alone(qsgi, files, every):
+    """Lines naming each sampled run whose batch answer differs from the same file run alone."""
+    problems = []
+    for i, (result, paths) in enumerate(files):
+        if i % every:
+            continue
+        for label, variant, strict in INVALID_RUNS:
+            batch = result["runs"][label]
+            if strict and batch["exit"] == EXIT_REFUSED and result["runs"][label.replace(" --strict", "")]["exit"] == EXIT_REFUSED:
+                continue  # not run: the plain run's answer
+            alone = run_inspect(qsgi, paths[variant], strict)
+            for key in ("exit", "errors", "warnings"):
+                if alone[key] != batch[key]:
+                    problems.append("%s %s: --scenes gave %s %r, alone %r" % (result["file"], label, key, batch[key], alone[key]))
+    return problems
 
 
 def copy_corpus_folders(data_dir, work_dir):
@@ -601,8 +682,10 @@ def main():
     with tempfile.TemporaryDirectory(prefix="validator_corpus.") as tmp:
         work_dir = Path(tmp)
         copy_corpus_folders(data_dir, work_dir)
-        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            results = list(pool.map(lambda item: check_file(qsgi, work_dir, *item), corpus_files(data_dir)))
+        files = [prepare_file(work_dir, *item) for item in corpus_files(data_dir)]
+        results = run_everything(qsgi, work_dir, files, args.jobs)
+        # One file in SAMPLE_EVERY is run alone too: `--scenes` must answer as single runs do.
+        batch_problems = batch_equals_alone(qsgi, files, SAMPLE_EVERY)
     seconds = time.monotonic() - started
 
     print_summary(results, seconds)
@@ -621,6 +704,11 @@ def main():
         failed = bool(problems)
     elif gaps["crash"]:
         failed = True
+    print("\n--scenes against runs alone (every %dth file): %s" % (SAMPLE_EVERY, "the same" if not batch_problems
+                                                                     else "%d differences" % len(batch_problems)))
+    for line in batch_problems:
+        print("  " + line)
+    failed = failed or bool(batch_problems)
     if gaps["crash"]:
         print("\n%d file(s) crash qsgi: %s" % (len(gaps["crash"]), ", ".join(gaps["crash"])))
     return 1 if failed else 0

@@ -4,9 +4,11 @@
 // the render's message and exit code.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "output/ply_reader.h"
@@ -239,4 +241,58 @@ TEST(Inspect, TrianglesLongerThanFourRadiiAreCountedAndWarnedAbout) {
     const json cornellReport = inspectJson(cornell());
     EXPECT_EQ(cornellReport["mesh_resolution"]["coarse_triangles"].get<int>(), 0);
     EXPECT_LE(cornellReport["mesh_resolution"]["longest_edge"].get<double>(), cornellReport["mesh_resolution"]["edge_limit"].get<double>());
+}
+
+// `inspect --scenes LIST` checks many scenes in one process: one JSON line a listed scene, whose
+// exit code, error line and report are what `qsgi inspect SCENE --json` gives for it alone — a
+// good scene, a hostile file, a skinned one and an absent path, in one list, a blank line skipped.
+TEST(Inspect, ScenesListAnswersForEachSceneAsItAloneWould) {
+    const fs::path dir = testScratchDir("inspect-scenes");
+    const std::vector<std::string> scenes = {cornell(), (sourceDir() / "tests/data/bad/gltf/accessor_past_view.gltf").string(),
+                                             (sourceDir() / "data/walker/walker.gltf").string(), (dir / "absent.gltf").string()};
+    const fs::path list = dir / "scenes.txt";
+    {
+        std::ofstream out(list);
+        out << scenes[0] << "\n" << scenes[1] << "\n\n" << scenes[2] << "\r\n" << scenes[3];
+    }
+    const std::string qsgi = QSGI_CLI;
+    const fs::path stderrFile = dir / "stderr.txt";
+    // In a subshell of its own: runCommand sends the whole line's stderr to its output.
+    const auto stdoutOnly = [&](const std::string& arguments) {
+        return runCommand("(" + qsgi + " " + arguments + " 2>'" + stderrFile.string() + "')");
+    };
+    const CommandResult batch = stdoutOnly("inspect --scenes '" + list.string() + "' --json");
+    EXPECT_EQ(batch.exitCode, 2) << "a refused scene makes the whole command exit 2";
+    EXPECT_EQ(readFileBytes(stderrFile), "") << "each scene's error is in its line";
+    std::vector<json> lines;
+    std::istringstream in(batch.output);
+    for (std::string line; std::getline(in, line);) lines.push_back(json::parse(line));
+    ASSERT_EQ(lines.size(), scenes.size()) << batch.output;
+    for (size_t i = 0; i < scenes.size(); ++i) {
+        SCOPED_TRACE(scenes[i]);
+        const CommandResult alone = stdoutOnly("inspect '" + scenes[i] + "' --json");
+        const std::string aloneStderr = readFileBytes(stderrFile);
+        EXPECT_EQ(lines[i]["scene"], scenes[i]);
+        EXPECT_EQ(lines[i]["exit"].get<int>(), alone.exitCode);
+        if (alone.exitCode == 0) {
+            EXPECT_EQ(lines[i]["error"], "");
+            EXPECT_EQ(lines[i]["report"], json::parse(alone.output));
+        } else {
+            EXPECT_EQ(lines[i]["error"].get<std::string>() + "\n", aloneStderr);
+            EXPECT_TRUE(lines[i]["report"].is_null());
+        }
+    }
+    EXPECT_EQ(lines[0]["exit"], 0);
+    EXPECT_EQ(lines[1]["exit"], 2);
+    EXPECT_EQ(lines[3]["exit"], 2);
+
+    // A scene and a list at once, or a list that is not there: one line naming the problem, exit 2.
+    const CommandResult both = runQsgi("inspect " + cornell() + " --scenes '" + list.string() + "'");
+    EXPECT_EQ(both.exitCode, 2) << both.output;
+    EXPECT_NE(both.output.find("--scenes"), std::string::npos) << both.output;
+    EXPECT_EQ(std::count(both.output.begin(), both.output.end(), '\n'), 1) << both.output;
+    const CommandResult absent = runQsgi("inspect --scenes '" + (dir / "no-list.txt").string() + "'");
+    EXPECT_EQ(absent.exitCode, 2) << absent.output;
+    EXPECT_NE(absent.output.find("no-list.txt"), std::string::npos) << absent.output;
+    EXPECT_EQ(std::count(absent.output.begin(), absent.output.end(), '\n'), 1) << absent.output;
 }
