@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cstdio>
 #include <optional>
+#include <utility>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -250,6 +251,13 @@ int runCompare(const std::string& a, const std::string& b, std::optional<double>
     return 0;
 }
 
+// What `qsgi inspect` reports for these settings: the scene loaded and checked as a render would.
+nlohmann::json inspectionOf(qsgi::RenderSettings settings) {
+    qsgi::Warnings warnings;
+    const qsgi::RenderJob job(std::move(settings), warnings);
+    return qsgi::inspectRender(job, warnings);
+}
+
 // `qsgi inspect --scenes LIST`: each listed scene inspected with `settings`, one JSON line each, so
 // that a folder of assets (or the glTF-Validator's corpus, scripts/validator_corpus.py) is checked
 // without a process start per file. Each line's exit code and error are what the scene alone gives.
@@ -269,9 +277,7 @@ int inspectEach(const std::string& listPath, const qsgi::RenderSettings& setting
         const WorkOutcome outcome = outcomeOf([&] {
             qsgi::RenderSettings own = settings;
             own.scenePath = scene;
-            qsgi::Warnings warnings;
-            const qsgi::RenderJob job(own, warnings);
-            report = qsgi::inspectRender(job, warnings);
+            report = inspectionOf(std::move(own));
             return 0;
         });
         const nlohmann::json line = {{"scene", scene}, {"exit", outcome.exitCode}, {"error", outcome.error}, {"report", report}};
@@ -350,9 +356,7 @@ int main(int argc, char** argv) {
         return exitCodeOf([&] { return inspectEach(inspectScenes, settingsFrom(inspectOptions)); });
     if (inspect->parsed())
         return exitCodeOf([&] {
-            qsgi::Warnings warnings;
-            const qsgi::RenderJob job(settingsFrom(inspectOptions), warnings);
-            const nlohmann::json report = qsgi::inspectRender(job, warnings);
+            const nlohmann::json report = inspectionOf(settingsFrom(inspectOptions));
             // Names are UTF-8 or pathJson's objects; bytes a message quotes are shown as U+FFFD.
             const std::string text =
                 inspectJson ? report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n" : qsgi::inspectionText(report);

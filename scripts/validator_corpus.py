@@ -505,10 +505,12 @@ def run_everything(qsgi, work_dir, files, jobs):
                 runs.update({str(p): r for p, r in part.items()})
         return runs
 
+    def refused(run):
+        return run["exit"] == EXIT_REFUSED and not run["crash"]
+
     plain = in_batches([paths[variant] for _, paths in files for _, variant, strict in INVALID_RUNS if not strict], False)
-    strict_paths = [paths[variant] for _, paths in files for _, variant, strict in INVALID_RUNS
-                    if strict and not (plain[str(paths[variant])]["exit"] == EXIT_REFUSED and not plain[str(paths[variant])]["crash"])]
-    strict_runs = in_batches(strict_paths, True)
+    strict_runs = in_batches([paths[variant] for _, paths in files for _, variant, strict in INVALID_RUNS
+                              if strict and not refused(plain[str(paths[variant])])], True)
     results = []
     for result, paths in files:
         valid = result["valid"]
