@@ -11,11 +11,14 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "estimate/final_gather.h"
 #include "estimate/surface_accuracy.h"
 #include "estimate/vertex_fit.h"
+#include "pipeline/vertex_fit_stage.h"
+#include "scene/animation.h"
 #include "scene/contact_refinement.h"
 #include "scene/mesh_refinement.h"
 #include "test_support.h"
@@ -288,6 +291,76 @@ TEST(VertexFit, TheVisibleFloorRoundABlocksFootIsFittedWithoutTheCoveredFloorsSa
     EXPECT_LT(rmsFitCut, 0.6 * rmsPointCut);
     EXPECT_LT(std::fabs(fitCutBias), 0.4 * std::fabs(pointCutBias));
     for (uint32_t v = 0; v < floorVertices; ++v) EXPECT_GE(fitted.irradiance[v].x, 0.0f);
+}
+
+// A sheet hung a centimetre over a floor of 6.25 cm cells (the ceiling panel's housing in
+// tests/scenes/ceiling_panel, upside down), the sampling mesh made by the renderer's rule. The gap is
+// finer than the floor's triangles resolve, so the covered-vertex rule covers the floor's vertices
+// under the sheet; the sampling mesh's finer triangles would resolve it, but the rule judges the
+// output's vertices there by the output's resolution (Scene::coverEdges), as it does without the
+// fit, and the samples between them by their own: those are seen. A floor vertex
+// whose triangles' corners are all covered has no weighed sample (those between covered vertices
+// are carried by none), and the fit must give it its own point value, to the bit: before, samples
+// seen between two covered vertices fixed only sums of their values and left the grid's
+// chequerboard free (the 81 ceiling vertices over the panel read 0.014 RMS against the
+// reference's 0.0005, point sampling's 0.005). Four cells out from the sheet the field is linear
+// and the fit gives it back, to the ridge's 10⁻⁶.
+TEST(VertexFit, VerticesNoSampleSeesKeepTheirPointValuesUnderAPanel) {
+    constexpr float kHalf = 0.25f, kGap = 0.01f, kCell = 2.0f / 32;
+    // The sheet's front faces the floor, as a fixture's housing faces the ceiling it hangs from: a
+    // surface in front of the floor, which covers it only under the cover height (a back covers at any).
+    const Scene output = testscenes::plateUnderSheet(1.0f, 32, kHalf, 4, kGap, false, Vec3f(0.5f));
+    const std::optional<Scene> refined =
+        VertexFitStage::samplingMesh(output, Animation::still(output), std::vector<uint8_t>(output.instances.size(), 0), 0.05f, SIZE_MAX);
+    ASSERT_TRUE(refined);
+    const Scene& samples = *refined;
+    const uint32_t floorVertices = output.instances[0].vertexCount;
+    ASSERT_GT(samples.instances[0].vertexCount, floorVertices + 100) << "the floor round the sheet is refined";
+    auto under = [&](const Vec3f& p, float margin) { return std::max(std::fabs(p.x), std::fabs(p.z)) < kHalf - margin; };
+    // Lit outside the sheet, linearly; under it a faint, uneven light, as the gap lets in.
+    auto light = [&](const Vec3f& p) { return under(p, 1e-6f) ? 0.002f * (1.0f + 0.5f * std::sin(37.0f * p.x + 53.0f * p.z)) : 1.0f + 0.25f * p.x; };
+
+    const SecondPassRig rig(samples);
+    const std::vector<uint8_t> covered = FinalGather(FinalGather::kCoverRays, 7).castCovered(samples, rig.bvh, rig.starts);
+    std::vector<Vec3f> sampled(samples.vertexCount(), Vec3f(0.5f));  // the sheet: any constant
+    // Two cells in from the sheet's edge, where a ray escapes only within 5° of the horizon, the
+    // output's own vertices are covered, judged by the output's cover height (a quarter of its 8.8 cm
+    // diagonals) as a run without the fit judges them. The samples added between them keep their
+    // own, a quarter of their 2.2 cm edges, under which the sheet 1 cm up covers none of them.
+    size_t deepVertices = 0, deepCovered = 0;
+    for (uint32_t s = 0; s < samples.instances[0].vertexCount; ++s) {
+        sampled[s] = Vec3f(light(samples.positions[s]));
+        if (s >= floorVertices || !under(samples.positions[s], 2 * kCell)) continue;
+        ++deepVertices;
+        deepCovered += covered[s];
+    }
+    EXPECT_EQ(deepVertices, 3u * 3u);
+    EXPECT_EQ(deepCovered, deepVertices);
+
+    // The floor vertices that no weighed sample can lie on: covered, as is every vertex they share a triangle with.
+    std::vector<uint8_t> alone(floorVertices, 1);
+    for (uint32_t t = 0; t < output.instances[0].triangleCount; ++t) {
+        const Triangle& tri = output.triangles[t];
+        const bool allCovered = covered[tri.v[0]] && covered[tri.v[1]] && covered[tri.v[2]];
+        if (!allCovered)
+            for (uint32_t v : tri.v) alone[v] = 0;
+    }
+    VertexFit fit(output, samples);
+    VertexRadiosity fitted;
+    fit.fit(output, samples, sampled, covered, fitted);
+    size_t kept = 0, linear = 0;
+    for (uint32_t v = 0; v < floorVertices; ++v) {
+        const Vec3f& p = output.positions[v];
+        if (alone[v]) {
+            EXPECT_EQ(fitted.irradiance[v].x, light(p)) << "vertex " << v << " at " << p.x << ", " << p.z;
+            ++kept;
+        } else if (!under(p, -4 * kCell)) {  // four cells out: the samples round it and its neighbours' all on the linear field
+            EXPECT_NEAR(fitted.irradiance[v].x, 1.0f + 0.25f * p.x, 1e-4f) << "vertex " << v << " at " << p.x << ", " << p.z;
+            ++linear;
+        }
+    }
+    EXPECT_GE(kept, 9u);
+    EXPECT_GT(linear, 600u);
 }
 
 // A value the fit makes negative (a step of light the output's triangles cannot follow) is written

@@ -158,12 +158,28 @@ VertexFit::Report VertexFit::fit(const Scene& output, const Scene& samples, cons
             const double third = double(samples.triangleArea(t)) / 3;
             for (uint32_t v : samples.triangles[t].v) weight[v - mesh.firstSample] += third;
         }
-        double total = 0;
         for (uint32_t s = 0; s < mesh.sampleCount; ++s) {
             const uint32_t g = mesh.firstSample + s;
             if ((!unseen.empty() && unseen[g]) || samples.vertexHidden[g]) weight[s] = 0;
-            total += weight[s];
         }
+        // A sample between output vertices that are all unseen themselves (the samples are the
+        // output's own vertices first) has no vertex to carry it: the ceiling over a panel hung a
+        // centimetre below it, where the sampling mesh's finer triangles resolve the gap that the
+        // output's do not, so its midpoints are seen and its vertices covered. Weighed, those
+        // samples fix only sums of unseen values (a chequerboard of the grid's two halves is left
+        // free), and the solve swings the unknowns about. Unweighed, such a vertex has no sample
+        // and keeps its own value; a covered vertex beside a seen one (a floor vertex just inside
+        // a block's foot) still takes the seen part of its triangles from the samples there.
+        std::vector<uint8_t> outputSeen(mesh.outputCount);
+        for (uint32_t v = 0; v < mesh.outputCount; ++v) outputSeen[v] = weight[v] > 0;
+        for (uint32_t s = mesh.outputCount; s < mesh.sampleCount; ++s) {
+            const SamplePlace& p = mesh.place[s];
+            bool carried = false;
+            for (int k = 0; k < p.count; ++k) carried = carried || outputSeen[p.vertex[k]];
+            if (!carried) weight[s] = 0;
+        }
+        double total = 0;
+        for (uint32_t s = 0; s < mesh.sampleCount; ++s) total += weight[s];
 
         // Point values: each unknown's mean over its vertices' own samples.
         Eigen::MatrixX3d point = Eigen::MatrixX3d::Zero(mesh.unknowns, 3);
@@ -240,6 +256,17 @@ VertexFit::Report VertexFit::fit(const Scene& output, const Scene& samples, cons
                 if (fitted.allFinite()) x = fitted, solved = true;
             }
             if (!solved) ++report.pointFallbacks;
+            // An unknown no weighed sample lies on keeps its point value, to the bit. With λ = 0
+            // its row is the ridge's alone, so the solve gives that value to rounding; with λ > 0
+            // the hinges continue the seen field into it (TheRegulariserContinues…) instead.
+            if (smoothing_ == 0) {
+                std::vector<uint8_t> weighed(mesh.unknowns, 0);
+                for (uint32_t s = 0; s < mesh.sampleCount; ++s)
+                    if (weight[s] > 0)
+                        for (int k = 0; k < mesh.place[s].count; ++k) weighed[mesh.unknownOf[mesh.place[s].vertex[k]]] = 1;
+                for (uint32_t u = 0; u < mesh.unknowns; ++u)
+                    if (!weighed[u]) x.row(u) = point.row(u);
+            }
         }
         for (uint32_t v = 0; v < mesh.outputCount; ++v) {
             const uint32_t g = mesh.firstOutput + v;

@@ -17,7 +17,11 @@
 // direct light, the gather, incremental frames) as any mesh is. w_s is a third of the area of the
 // sampling triangles round s (the lumped quadrature of ∫ (g − E)²), and 0 for a sample that is hidden or
 // covered (inside or under closed geometry: FinalGather's rule), so the floor under a block's foot
-// has no say and its vertices take whatever values make their visible triangles right.
+// has no say and its vertices take whatever values make their visible triangles right. A sample
+// all of whose output vertices are unseen has no weight either: none of them can carry it (the
+// ceiling over a fixture hung a centimetre below, covered at the output's vertices, seen at the
+// finer samples between), and weighed it would fix only sums of unseen values. An unknown no
+// weighed sample lies on keeps its point value (issue 60).
 // J_e is the jump of g's gradient across a hinge — an edge shared by two triangles of the same
 // unknowns whose normals are within 45° — with the two triangles unfolded into one plane, w_e the
 // hinges' area over 3 times their mean height squared (so that λ weighs a gradient's jump as the

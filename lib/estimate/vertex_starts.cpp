@@ -91,6 +91,14 @@ bool acceptable(const StartProbe& probe, double offset) { return !probe.inside &
 
 }  // namespace
 
+double longestIncidentEdge(const Scene& scene, const MeshTopology& topology, uint32_t v) {
+    const Vec3d p(scene.positions[v]);
+    double longest = 0;
+    for (const uint32_t* it = topology.trianglesBegin(v); it != topology.trianglesEnd(v); ++it)
+        for (uint32_t c : scene.triangles[*it].v) longest = std::max(longest, length(Vec3d(scene.positions[c]) - p));
+    return longest;
+}
+
 VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTopology& topology,
                            const std::vector<Vec3f>& frontNormals, uint32_t v) {
     VertexStart out;
@@ -100,7 +108,8 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
     // n_v, and those that stand up from v's tangent plane (cosine below kLeastCosine: the wall at
     // a floor vertex's foot, where the floor and the wall meet with split normals), which the lift
     // along n_v alone would not clear.
-    double longest = 0, leastCosine = 1, facingArea = 0;
+    const double longest = longestIncidentEdge(scene, topology, v);
+    double leastCosine = 1, facingArea = 0;
     Vec3d awayFromWalls(0.0), facingCentroid(0.0);
     const Vec3d unit = normalize(n);
     const uint32_t self = topology.weldedId(v);
@@ -108,7 +117,6 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
     for (const uint32_t* it = topology.trianglesBegin(v); it != topology.trianglesEnd(v); ++it) {
         Vec3d centroid(0.0);
         for (uint32_t c : scene.triangles[*it].v) {
-            longest = std::max(longest, length(Vec3d(scene.positions[c]) - p));
             centroid += Vec3d(scene.positions[c]) / 3.0;
             if (topology.weldedId(c) != self) edges.add(topology.weldedId(c));
         }
@@ -129,7 +137,8 @@ VertexStart vertexRayStart(const Scene& scene, const SceneBvh& bvh, const MeshTo
     double offset = magnitude * kOffsetScale / std::max(leastCosine, kLeastCosine);
     if (!(offset > 0)) offset = double(scene.sceneEpsilon());  // a lone vertex at the origin
     out.offset = float(offset);
-    out.coverHeight = float(0.25 * longest);
+    // A sampling mesh judges a gap by the resolution of the mesh it samples (Scene::coverEdges).
+    out.coverHeight = float(0.25 * (scene.coverEdges.empty() ? longest : std::max(longest, double(scene.coverEdges[v]))));
     Vec3d lifted = p + n * offset;
     if (scene.vertexHidden[v]) {
         out.point = Vec3f(lifted);

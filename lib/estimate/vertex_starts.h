@@ -29,12 +29,17 @@ class MeshTopology;
 
 // One vertex's start: the point, the offset δ_v it was made with, and the height under which
 // a surface in front of v covers it (FinalGather's covered-vertex rule): a quarter of v's
-// longest incident edge, what v's own mesh cannot resolve.
+// longest incident edge, what v's own mesh cannot resolve (at an output vertex in a sampling mesh,
+// of its edge on the output mesh: Scene::coverEdges).
 struct VertexStart {
     Vec3f point{0.0f};
     float offset = 0;
     float coverHeight = 0;
 };
+
+// The longest edge of the triangles at v's position (welded), in the current pose: the size of
+// surface detail v's mesh resolves, of which the cover height is a quarter.
+double longestIncidentEdge(const Scene& scene, const MeshTopology& topology, uint32_t v);
 
 // The rule for vertex v in the scene's current pose (bvh holds it). frontNormals:
 // Scene::frontFaceNormals(). Depends on nothing but the geometry within kReachOffsets·offset of v.

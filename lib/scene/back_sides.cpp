@@ -94,6 +94,7 @@ void addBackSides(Scene& scene, const std::vector<uint8_t>& which) {
             scene.positions.push_back(scene.positions[v]);
             scene.normals.push_back(-scene.normals[v]);
             scene.vertexHidden.push_back(scene.vertexHidden[v]);
+            if (!scene.coverEdges.empty()) scene.coverEdges.push_back(scene.coverEdges[v]);
             scene.vertexMaterial.push_back(material);
             for (std::vector<TexCoord>& set : scene.vertexTexCoords) set.push_back(set[v]);
             if (!scene.vertexColours.empty()) scene.vertexColours.push_back(scene.vertexColours[v]);

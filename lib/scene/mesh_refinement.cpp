@@ -316,6 +316,7 @@ RefinementReport storeRefined(Scene& scene, std::vector<InstanceRefiner>& refine
     scene.positions.clear();
     scene.normals.clear();
     scene.vertexHidden.clear();
+    scene.coverEdges.clear();  // a sampling mesh refined again samples its own resolution
     scene.vertexMaterial.clear();
     for (std::vector<TexCoord>& set : scene.vertexTexCoords) set.clear();
     scene.vertexColours.clear();

@@ -365,6 +365,7 @@ void Scene::addInstance(int node, std::vector<Vec3f> objectPositions, std::vecto
     positions.resize(positions.size() + inst.vertexCount);
     normals.resize(normals.size() + inst.vertexCount, Vec3f(0.0f));
     vertexHidden.resize(vertexHidden.size() + inst.vertexCount, 0);
+    if (!coverEdges.empty()) coverEdges.resize(positions.size(), 0.0f);
     vertexMaterial.resize(vertexMaterial.size() + inst.vertexCount, material);
     for (std::vector<TexCoord>& set : vertexTexCoords) set.resize(positions.size());
     if (!vertexColours.empty()) vertexColours.resize(positions.size(), Rgba{1, 1, 1, 1});

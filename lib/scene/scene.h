@@ -189,6 +189,12 @@ struct Scene {
     // singular blend puts it. Hidden vertices keep their last finite normal and carry radiosity 0
     // (computeRadiosity).
     std::vector<uint8_t> vertexHidden;
+    // A sampling mesh's (the vertex fit's, lib/pipeline/vertex_fit_stage.h), else empty: at each of
+    // the output's own vertices, its longest incident edge on the output mesh (rest pose); 0 at the
+    // samples added between them. The covered-vertex rule (VertexStarts' cover height) judges the
+    // output's vertices by it, as a run without the fit does, and the added samples by their own
+    // finer edges: a gap the output cannot resolve covers its vertices, not the samples between.
+    std::vector<float> coverEdges;
 
     // The back sides of doubleSided surfaces (issue 57; lib/scene/back_sides.h): each such instance
     // has a copy with reversed winding and negated normals, appended after every instance of the
