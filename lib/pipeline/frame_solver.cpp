@@ -114,6 +114,12 @@ void FrameSolver::dropTracking() {
 }
 
 FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
+    PoseChange change = changeTo(target);
+    if (change.any) bvh_.updateDynamic(scene_);
+    return change;
+}
+
+FrameSolver::PoseChange FrameSolver::changeTo(const Pose& target) {
     PoseChange change;
     // Only instances the animation moves can move: keep their positions to compare with.
     previousPositions_.resize(scene_.vertexCount());
@@ -154,8 +160,28 @@ FrameSolver::PoseChange FrameSolver::pose(const Pose& target) {
         change.newBounds.push_back(after);
     }
     std::sort(change.movedTriangles.begin(), change.movedTriangles.end());
-    if (change.any) bvh_.updateDynamic(scene_);
     return change;
+}
+
+double FrameSolver::foreseenUpdateShare(const Pose& current) {
+    decision_.shares.clear();
+    for (const auto& [from, to] : lookAhead_) {
+        changeTo(from);
+        const PoseChange change = changeTo(to);
+        if (!change.any) {
+            decision_.shares.push_back(0);
+            continue;
+        }
+        // The vertices that moved are recomputed at least; the disc regions a move changes
+        // beside them are not known without computing them, so the count is a lower bound.
+        const size_t moved = size_t(std::count(change.vertexMoved.begin(), change.vertexMoved.end(), uint8_t(1)));
+        decision_.shares.push_back(predictedUpdateShare(change, moved) - trackingBuildShare());
+    }
+    changeTo(current);  // the same pose, the same bits: the BVH was never moved from it
+    std::vector<double> sorted = decision_.shares;
+    std::sort(sorted.begin(), sorted.end());
+    decision_.median = sorted.empty() ? 0 : sorted[sorted.size() / 2];
+    return decision_.median;
 }
 
 double FrameSolver::trackingBuildShare() const {
@@ -236,8 +262,20 @@ FrameSolver::Solution FrameSolver::solve(const Pose& target, bool updateFollows)
         if (firstFrame && updatesMayFollow) {
             const TrackingLayout layout = trackingLayout();
             EnvelopeTails tails{layout.envelope, layout.extension, {}};
-            solveFromScratch(false, record, &tails);
-            startTracking(record, &tails, record.segments);
+            // With steps to judge, the cache is kept until they are: it is what they are judged from.
+            const bool judged = !lookAhead_.empty() && !settings_.update.alwaysUpdate;
+            solveFromScratch(judged, record, &tails);
+            if (judged) {
+                Stopwatch clock;
+                const bool track = foreseenUpdateShare(target) <= kWorthUpdatingBelow;
+                decision_.decision = track ? "track" : "retrace";
+                record.predictedUpdateShare = decision_.median;
+                record.photonSimulationSeconds += clock.seconds();
+                if (track) startTracking(record, &tails, record.segments);
+            } else {
+                decision_ = {"track", {}, 0};
+                startTracking(record, &tails, record.segments);
+            }
         } else {
             solveFromScratch(updatesMayFollow, record);
         }

@@ -8,6 +8,8 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "estimate/disc_regions.h"
@@ -73,6 +75,21 @@ public:
     // The next solve starts from scratch, disc regions included.
     void reset();
 
+    // Frame 0's decision whether to build the tracking state (issue 60): `steps` are a few pairs
+    // of consecutive poses sampled over the frames to come. The first frame solved from scratch
+    // with updates to follow predicts, from its own photons, what updating each step would cost
+    // (predictedUpdateShare, less the build that frame pays anyway); it builds the tracking state
+    // only if the median step would be updated, and otherwise keeps its cache as a frame that
+    // fell back does. No steps: it tracks whenever updates may follow.
+    void lookAhead(std::vector<std::pair<Pose, Pose>> steps) { lookAhead_ = std::move(steps); }
+    struct TrackingDecision {
+        std::string decision;        // "track", "retrace", or "" (no frame was judged)
+        std::vector<double> shares;  // predicted update share of each step, in order
+        double median = 0;
+    };
+    // The last first-frame decision (empty before one is made).
+    const TrackingDecision& trackingDecision() const { return decision_; }
+
     // Told what a solve is doing, for a progress display: the stage ("regions", "tracing",
     // "estimating", "tracking", "retracing", "updating") and, where known, how far it is (done of
     // total; total 0 when unknown). Called from the solving thread, and from worker threads a few
@@ -117,7 +134,12 @@ private:
         std::vector<uint32_t> movedTriangles;
         bool any = false;
     };
+    // Poses the scene (and its BVH) as `target` shows it; changeTo poses the scene alone.
     PoseChange pose(const Pose& target);
+    PoseChange changeTo(const Pose& target);
+    // The median over lookAhead_'s steps of what updating them would cost from this frame's kept
+    // cache, without the tracking build (decision_ records each); the scene is left posed as `current`.
+    double foreseenUpdateShare(const Pose& current);
     // Why this frame cannot or should not be updated (None: update it), and the prediction it
     // judged by (0 where none was made). `recomputed`: the vertices the estimator would recompute.
     struct Verdict {
@@ -180,6 +202,8 @@ private:
     // Of the segments, the share the last tracking build tracked: what a build after a fallback
     // will cost, before it is made.
     double trackedShare_ = 1;
+    std::vector<std::pair<Pose, Pose>> lookAhead_;
+    TrackingDecision decision_;
     VertexRadiosity result_;
 };
 

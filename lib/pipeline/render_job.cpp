@@ -72,6 +72,20 @@ Camera resolveCamera(const RenderSettings& s, const Scene& scene, Warnings& warn
 }  // namespace
 
 namespace {
+// Frame 0's look ahead (FrameSolver::lookAhead): up to four steps between consecutive frames,
+// evenly spread over the frames after `first` up to `last`, so that a mover that pauses or turns
+// is judged by most of its path, not its first step.
+std::vector<std::pair<Pose, Pose>> sampledSteps(const Animation& animation, int first, int last) {
+    constexpr int kSteps = 4;
+    std::vector<std::pair<Pose, Pose>> steps;
+    const int count = last - first;  // steps first→first+1 … last−1→last
+    for (int k = 0; k < std::min(kSteps, count); ++k) {
+        const int from = first + int((int64_t(k) * count) / std::min(kSteps, count));
+        steps.emplace_back(animation.poseAt(from), animation.poseAt(from + 1));
+    }
+    return steps;
+}
+
 // The memory a rendered triangle takes at least (issue 48): the scene's arrays (16 bytes a
 // triangle, about 60 a vertex, half a vertex a triangle), the BVH (about 64) and the second pass's
 // per-vertex state (the gather's 16 kept probes, 256 bytes a vertex). A refinement that would make
@@ -392,6 +406,7 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
     };
     const FrameSolver& frames = solver.frameSolver();
     solver.frameSolver().reportStagesTo(stage);
+    solver.frameSolver().lookAhead(sampledSteps(animation_, start, last_));
     const double setupSeconds = started_.seconds();
     for (int frame = start; frame <= last_; ++frame) {
         current = frame;
@@ -410,6 +425,12 @@ RunOutcome RenderJob::run(const RunObserver& observer) {
             log.setup = {{"before_first_frame_s", setupSeconds},
                          {"aimed_lights", lights.aimedLights()},
                          {"aim_s", lights.aimSeconds()}};
+            const FrameSolver::TrackingDecision& tracking = frames.trackingDecision();
+            if (!tracking.decision.empty())
+                log.setup["tracking"] = {{"decision", tracking.decision},
+                                         {"steps_judged", tracking.shares.size()},
+                                         {"predicted_update_shares", tracking.shares},
+                                         {"median_share", tracking.median}};
             if (const DirectLight* direct = frames.directLight())
                 log.setup["light_tree"] = {{"emitters", direct->sampledEmitters()},
                                            {"lights_sampled", direct->lightsSampled()},
