@@ -642,17 +642,23 @@ TEST(Incremental, AChangeTooLargeToUpdateFallsBackToScratchWithTheSameBytes) {
     });
 }
 
+// A plate under the light that nearly every photon meets, sliding across the floor.
+AnimatedScene sweepingPanel() {
+    return {"sweeping panel",
+            [] {
+                Scene s = testscenes::plateOverFloor(12, 0.7f, 0.8f, Vec3f(0.7f));
+                testscenes::addPointLight(s, Vec3f(0.0f, 1.5f, 0.0f), Vec3f(10.0f));
+                return s;
+            },
+            "Plate", [](int f) { return Vec3d(-0.6 + 0.3 * f, 0.0, 0.0); }, 5};
+}
+
 // The sweeping panel (issue 34): a plate under the light that nearly every photon meets slides
 // across the floor, so nearly every path changes every frame. The solver sees this from counts,
 // before it traces anything again, computes every frame from scratch (never paying for an update
 // and a fallback both), and gives --full-recompute's bytes.
 TEST(Incremental, APanelSweepingUnderTheLightFallsBackEveryFrameFromCountsAlone) {
-    AnimatedScene a{"sweeping panel", [] {
-                        Scene s = testscenes::plateOverFloor(12, 0.7f, 0.8f, Vec3f(0.7f));
-                        testscenes::addPointLight(s, Vec3f(0.0f, 1.5f, 0.0f), Vec3f(10.0f));
-                        return s;
-                    },
-                    "Plate", [](int f) { return Vec3d(-0.6 + 0.3 * f, 0.0, 0.0); }, 5};
+    const AnimatedScene a = sweepingPanel();
     expectAutomaticEqualsFull(a, [](int f, const FrameTiming& wi) {
         EXPECT_TRUE(wi.fromScratch) << "frame " << f;
         EXPECT_EQ(wi.fromScratchReason, f == 0 ? "" : "change-too-large") << "frame " << f;
@@ -670,12 +676,7 @@ TEST(Incremental, APanelSweepingUnderTheLightFallsBackEveryFrameFromCountsAlone)
 // builds no tracking state (none is ever built), every frame is computed from scratch, and the
 // bytes are --full-recompute's.
 TEST(Incremental, AMoverCrossingTheSceneIsJudgedAtFrameZeroAndNothingIsTracked) {
-    AnimatedScene a{"sweeping panel", [] {
-                        Scene s = testscenes::plateOverFloor(12, 0.7f, 0.8f, Vec3f(0.7f));
-                        testscenes::addPointLight(s, Vec3f(0.0f, 1.5f, 0.0f), Vec3f(10.0f));
-                        return s;
-                    },
-                    "Plate", [](int f) { return Vec3d(-0.6 + 0.3 * f, 0.0, 0.0); }, 5};
+    const AnimatedScene a = sweepingPanel();
     expectAutomaticEqualsFull(
         a,
         [](int f, const FrameTiming& wi) {
