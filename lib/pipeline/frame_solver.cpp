@@ -5,9 +5,11 @@
 #endif
 
 #include <algorithm>
-#include <atomic>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
+
+#include <tbb/parallel_for.h>
 
 #include "util/stopwatch.h"
 
@@ -163,19 +165,27 @@ FrameSolver::PoseChange FrameSolver::changeTo(const Pose& target) {
     return change;
 }
 
-double FrameSolver::foreseenUpdateShare(const Pose& current) {
+double FrameSolver::foreseenUpdateShare(const Pose& current, const EnvelopeTails& tails, uint64_t segments) {
     decision_.shares.clear();
     for (const auto& [from, to] : lookAhead_) {
         changeTo(from);
         const PoseChange change = changeTo(to);
-        if (!change.any) {
-            decision_.shares.push_back(0);
-            continue;
+        // A segment that meets no part of the envelope can neither impact a mover nor pass
+        // through one in any frame: the tails hold every segment the count can find.
+        AffectedCount affected;
+        if (change.any) {
+            std::mutex sum;
+            tbb::parallel_for(size_t(0), tails.blocks.size(), [&](size_t b) {
+                const AffectedCount counted = countAffected(tails.blocks[b], change);
+                const std::lock_guard<std::mutex> lock(sum);
+                affected.listed += counted.listed;
+                affected.nearMovers += counted.nearMovers;
+            });
         }
         // The vertices that moved are recomputed at least; the disc regions a move changes
         // beside them are not known without computing them, so the count is a lower bound.
         const size_t moved = size_t(std::count(change.vertexMoved.begin(), change.vertexMoved.end(), uint8_t(1)));
-        decision_.shares.push_back(predictedUpdateShare(change, moved) - trackingBuildShare());
+        decision_.shares.push_back(updateShare(affected, segments, moved));
     }
     changeTo(current);  // the same pose, the same bits: the BVH was never moved from it
     std::vector<double> sorted = decision_.shares;
@@ -193,32 +203,40 @@ double FrameSolver::predictedUpdateShare(const PoseChange& change, size_t recomp
     // new bounds (rule b's candidates): from the index once tracking (the entries of the cells
     // the new bounds overlap, a bound on the candidates), counted in the last frame's cache
     // before (a scan, far cheaper than either way of computing the frame).
-    uint64_t listed = 0, nearMovers = 0, segments = 0;
+    AffectedCount affected;
+    uint64_t segments = 0;
     if (mode_ == Mode::Tracking) {
-        listed = tracked_->segmentsListedOn(change.movedTriangles);
-        nearMovers = tracked_->entriesNear(change.newBounds);
+        affected.listed = tracked_->segmentsListedOn(change.movedTriangles);
+        affected.nearMovers = tracked_->entriesNear(change.newBounds);
         segments = foldedSegments_ + tracked_->trackedSegments();
     } else {
-        const RayCache& cache = *lastCache_;
-        segments = cache.segmentCount();
-        std::atomic<uint64_t> onMoved{0}, near{0};
-        cache.forEachBlock([&](size_t, const std::vector<Segment>& block) {
-            uint64_t n = 0, m = 0;
-            for (const Segment& s : block) {
-                n += s.hasImpact() && s.impactDynamic && change.triangleMoved[s.triangle];
-                m += rayMeetsAny(change.newBounds, s.origin, s.direction, double(s.length));
-            }
-            onMoved += n;
-            near += m;
+        segments = lastCache_->segmentCount();
+        std::mutex sum;
+        lastCache_->forEachBlock([&](size_t, const std::vector<Segment>& block) {
+            const AffectedCount counted = countAffected(block, change);
+            const std::lock_guard<std::mutex> lock(sum);
+            affected.listed += counted.listed;
+            affected.nearMovers += counted.nearMovers;
         });
-        listed = onMoved.load();
-        nearMovers = near.load();
     }
+    return updateShare(affected, segments, recomputed) + trackingBuildShare();
+}
+
+FrameSolver::AffectedCount FrameSolver::countAffected(const std::vector<Segment>& block, const PoseChange& change) {
+    AffectedCount counted;
+    for (const Segment& s : block) {
+        counted.listed += s.hasImpact() && s.impactDynamic && change.triangleMoved[s.triangle];
+        counted.nearMovers += rayMeetsAny(change.newBounds, s.origin, s.direction, double(s.length));
+    }
+    return counted;
+}
+
+double FrameSolver::updateShare(const AffectedCount& affected, uint64_t segments, size_t recomputed) const {
     const double perSegment = 1.0 / double(std::max<uint64_t>(segments, 1));
-    const double segmentShare = double(listed) * kSegmentsPerListedImpact * kRemoveAndAdd * perSegment +
-                                double(nearMovers) * kBlockingCandidate * perSegment;
+    const double segmentShare = double(affected.listed) * kSegmentsPerListedImpact * kRemoveAndAdd * perSegment +
+                                double(affected.nearMovers) * kBlockingCandidate * perSegment;
     const double vertexShare = double(recomputed) * kRecomputedVertex / double(std::max<size_t>(scene_.vertexCount(), 1));
-    return segmentShare + vertexShare + trackingBuildShare();
+    return segmentShare + vertexShare;
 }
 
 FrameSolver::Verdict FrameSolver::judge(const PoseChange& change, size_t recomputed) const {
@@ -262,16 +280,21 @@ FrameSolver::Solution FrameSolver::solve(const Pose& target, bool updateFollows)
         if (firstFrame && updatesMayFollow) {
             const TrackingLayout layout = trackingLayout();
             EnvelopeTails tails{layout.envelope, layout.extension, {}};
-            // With steps to judge, the cache is kept until they are: it is what they are judged from.
+            // The steps are judged from the tails, before the tracking state is built from them.
+            // Judged not worth it, the cache is kept instead, as after a fallback: the frames
+            // after are judged from it, and one worth updating builds the state then.
             const bool judged = !lookAhead_.empty() && !settings_.update.alwaysUpdate;
             solveFromScratch(judged, record, &tails);
             if (judged) {
                 Stopwatch clock;
-                const bool track = foreseenUpdateShare(target) <= kWorthUpdatingBelow;
+                const bool track = foreseenUpdateShare(target, tails, record.segments) <= kWorthUpdatingBelow;
                 decision_.decision = track ? "track" : "retrace";
                 record.predictedUpdateShare = decision_.median;
                 record.photonSimulationSeconds += clock.seconds();
-                if (track) startTracking(record, &tails, record.segments);
+                if (track) {
+                    lastCache_.reset();  // not held beside the tracking state while it is built
+                    startTracking(record, &tails, record.segments);
+                }
             } else {
                 decision_ = {"track", {}, 0};
                 startTracking(record, &tails, record.segments);

@@ -137,9 +137,10 @@ private:
     // Poses the scene (and its BVH) as `target` shows it; changeTo poses the scene alone.
     PoseChange pose(const Pose& target);
     PoseChange changeTo(const Pose& target);
-    // The median over lookAhead_'s steps of what updating them would cost from this frame's kept
-    // cache, without the tracking build (decision_ records each); the scene is left posed as `current`.
-    double foreseenUpdateShare(const Pose& current);
+    // The median over lookAhead_'s steps of what updating them would cost, counted in this frame's
+    // tails (its trace's `segments` in all), without the tracking build (decision_ records each);
+    // the scene is left posed as `current`.
+    double foreseenUpdateShare(const Pose& current, const EnvelopeTails& tails, uint64_t segments);
     // Why this frame cannot or should not be updated (None: update it), and the prediction it
     // judged by (0 where none was made). `recomputed`: the vertices the estimator would recompute.
     struct Verdict {
@@ -151,6 +152,15 @@ private:
     // counts alone (timing.json's predicted_update_share): the update's own work and, when the
     // last frame was solved from scratch, the tracking state it must build first.
     double predictedUpdateShare(const PoseChange& change, size_t recomputed) const;
+    // Of a block of segments, those that impacted a triangle `change` moves (rule a) and those
+    // passing through a mover's new bounds (rule b's candidates).
+    struct AffectedCount {
+        uint64_t listed = 0, nearMovers = 0;
+    };
+    static AffectedCount countAffected(const std::vector<Segment>& block, const PoseChange& change);
+    // What updating costs, as a share of a frame from scratch, for the counts of `segments` in all
+    // and `recomputed` vertices: predictedUpdateShare without the tracking build.
+    double updateShare(const AffectedCount& affected, uint64_t segments, size_t recomputed) const;
     // The share of a from-scratch frame that building the tracking state costs.
     double trackingBuildShare() const;
     // keepCache: a frame may update from this one (its cache is kept for the tracked paths).
