@@ -20,8 +20,9 @@ uint16_t quantised(float b) { return roundToUint16(std::clamp(b, 0.0f, 1.0f) * k
 // decoding: the decoded direction is the one cast, whenever the ray is cast.
 float signNotZero(float x) { return x < 0 ? -1.0f : 1.0f; }
 void encodeOctahedral(const Vec3f& d, uint16_t& u, uint16_t& v) {
-    const float l1 = std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z);
-    float px = d.x / l1, py = d.y / l1;
+    // Any length: the L1 norm divides it out (the gather's directions come unnormalised).
+    const float inverseL1 = 1.0f / (std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z));
+    float px = d.x * inverseL1, py = d.y * inverseL1;
     if (d.z < 0) {
         const float qx = (1 - std::fabs(py)) * signNotZero(px), qy = (1 - std::fabs(px)) * signNotZero(py);
         px = qx;
@@ -53,12 +54,14 @@ public:
     Directions(const VertexSamples& numbers, const Vec3f& n) : radius_(numbers.dimension(0)), angle_(numbers.dimension(1)), n_(n) {
         orthonormalBasis(n_, t_, b_);
     }
-    // Cosine-weighted about n_v (pdf cosθ/π), as cosineHemisphere.
+    // Cosine-weighted about n_v (pdf cosθ/π), as cosineHemisphere; of length 1 up to rounding and
+    // not normalised: the octahedral encoding it goes to divides by its L1 norm, and the decoded
+    // direction cast is normalised once, there.
     Vec3f operator()(uint32_t ray) const {
         const float u0 = radius_.uniform(ray), u1 = angle_.uniform(ray);
         const float r = std::sqrt(u0), phi = 2 * kPi * u1;
         const float z = std::sqrt(std::max(0.0f, 1 - u0));
-        return normalize(t_ * (r * std::cos(phi)) + b_ * (r * std::sin(phi)) + n_ * z);
+        return t_ * (r * std::cos(phi)) + b_ * (r * std::sin(phi)) + n_ * z;
     }
 
 private:
