@@ -8,11 +8,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "estimate/direct_light.h"
 #include "estimate/disc_regions.h"
 #include "estimate/vertex_starts.h"
+#include "scene/environment_light.h"
 #include "test_support.h"
 #include "trace/scene_bvh.h"
 
@@ -321,4 +323,49 @@ TEST(DirectLight, ParallelRectangularEmitterMatchesTheConfigurationFactor) {
     rmsAt(4096);
     EXPECT_LT(rms64, rms4 / 4) << "the error does not fall with the sample count";
     std::printf("rectangle: %.2f s\n", seconds(start));
+}
+
+// A later frame finds the vertices whose shadow rays meet a mover's bounds (raysMeeting). The cone
+// cull rules vertices out without making their rays; it must find exactly the vertices that making
+// every vertex's rays finds, for finite emitters (lamps and point and spot lights, some under the
+// floor), directional lights and an environment, boxes anywhere from a few centimetres to most of
+// the scene. On the lamps alone a 10 cm box leaves most vertices' rays unmade.
+TEST(DirectLight, TheConeCullFindsTheVerticesMakingEveryRayFinds) {
+    for (const int lighting : {0, 1, 2}) {
+        SCOPED_TRACE(lighting == 0 ? "lamps and lights" : lighting == 1 ? "lamps and two directional lights" : "lamps under a sky");
+        Scene scene = testscenes::lampsOverBlocks(24, 12, lighting == 0 ? 8 : 0, 5);
+        if (lighting == 1) {
+            scene.lights.push_back(light(scene, LightType::Directional, {0, 0, 0}, normalize(Vec3f(0.3f, -1.0f, 0.2f)), Vec3f(1.0f)));
+            scene.lights.push_back(light(scene, LightType::Directional, {0, 0, 0}, normalize(Vec3f(-0.5f, -1.0f, -0.1f)), Vec3f(0.5f)));
+        }
+        if (lighting == 2) scene.environment = std::make_shared<const EnvironmentLight>(EnvironmentLight::uniform(Vec3f(0.3f)));
+        const Rig rig(scene);
+        DirectLight direct(8, 7);
+        direct.computeAll(scene, rig.bvh, rig.starts);
+        const Bounds3f sceneBounds = scene.bounds();
+        const Vec3f lower = sceneBounds.lower, extent = sceneBounds.upper - sceneBounds.lower;
+        uint64_t state = 11;
+        auto uniform = [&] {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            return float(state >> 40) / float(1u << 24);
+        };
+        for (const float size : {0.1f, 0.5f, 2.0f}) {
+            for (int k = 0; k < 6; ++k) {
+                const Vec3f centre = lower + Vec3f(uniform() * extent.x, uniform() * extent.y, uniform() * extent.z);
+                Bounds3f box;
+                box.extend(centre - Vec3f(0.5f * size));
+                box.extend(centre + Vec3f(0.5f * size));
+                uint64_t culledDerived = 0, allDerived = 0;
+                const std::vector<uint32_t> culled =
+                    direct.raysMeeting(scene, rig.starts, {box}, DirectLight::ShadowCull::ByCone, &culledDerived);
+                const std::vector<uint32_t> all = direct.raysMeeting(scene, rig.starts, {box}, DirectLight::ShadowCull::None, &allDerived);
+                EXPECT_EQ(culled, all) << "a " << size << " m box at " << centre.x << ", " << centre.y << ", " << centre.z;
+                EXPECT_EQ(allDerived, scene.vertexCount());
+                EXPECT_GE(culledDerived, all.size());
+                if (lighting == 0 && size == 0.1f) {
+                    EXPECT_LT(double(culledDerived), 0.5 * double(scene.vertexCount())) << "a 10 cm box at " << centre.x << ", " << centre.y;
+                }
+            }
+        }
+    }
 }

@@ -76,8 +76,71 @@ void DirectLight::readEmitters(const Scene& scene) {
                                   : LightBounds::point(l.position, intensity));
         }
     tree_ = LightTree(bounds);
+    // Where shadow rays can go, for raysMeeting's cull: to the tree's emitters, to the point and
+    // spot lights that have a ray each, along the directional lights' directions, and toward the
+    // environment anywhere above v's tangent plane.
+    towardDirectional_.clear();
+    ownRayLights_.clear();
+    reachScale_ = 1;
+    for (const PunctualLight& l : scene.lights) {
+        if (l.type == LightType::Directional) {
+            towardDirectional_.push_back(-Vec3d(l.direction));
+            continue;
+        }
+        reachScale_ = std::max(reachScale_, length(Vec3d(l.position)));
+        if (!lightsSampled_) ownRayLights_.push_back(Vec3d(l.position));
+    }
+    for (const Emitter& e : emitters_)
+        for (const Vec3d& c : e.corner) reachScale_ = std::max(reachScale_, length(c));
+    environmentRays_ = scene.environment && samples_ > 0;
     emittersRead_ = true;
     treeSeconds_ = clock.seconds();
+}
+
+namespace {
+// Whether a segment from `start` to a point of the ball `lights` can pass through the ball `box`:
+// it lies in the cone from `start` that holds `lights`, no further than its far side, and the
+// box's ball meets that cone if the angle between their axes is at most the sum of their
+// half-angles (compared as cosines: the sum is at most π).
+bool coneMeets(const Vec3d& start, const Vec3d& lightsCentre, double lightsRadius, const Vec3d& boxCentre, double boxRadius) {
+    const Vec3d towardBox = boxCentre - start, towardLights = lightsCentre - start;
+    const double boxDistance = length(towardBox), lightDistance = length(towardLights);
+    if (boxDistance <= boxRadius || lightDistance <= lightsRadius) return true;
+    if (boxDistance - boxRadius > lightDistance + lightsRadius) return false;
+    const double sinLights = lightsRadius / lightDistance, sinBox = boxRadius / boxDistance;
+    const double cosSum = std::sqrt(1 - sinLights * sinLights) * std::sqrt(1 - sinBox * sinBox) - sinLights * sinBox;
+    return dot(towardLights, towardBox) >= cosSum * lightDistance * boxDistance;
+}
+}  // namespace
+
+bool DirectLight::mayMeet(const Vec3d& start, const Vec3d& p, const Vec3d& n, const Ball& box) const {
+    const Vec3d towardBox = box.centre - start;
+    if (length(towardBox) <= box.radius) return true;
+    // The environment's rays: anywhere above the tangent plane.
+    if (environmentRays_ && dot(towardBox, n) > -box.radius) return true;
+    // A directional light's ray: the half-line from the start.
+    for (const Vec3d& w : towardDirectional_) {
+        const double along = dot(towardBox, w);
+        if (along >= -box.radius && length(towardBox - w * std::max(along, 0.0)) <= box.radius) return true;
+    }
+    for (const Vec3d& light : ownRayLights_)
+        if (coneMeets(start, light, 0.0, box.centre, box.radius)) return true;
+    // The tree's emitters: down every node a sample can reach from (p, n) (importance above 0, as
+    // LightTree::sample descends) whose box's ball the box's cone meets, to a leaf or a panel.
+    if (tree_.empty()) return false;
+    std::vector<uint32_t> stack = {0};
+    while (!stack.empty()) {
+        const LightTree::Node& node = tree_.node(stack.back());
+        const uint32_t index = stack.back();
+        stack.pop_back();
+        if (!(node.bounds.importance(p, n) > 0) && tree_.nodeCount() > 1) continue;
+        const Vec3d lower(node.bounds.box.lower), upper(node.bounds.box.upper);
+        if (!coneMeets(start, (lower + upper) * 0.5, 0.5 * length(upper - lower), box.centre, box.radius)) continue;
+        if (node.leaf() || node.panel) return true;
+        stack.push_back(index + 1);
+        stack.push_back(uint32_t(node.second));
+    }
+    return false;
 }
 
 template <class Visit>
@@ -263,13 +326,28 @@ void DirectLight::recompute(const Scene& scene, const SceneBvh& bvh, const Verte
     raysCast_ = rays.load();
 }
 
-std::vector<uint32_t> DirectLight::raysMeeting(const Scene& scene, const VertexStarts& starts,
-                                               const std::vector<Bounds3f>& boxes) const {
+std::vector<uint32_t> DirectLight::raysMeeting(const Scene& scene, const VertexStarts& starts, const std::vector<Bounds3f>& boxes,
+                                               ShadowCull cull, uint64_t* derived) const {
     std::vector<uint8_t> meets(scene.vertexCount(), 0);
     if (boxes.empty()) return {};
+    // Each box's ball, padded far beyond a shadow ray's rounding (its float direction and length
+    // are a few ulps off the double segment): no ray the exact test would take is culled.
+    std::vector<Ball> balls;
+    for (const Bounds3f& box : boxes) {
+        const Vec3d lower(box.lower), upper(box.upper);
+        const double scale = std::max({length(lower), length(upper), reachScale_});
+        balls.push_back({(lower + upper) * 0.5, 0.5 * length(upper - lower) + 1e-5 * scale});
+    }
+    std::atomic<uint64_t> looked{0};
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
+        uint64_t count = 0;
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             const Vec3f origin = starts.point(v);
+            if (cull == ShadowCull::ByCone &&
+                std::none_of(balls.begin(), balls.end(),
+                             [&](const Ball& b) { return mayMeet(Vec3d(origin), Vec3d(scene.positions[v]), Vec3d(starts.normal(v)), b); }))
+                continue;
+            ++count;
             bool hit = false;
             forEachShadowRay(scene, starts, v, [&](const Vec3f& w, float tfar, const Vec3d&) {
                 for (const Bounds3f& box : boxes) {
@@ -280,7 +358,9 @@ std::vector<uint32_t> DirectLight::raysMeeting(const Scene& scene, const VertexS
             });
             meets[v] = hit;
         }
+        looked += count;
     });
+    if (derived) *derived = looked.load();
     std::vector<uint32_t> out;
     for (uint32_t v = 0; v < scene.vertexCount(); ++v)
         if (meets[v]) out.push_back(v);
