@@ -145,6 +145,8 @@ TEST(RenderOptions, ExactlyTheFingerprintedOptionsChangeTheFingerprint) {
         const std::string reference = runFingerprint(base, scene, "", camera).digest;
         for (const RenderOption& o : renderOptions()) {
             if (!o.key || !o.set) continue;
+            // A level sets other options, which are fingerprinted (QualityLevel.ALevelAndItsValues…).
+            if (std::string(o.key) == "quality") continue;
             SCOPED_TRACE(std::string(o.key) + " with " + estimatorName(kind));
             const json other = otherValue(o, base);
             ASSERT_FALSE(other.is_null());
@@ -310,7 +312,7 @@ TEST(RenderOptions, AnUnknownKeyNamesTheNearestKnownKeyMisspeltOrInOtherWords) {
         {"estimater", "estimator"},     {"gltf_output", "gltf_out"},   {"detp_boundry", "detp_boundary"}};
     for (const auto& [typo, key] : typos)
         EXPECT_EQ(didYouMean(typo, keys), " (did you mean \"" + key + "\"?)") << typo;
-    for (const char* unrelated : {"resolution", "quality", "tone_curve"}) EXPECT_EQ(didYouMean(unrelated, keys), "") << unrelated;
+    for (const char* unrelated : {"resolution", "vignette", "tone_curve"}) EXPECT_EQ(didYouMean(unrelated, keys), "") << unrelated;
     // The same rule for flags, choices and node names.
     EXPECT_EQ(didYouMean("--photon-count", {"--photons", "--out", "--threads"}), " (did you mean \"--photons\"?)");
     EXPECT_EQ(didYouMean("photon_mapping", {"impact-count", "photon-map", "detp"}), " (did you mean \"photon-map\"?)");

@@ -214,11 +214,12 @@ json getCamera(const RenderSettings& s) {
 }
 
 // Every setting is reachable: each field of RenderSettings and of the stage settings it holds is
-// set by an option below, except the six that record where values came from (configPath,
-// radiusGiven, qmcBouncesGiven, gatherGiven, framesSource, EnvironmentSettings' source), EmissionAim's margin (FrameSolver
+// set by an option below, except the eight that record where values came from (configPath,
+// radiusGiven, qmcBouncesGiven, gatherGiven, directSamplesGiven, photonsGiven, framesSource,
+// EnvironmentSettings' source), EmissionAim's margin (FrameSolver
 // sets it from the estimator) and UpdateSettings' trackedGenerations (tests lower it). A field
 // added without an option fails here; add its option (and count it).
-static_assert(fieldCount<RenderSettings>() == 38, "a RenderSettings field was added or removed: give it an option below");
+static_assert(fieldCount<RenderSettings>() == 41, "a RenderSettings field was added or removed: give it an option below");
 static_assert(fieldCount<TraceSettings>() == 5, "a TraceSettings field was added or removed: give it an option");
 static_assert(fieldCount<EmissionAim>() == 2, "an EmissionAim field was added or removed: give it an option");
 static_assert(fieldCount<PhotonSampling>() == 2, "a PhotonSampling field was added or removed: give it an option");
@@ -320,7 +321,10 @@ std::vector<RenderOption> declareOptions() {
                  "tree (one per point, spot and directional light besides while there are at most S; past S they "
                  "are sampled too)",
                  true, true,
-                 [](RenderSettings& s, const json& v, const OptionSource&) { s.lighting.directSamples = v.get<uint32_t>(); },
+                 [](RenderSettings& s, const json& v, const OptionSource&) {
+                     s.lighting.directSamples = v.get<uint32_t>();
+                     s.directSamplesGiven = true;
+                 },
                  [](const RenderSettings& s) { return orNull(s.lighting.exactDirect(), json(s.lighting.directSamples)); }});
     o.push_back({"gather", "--gather", T::Integer, 0, double(kMaxGatherRays), "", {}, true, "M", "256",
                  "exact direct only: final-gather rays per vertex over the photon solution (0: none; the vertex then "
@@ -389,8 +393,29 @@ std::vector<RenderOption> declareOptions() {
                  true, "N", "1000000", "photons traced per frame", true, true,
                  [](RenderSettings& s, const json& v, const OptionSource& src) {
                      s.trace.photons = checkedPhotons(v.get<int64_t>(), src.file, src.place);
+                     s.photonsGiven = true;
                  },
                  [](const RenderSettings& s) { return json(s.trace.photons); }});
+    {
+        std::vector<std::string> levels;
+        for (const QualityLevel& level : kQualityLevels) levels.push_back(level.name);
+        // Not fingerprinted itself: the values it sets are, so a level and the same options given
+        // one by one make the same run.
+        o.push_back({"quality", "--quality", T::Choice, 0, 0, "", levels, true, "LEVEL", kDefaultQuality,
+                     "speed against accuracy in one knob: sets photons, gather and direct_samples, each where "
+                     "not given itself (draft 100k photons, gather 64, 16 shadow rays; fast 300k, 256, 64; "
+                     "standard, the defaults, 10^6, 256, 64; high 10^6, 1024, 64; measured error and time: "
+                     "docs/photons-and-radius.md)",
+                     false, true,
+                     [](RenderSettings& s, const json& v, const OptionSource&) {
+                         s.quality = v.get<std::string>();
+                         const QualityLevel& level = qualityLevel(s.quality);
+                         if (!s.photonsGiven) s.trace.photons = level.photons;
+                         if (!s.gatherGiven) s.lighting.gatherRays = level.gatherRays;
+                         if (!s.directSamplesGiven) s.lighting.directSamples = level.directSamples;
+                     },
+                     [](const RenderSettings& s) { return json(s.quality); }});
+    }
     o.push_back({"seed", "--seed", T::Integer, 0, double(kMaxSeed), "", {}, true, "S", "1",
                  "the random seed: the same inputs and seed give the same bytes for any thread count", true, true,
                  [](RenderSettings& s, const json& v, const OptionSource&) { s.trace.seed = v.get<uint64_t>(); },

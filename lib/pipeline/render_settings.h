@@ -12,6 +12,7 @@
 #include "estimate/estimator_settings.h"
 #include "estimate/lighting_settings.h"
 #include "estimate/vertex_fit_settings.h"
+#include "pipeline/quality_level.h"
 #include "pipeline/update_settings.h"
 #include "scene/scene.h"
 #include "trace/trace_settings.h"
@@ -39,9 +40,14 @@ struct RenderSettings {
     // own defaults are the paper's method.
     LightingSettings lighting{DirectLighting::Exact, 64, 256, LightingSettings::kGatherCacheAuto};
     bool gatherGiven = false;   // gather from the config or the command line
+    bool directSamplesGiven = false;  // direct_samples likewise
+    // The speed/accuracy level (--quality, quality_level.h): photons, gather and direct_samples
+    // where those are not given themselves. The defaults above are "standard"'s.
+    std::string quality = kDefaultQuality;
     // 10^6 photons (TraceSettings' own 10^5 is for the library's callers). K as given: a run
     // traces with effectiveTrace's, capped at max_bounces.
     TraceSettings trace{1000000, 1, 32, EmissionAim{}, PhotonSampling{}};
+    bool photonsGiven = false;  // photons from the config or the command line
     bool qmcBouncesGiven = false;  // K from the config or the command line (else the default, capped at maxBounces)
     UpdateSettings update;  // frames after the first (trackedGenerations has no option: TrackedPaths' most)
     int threads = 0;  // 0: all cores
