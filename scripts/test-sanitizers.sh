@@ -6,7 +6,7 @@
 #
 # Left out here, and run in the Release suite (scripts/test.sh step 1): the statistical tests that
 # trace millions of photons to bound a bias (or to compare with the reference renders) or 10^3-10^4
-# frames to bound drift. Under the sanitizers they run 4-5x slower (the inside-corner test alone
+# frames to bound drift, or render every --quality level against them. Under the sanitizers they run 4-5x slower (the inside-corner test alone
 # took 328 s on 2 cores) and repeat, millions of times over, code paths that the other tests take
 # under the sanitizers too: tracing, every estimator and boundary rule, disc regions,
 # incremental updates, the sweep and resume CLIs. Also left out: the glTF-Validator corpus
@@ -29,6 +29,6 @@ cd build-asan
 statistical='DetpBoundary\.(InsideCorner|OpenEdgeOfAFloor|OutsideOfASphere|FloorBesideABox|CeilingAboveALightPanel)'
 statistical+='|Estimators\.(PaperRuleMatches|PlaneUnderPointLight|ClosedSphereGives|DetpAndPhotonMapAreIndependentOfTessellation)'
 statistical+='|Incremental\.(NoDriftOverTenThousandFrames|RememberedCrossingsLeaveNoTraceAfterAThousandFrames)|Sweep\.TinyGrid|ReferenceAccuracy|GatherAccuracy|FinalGather\.ClosedSphere'
-statistical+='|Sobol\.AgreesWith'
+statistical+='|Sobol\.AgreesWith|QualityLevel\.EachLevelsErrorOnTheCommittedReferences'
 statistical+='|Materials\.(AClosedSphereWithATexturedAlbedo|TheMaterialsRoomAgreesWith|EachFeatureAgreesWith)'
 ctest --output-on-failure -j 2 -E "$statistical|ValidatorCorpus" "$@"
