@@ -331,11 +331,14 @@ std::vector<uint32_t> DirectLight::raysMeeting(const Scene& scene, const VertexS
     std::vector<uint8_t> meets(scene.vertexCount(), 0);
     if (boxes.empty()) return {};
     // Each box's ball, padded far beyond a shadow ray's rounding (its float direction and length
-    // are a few ulps off the double segment): no ray the exact test would take is culled.
+    // are a few ulps off the double segment, over at most the scene's and the lights' reach): no
+    // ray the exact test would take is culled.
+    const Bounds3f sceneBounds = scene.bounds();
+    const double sceneScale = std::max(length(Vec3d(sceneBounds.lower)), length(Vec3d(sceneBounds.upper)));
     std::vector<Ball> balls;
     for (const Bounds3f& box : boxes) {
         const Vec3d lower(box.lower), upper(box.upper);
-        const double scale = std::max({length(lower), length(upper), reachScale_});
+        const double scale = std::max({length(lower), length(upper), reachScale_, sceneScale});
         balls.push_back({(lower + upper) * 0.5, 0.5 * length(upper - lower) + 1e-5 * scale});
     }
     std::atomic<uint64_t> looked{0};
