@@ -133,7 +133,9 @@ bool DirectLight::mayMeet(const Vec3d& start, const Vec3d& p, const Vec3d& n, co
         const LightTree::Node& node = tree_.node(stack.back());
         const uint32_t index = stack.back();
         stack.pop_back();
-        if (!(node.bounds.importance(p, n) > 0) && tree_.nodeCount() > 1) continue;
+        // sample() never asks the root's importance (a single emitter, or a panel at the root, is
+        // chosen whatever it is): nor does the cull.
+        if (index != 0 && !(node.bounds.importance(p, n) > 0)) continue;
         const Vec3d lower(node.bounds.box.lower), upper(node.bounds.box.upper);
         if (!coneMeets(start, (lower + upper) * 0.5, 0.5 * length(upper - lower), box.centre, box.radius)) continue;
         if (node.leaf() || node.panel) return true;

@@ -167,6 +167,9 @@ FrameSolver::PoseChange FrameSolver::changeTo(const Pose& target) {
 
 double FrameSolver::foreseenUpdateShare(const Pose& current, const EnvelopeTails& tails, uint64_t segments) {
     decision_.shares.clear();
+    // A hidden vertex keeps the last normal a visible pose gave it (Scene::applyPose): the steps
+    // must not leave theirs on the vertices hidden now, which the frame's files carry.
+    const std::vector<Vec3f> normals = scene_.normals;
     for (const auto& [from, to] : lookAhead_) {
         changeTo(from);
         const PoseChange change = changeTo(to);
@@ -188,6 +191,7 @@ double FrameSolver::foreseenUpdateShare(const Pose& current, const EnvelopeTails
         decision_.shares.push_back(updateShare(affected, segments, moved));
     }
     changeTo(current);  // the same pose, the same bits: the BVH was never moved from it
+    scene_.normals = normals;
     std::vector<double> sorted = decision_.shares;
     std::sort(sorted.begin(), sorted.end());
     decision_.median = sorted.empty() ? 0 : sorted[sorted.size() / 2];
@@ -244,7 +248,13 @@ FrameSolver::Verdict FrameSolver::judge(const PoseChange& change, size_t recompu
     if (settings_.update.fullRecompute) verdict.reason = FromScratchReason::FullRecompute;
     else if (!estimator_->canUpdate()) verdict.reason = FromScratchReason::EstimatorHasNoUpdate;
     else if (mode_ == Mode::FromScratch && !lastCache_) verdict.reason = FromScratchReason::NoKeptState;
-    else if (change.any) {
+    else if (change.any && !settings_.update.alwaysUpdate && mode_ == Mode::FromScratch &&
+             trackingBuildShare() > kWorthUpdatingBelow) {
+        // The build alone would cost more than the frame: no count can make the update worth it,
+        // so the cache is not scanned for one.
+        verdict.predictedUpdateShare = trackingBuildShare();
+        verdict.reason = FromScratchReason::ChangeTooLarge;
+    } else if (change.any) {
         verdict.predictedUpdateShare = predictedUpdateShare(change, recomputed);
         if (!settings_.update.alwaysUpdate && verdict.predictedUpdateShare > kWorthUpdatingBelow)
             verdict.reason = FromScratchReason::ChangeTooLarge;
@@ -294,6 +304,11 @@ FrameSolver::Solution FrameSolver::solve(const Pose& target, bool updateFollows)
                 if (track) {
                     lastCache_.reset();  // not held beside the tracking state while it is built
                     startTracking(record, &tails, record.segments);
+                } else {
+                    // What a build would track, for the later frames' verdicts: the tails.
+                    uint64_t tailSegments = 0;
+                    for (const std::vector<Segment>& block : tails.blocks) tailSegments += block.size();
+                    trackedShare_ = double(tailSegments) / double(std::max<uint64_t>(record.segments, 1));
                 }
             } else {
                 decision_ = {"track", {}, 0};

@@ -192,7 +192,8 @@ struct Scene {
     // A sampling mesh's (the vertex fit's, lib/pipeline/vertex_fit_stage.h), else empty: at each of
     // the output's own vertices, its longest incident edge on the output mesh (rest pose); 0 at the
     // samples added between them. The covered-vertex rule (VertexStarts' cover height) judges the
-    // output's vertices by it, as a run without the fit does, and the added samples by their own
+    // output's vertices by it, as a run without the fit does (exactly for a rigid mesh; a deforming
+    // one's edges are its rest pose's), and the added samples by their own
     // finer edges: a gap the output cannot resolve covers its vertices, not the samples between.
     std::vector<float> coverEdges;
 

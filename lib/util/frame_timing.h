@@ -24,7 +24,8 @@ struct FrameTiming {
     std::string fromScratchReason;
     // What updating this frame was predicted to cost, in shares of a from-scratch frame, from
     // counts before any work (FrameSolver::predictedUpdateShare; 0 where nothing was predicted:
-    // the first frame, a frame nothing moved in, --full-recompute).
+    // a frame nothing moved in, --full-recompute; where the tracking build alone passes 0.8, that
+    // build's share; at the first frame, the look-ahead's median, else 0).
     double predictedUpdateShare = 0;
     double findAffectedSeconds = 0, retraceSeconds = 0;  // the parts of an update's photon time
     double photonSimulationSeconds = 0;  // tracing (or finding and retracing) photons
