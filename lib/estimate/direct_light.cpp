@@ -113,7 +113,7 @@ bool coneMeets(const Vec3d& start, const Vec3d& lightsCentre, double lightsRadiu
 }
 }  // namespace
 
-bool DirectLight::mayMeet(const Vec3d& start, const Vec3d& p, const Vec3d& n, const Ball& box) const {
+bool DirectLight::mayMeet(const Vec3d& start, const Vec3d& p, const Vec3d& n, const Ball& box, std::vector<uint32_t>& stack) const {
     const Vec3d towardBox = box.centre - start;
     if (length(towardBox) <= box.radius) return true;
     // The environment's rays: anywhere above the tangent plane.
@@ -128,7 +128,7 @@ bool DirectLight::mayMeet(const Vec3d& start, const Vec3d& p, const Vec3d& n, co
     // The tree's emitters: down every node a sample can reach from (p, n) (importance above 0, as
     // LightTree::sample descends) whose box's ball the box's cone meets, to a leaf or a panel.
     if (tree_.empty()) return false;
-    std::vector<uint32_t> stack = {0};
+    stack.assign(1, 0);
     while (!stack.empty()) {
         const LightTree::Node& node = tree_.node(stack.back());
         const uint32_t index = stack.back();
@@ -346,11 +346,12 @@ std::vector<uint32_t> DirectLight::raysMeeting(const Scene& scene, const VertexS
     std::atomic<uint64_t> looked{0};
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(scene.vertexCount()), 64), [&](const tbb::blocked_range<uint32_t>& r) {
         uint64_t count = 0;
+        std::vector<uint32_t> stack;
         for (uint32_t v = r.begin(); v != r.end(); ++v) {
             const Vec3f origin = starts.point(v);
-            if (cull == ShadowCull::ByCone &&
-                std::none_of(balls.begin(), balls.end(),
-                             [&](const Ball& b) { return mayMeet(Vec3d(origin), Vec3d(scene.positions[v]), Vec3d(starts.normal(v)), b); }))
+            if (cull == ShadowCull::ByCone && std::none_of(balls.begin(), balls.end(), [&](const Ball& b) {
+                    return mayMeet(Vec3d(origin), Vec3d(scene.positions[v]), Vec3d(starts.normal(v)), b, stack);
+                }))
                 continue;
             ++count;
             bool hit = false;

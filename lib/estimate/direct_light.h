@@ -111,7 +111,9 @@ private:
         Vec3d centre{0.0};
         double radius = 0;
     };
-    bool mayMeet(const Vec3d& start, const Vec3d& p, const Vec3d& n, const Ball& box) const;
+    // `stack`: the tree descent's, reused by the caller across vertices (this runs for every
+    // vertex of every later frame).
+    bool mayMeet(const Vec3d& start, const Vec3d& p, const Vec3d& n, const Ball& box, std::vector<uint32_t>& stack) const;
 
     uint32_t samples_;
     uint64_t seed_;

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <mutex>
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
@@ -175,20 +174,13 @@ double FrameSolver::foreseenUpdateShare(const Pose& current, const EnvelopeTails
         const PoseChange change = changeTo(to);
         // A segment that meets no part of the envelope can neither impact a mover nor pass
         // through one in any frame: the tails hold every segment the count can find.
-        AffectedCount affected;
-        if (change.any) {
-            std::mutex sum;
-            tbb::parallel_for(size_t(0), tails.blocks.size(), [&](size_t b) {
-                const AffectedCount counted = countAffected(tails.blocks[b], change);
-                const std::lock_guard<std::mutex> lock(sum);
-                affected.listed += counted.listed;
-                affected.nearMovers += counted.nearMovers;
-            });
-        }
+        AffectedTally affected;
+        if (change.any)
+            tbb::parallel_for(size_t(0), tails.blocks.size(), [&](size_t b) { affected.add(countAffected(tails.blocks[b], change)); });
         // The vertices that moved are recomputed at least; the disc regions a move changes
         // beside them are not known without computing them, so the count is a lower bound.
         const size_t moved = size_t(std::count(change.vertexMoved.begin(), change.vertexMoved.end(), uint8_t(1)));
-        decision_.shares.push_back(updateShare(affected, segments, moved));
+        decision_.shares.push_back(updateShare(affected.total(), segments, moved));
     }
     changeTo(current);  // the same pose, the same bits: the BVH was never moved from it
     scene_.normals = normals;
@@ -215,13 +207,9 @@ double FrameSolver::predictedUpdateShare(const PoseChange& change, size_t recomp
         segments = foldedSegments_ + tracked_->trackedSegments();
     } else {
         segments = lastCache_->segmentCount();
-        std::mutex sum;
-        lastCache_->forEachBlock([&](size_t, const std::vector<Segment>& block) {
-            const AffectedCount counted = countAffected(block, change);
-            const std::lock_guard<std::mutex> lock(sum);
-            affected.listed += counted.listed;
-            affected.nearMovers += counted.nearMovers;
-        });
+        AffectedTally tally;
+        lastCache_->forEachBlock([&](size_t, const std::vector<Segment>& block) { tally.add(countAffected(block, change)); });
+        affected = tally.total();
     }
     return updateShare(affected, segments, recomputed) + trackingBuildShare();
 }

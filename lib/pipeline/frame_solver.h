@@ -5,6 +5,7 @@
 // bits (fixed-point sums, identical hits). The solver knows no estimator: each owns its update.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -156,6 +157,15 @@ private:
     // passing through a mover's new bounds (rule b's candidates).
     struct AffectedCount {
         uint64_t listed = 0, nearMovers = 0;
+    };
+    // Sums countAffected over blocks counted on any thread (integer sums: any order, the same total).
+    struct AffectedTally {
+        std::atomic<uint64_t> listed{0}, nearMovers{0};
+        void add(const AffectedCount& c) {
+            listed += c.listed;
+            nearMovers += c.nearMovers;
+        }
+        AffectedCount total() const { return {listed.load(), nearMovers.load()}; }
     };
     static AffectedCount countAffected(const std::vector<Segment>& block, const PoseChange& change);
     // What updating costs, as a share of a frame from scratch, for the counts of `segments` in all
